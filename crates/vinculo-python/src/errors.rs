@@ -1,0 +1,117 @@
+//! Maps core errors onto the exception classes of `vinculo.errors` (one root, `VinculoError`).
+
+use pyo3::exceptions::PyRuntimeError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use vinculo::Error;
+
+/// Builds the Python exception `vinculo.errors.<class>(message, **details)`.
+pub fn raise(py: Python<'_>, class: &str, message: String, details: Bound<'_, PyDict>) -> PyErr {
+    let built = (|| -> PyResult<PyErr> {
+        let cls = py.import("vinculo.errors")?.getattr(class)?;
+        let exc = cls.call((message.clone(),), Some(&details))?;
+        Ok(PyErr::from_value(exc))
+    })();
+    built.unwrap_or_else(|e| {
+        PyRuntimeError::new_err(format!(
+            "{message} (and the error class {class} could not be built: {e})"
+        ))
+    })
+}
+
+/// The details each variant carries, as keyword arguments.
+pub fn details<'py>(py: Python<'py>, e: &Error) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    match e {
+        Error::InvalidParameter { name, value, .. } => {
+            d.set_item("name", name)?;
+            d.set_item("value", value)?;
+        }
+        Error::InvalidVector { name, value, .. } => {
+            d.set_item("name", name)?;
+            d.set_item("value", value.clone())?;
+        }
+        Error::SameParticle { particle, .. } => d.set_item("value", particle)?,
+        Error::ConstraintOnFixedParticles { what } => d.set_item("name", what)?,
+        Error::UnknownParticle { index, .. } => d.set_item("value", index)?,
+        Error::LawOutOfDomain { what, .. } => d.set_item("name", what)?,
+        Error::InconsistentInitialState {
+            constraint,
+            violation,
+            tolerance,
+            ..
+        } => {
+            d.set_item("constraint", constraint)?;
+            d.set_item("violation", violation)?;
+            d.set_item("tolerance", tolerance)?;
+        }
+        Error::ProjectionFailed {
+            iterations,
+            residual,
+            equation,
+        } => {
+            d.set_item("iterations", iterations)?;
+            d.set_item("residual", residual)?;
+            d.set_item("equation", equation)?;
+        }
+        Error::NewtonFailed {
+            t,
+            dt,
+            iterations,
+            residual,
+            equation,
+        } => {
+            d.set_item("time", t)?;
+            d.set_item("step_size", dt)?;
+            d.set_item("iterations", iterations)?;
+            d.set_item("residual", residual)?;
+            d.set_item("equation", equation)?;
+        }
+        Error::SingularMatrix { t, detail } => {
+            d.set_item("time", t)?;
+            d.set_item("equation", detail)?;
+        }
+        Error::Interrupted { t } => d.set_item("time", t)?,
+    }
+    Ok(d)
+}
+
+/// Converts a core error into the matching Python exception.
+pub fn to_py(e: Error) -> PyErr {
+    Python::attach(|py| match details(py, &e) {
+        Ok(d) => raise(py, e.kind(), e.to_string(), d),
+        Err(err) => err,
+    })
+}
+
+/// An input error with a name and value, raised as `InvalidInputError`.
+pub fn invalid(name: &str, value: impl std::fmt::Display, expected: &str) -> PyErr {
+    Python::attach(|py| {
+        let d = PyDict::new(py);
+        let _ = d.set_item("name", name);
+        let _ = d.set_item("value", value.to_string());
+        raise(
+            py,
+            "InvalidInputError",
+            format!("invalid {name}: {value} ({expected})"),
+            d,
+        )
+    })
+}
+
+/// Turns a panic (a bug) into `InternalError` instead of crashing the interpreter.
+pub fn internal(payload: Box<dyn std::any::Any + Send>) -> PyErr {
+    let what = payload
+        .downcast_ref::<String>()
+        .cloned()
+        .or_else(|| payload.downcast_ref::<&str>().map(|s| s.to_string()))
+        .unwrap_or_else(|| "unknown panic".into());
+    Python::attach(|py| {
+        raise(
+            py,
+            "InternalError",
+            format!("internal error in vinculo's core (please report it): {what}"),
+            PyDict::new(py),
+        )
+    })
+}

@@ -1,0 +1,20 @@
+//! `vinculo._core`: PyO3 glue between the Rust core and the Python package. Conversions,
+//! exceptions and thin wrappers only; the physics lives in the `vinculo` crate.
+
+mod errors;
+mod laws;
+mod run;
+mod system;
+
+use pyo3::prelude::*;
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<laws::PyLaw>()?;
+    m.add_class::<system::PySystem>()?;
+    m.add_class::<system::PyParticleId>()?;
+    m.add_class::<system::PyConstraintId>()?;
+    m.add_class::<system::PyForceId>()?;
+    m.add_function(wrap_pyfunction!(run::simulate, m)?)?;
+    Ok(())
+}

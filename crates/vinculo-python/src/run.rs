@@ -1,0 +1,150 @@
+//! `simulate`: runs the core without the GIL, reports progress, returns numpy arrays.
+
+use crate::errors::{details, invalid, to_py};
+use crate::system::PySystem;
+use numpy::ndarray::{Array1, Array2, Array3};
+use numpy::IntoPyArray;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::time::{Duration, Instant};
+use vinculo::integrators::NewtonOptions;
+use vinculo::{simulate_with_observer, Observer, SimulationOptions};
+
+/// Calls the Python progress callback and checks for Ctrl-C about twice a second.
+struct Progress {
+    callback: Option<Py<PyAny>>,
+    last: Instant,
+    error: Option<PyErr>,
+}
+
+impl Observer for Progress {
+    fn step(&mut self, t: f64, t_end: f64) -> bool {
+        if self.last.elapsed() < Duration::from_millis(500) {
+            return true;
+        }
+        self.last = Instant::now();
+        Python::attach(|py| {
+            let result = py.check_signals().and_then(|_| match &self.callback {
+                Some(cb) => cb.call1(py, (t, t_end)).map(|_| ()),
+                None => Ok(()),
+            });
+            match result {
+                Ok(()) => true,
+                Err(e) => {
+                    self.error = Some(e);
+                    false
+                }
+            }
+        })
+    }
+}
+
+/// Integrates the system; see the type stubs (`_core.pyi`) for the returned dictionary.
+#[pyfunction]
+#[pyo3(signature = (system, t_end, dt, alpha=0.5, t_start=0.0, tolerance=1e-10, max_iterations=25,
+                    max_halvings=4, initial_tolerance=1e-8, save_every=1, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn simulate<'py>(
+    py: Python<'py>,
+    system: PyRef<'py, PySystem>,
+    t_end: f64,
+    dt: f64,
+    alpha: f64,
+    t_start: f64,
+    tolerance: f64,
+    max_iterations: i64,
+    max_halvings: i64,
+    initial_tolerance: f64,
+    save_every: i64,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let count = |name: &str, v: i64, min: i64| -> PyResult<usize> {
+        if v < min {
+            Err(invalid(name, v, &format!("must be an integer >= {min}")))
+        } else {
+            Ok(v as usize)
+        }
+    };
+    let options = SimulationOptions {
+        t_start,
+        t_end,
+        dt,
+        alpha,
+        newton: NewtonOptions {
+            tolerance,
+            max_iterations: count("max_iterations", max_iterations, 1)?,
+        },
+        max_halvings: count("max_halvings", max_halvings, 0)?,
+        initial_tolerance,
+        save_every: count("save_every", save_every, 1)?,
+        ..Default::default()
+    };
+    let model = &system.inner;
+    let mut observer = Progress {
+        callback: progress,
+        last: Instant::now(),
+        error: None,
+    };
+    let result = py.detach(|| {
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            simulate_with_observer(model, &options, &mut observer)
+        }))
+    });
+    if let Some(e) = observer.error.take() {
+        return Err(e);
+    }
+    let sol = result.map_err(crate::errors::internal)?.map_err(to_py)?;
+
+    let (s, n, m) = (sol.len(), sol.particles, sol.constraints);
+    let out = PyDict::new(py);
+    out.set_item("times", Array1::from(sol.times.clone()).into_pyarray(py))?;
+    out.set_item(
+        "positions",
+        Array3::from_shape_vec((s, n, 3), sol.positions.clone())
+            .expect("shape")
+            .into_pyarray(py),
+    )?;
+    out.set_item(
+        "velocities",
+        Array3::from_shape_vec((s, n, 3), sol.velocities.clone())
+            .expect("shape")
+            .into_pyarray(py),
+    )?;
+    out.set_item(
+        "multipliers",
+        Array2::from_shape_vec((s, m), sol.multipliers.clone())
+            .expect("shape")
+            .into_pyarray(py),
+    )?;
+    out.set_item(
+        "constraint_residual",
+        Array1::from(sol.constraint_residual.clone()).into_pyarray(py),
+    )?;
+    let stat = |f: &dyn Fn(&vinculo::StepStats) -> f64| Array1::from_iter(sol.stats.iter().map(f));
+    out.set_item(
+        "newton_iterations",
+        Array1::from_iter(sol.stats.iter().map(|x| x.newton_iterations as i64)).into_pyarray(py),
+    )?;
+    out.set_item("step_sizes", stat(&|x| x.step_size).into_pyarray(py))?;
+    out.set_item(
+        "residual_norms",
+        stat(&|x| x.residual_norm).into_pyarray(py),
+    )?;
+    out.set_item(
+        "increment_norms",
+        stat(&|x| x.increment_norm).into_pyarray(py),
+    )?;
+    out.set_item("steps_taken", sol.steps_taken)?;
+    out.set_item("steps_rejected", sol.steps_rejected)?;
+    out.set_item("linear_solver", sol.linear_solver)?;
+    match &sol.status {
+        Ok(()) => out.set_item("error", py.None())?,
+        Err(e) => {
+            let d = details(py, e)?;
+            d.set_item("kind", e.kind())?;
+            d.set_item("message", e.to_string())?;
+            out.set_item("error", d)?;
+        }
+    }
+    Ok(out)
+}

@@ -1,0 +1,456 @@
+//! `System` and the typed handles, wrapping the core's builder.
+
+use crate::errors::{invalid, to_py};
+use crate::laws::{scalar, vector};
+use numpy::ndarray::{Array1, Array2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn, PyReadonlyArrayDyn};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use vinculo::model::{ParticleId, System};
+
+/// Handle to a particle of one System.
+#[pyclass(name = "ParticleId", module = "vinculo._core", frozen, eq, hash)]
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct PyParticleId {
+    pub inner: ParticleId,
+}
+
+#[pymethods]
+impl PyParticleId {
+    /// Position of the particle in the arrays of a Solution.
+    #[getter]
+    fn index(&self) -> usize {
+        self.inner.index()
+    }
+    fn __repr__(&self) -> String {
+        format!("ParticleId({})", self.inner.index())
+    }
+}
+
+/// Handle to a constraint: the index of its multiplier.
+#[pyclass(name = "ConstraintId", module = "vinculo._core", frozen, eq, hash)]
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct PyConstraintId {
+    #[pyo3(get)]
+    index: usize,
+}
+
+#[pymethods]
+impl PyConstraintId {
+    fn __repr__(&self) -> String {
+        format!("ConstraintId({})", self.index)
+    }
+}
+
+/// Handle to a force element.
+#[pyclass(name = "ForceId", module = "vinculo._core", frozen, eq, hash)]
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct PyForceId {
+    #[pyo3(get)]
+    index: usize,
+}
+
+#[pymethods]
+impl PyForceId {
+    fn __repr__(&self) -> String {
+        format!("ForceId({})", self.index)
+    }
+}
+
+/// Positions or velocities of every particle at one instant.
+type Frame = Vec<[f64; 3]>;
+
+/// A constrained particle system under uniform gravity.
+#[pyclass(name = "System", module = "vinculo._core")]
+pub struct PySystem {
+    pub inner: System,
+}
+
+fn vec3(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<[f64; 3]> {
+    let v: Vec<f64> = obj.extract().map_err(|_| {
+        invalid(
+            what,
+            obj.repr().map(|r| r.to_string()).unwrap_or_default(),
+            "expected 3 numbers",
+        )
+    })?;
+    if v.len() != 3 {
+        return Err(invalid(
+            what,
+            format!("{v:?}"),
+            "expected exactly 3 numbers",
+        ));
+    }
+    Ok([v[0], v[1], v[2]])
+}
+
+impl PySystem {
+    fn particle(&self, obj: &Bound<'_, PyAny>) -> PyResult<ParticleId> {
+        let id = obj.cast::<PyParticleId>().map_err(|_| {
+            Python::attach(|py| {
+                let d = PyDict::new(py);
+                let _ = d.set_item("value", obj.clone());
+                crate::errors::raise(
+                    py,
+                    "UnknownHandleError",
+                    format!(
+                        "expected a ParticleId returned by System.add_particle, got {}",
+                        obj.repr().map(|r| r.to_string()).unwrap_or_default()
+                    ),
+                    d,
+                )
+            })
+        })?;
+        let id = id.get().inner;
+        self.inner.check(id).map_err(to_py)?;
+        Ok(id)
+    }
+
+    /// Reads an (..., n, 3) array as a list of (n, 3) frames.
+    fn frames(
+        &self,
+        array: &PyReadonlyArrayDyn<'_, f64>,
+        what: &str,
+    ) -> PyResult<(Vec<usize>, Vec<Frame>)> {
+        let a = array.as_array();
+        let shape = a.shape().to_vec();
+        let n = self.inner.particles().len();
+        if shape.len() < 2 || shape[shape.len() - 1] != 3 || shape[shape.len() - 2] != n {
+            return Err(invalid(
+                what,
+                format!("array of shape {shape:?}"),
+                &format!("expected shape (..., {n}, 3)"),
+            ));
+        }
+        let flat: Vec<f64> = a.iter().copied().collect();
+        let frames = flat
+            .chunks(3 * n)
+            .map(|c| c.chunks(3).map(|x| [x[0], x[1], x[2]]).collect())
+            .collect();
+        Ok((shape[..shape.len() - 2].to_vec(), frames))
+    }
+}
+
+fn positions_array<'py>(py: Python<'py>, x: &[[f64; 3]]) -> Bound<'py, PyArray2<f64>> {
+    Array2::from_shape_vec((x.len(), 3), x.iter().flatten().copied().collect())
+        .expect("shape")
+        .into_pyarray(py)
+}
+
+#[pymethods]
+impl PySystem {
+    #[new]
+    #[pyo3(signature = (gravity=None))]
+    fn new(gravity: Option<&Bound<'_, PyAny>>) -> PyResult<PySystem> {
+        let g = match gravity {
+            Some(g) => vec3(g, "gravity")?,
+            None => [0.0; 3],
+        };
+        Ok(PySystem {
+            inner: System::try_new(g).map_err(to_py)?,
+        })
+    }
+
+    /// Adds a point mass; returns its handle. Fixed particles never move.
+    #[pyo3(signature = (mass, position, velocity=None, fixed=false))]
+    fn add_particle(
+        &mut self,
+        mass: f64,
+        position: &Bound<'_, PyAny>,
+        velocity: Option<&Bound<'_, PyAny>>,
+        fixed: bool,
+    ) -> PyResult<PyParticleId> {
+        let index = self.inner.particles().len();
+        let x = vec3(position, &format!("position of particle {index}"))?;
+        let v = match velocity {
+            Some(v) => vec3(v, &format!("velocity of particle {index}"))?,
+            None => [0.0; 3],
+        };
+        Ok(PyParticleId {
+            inner: self.inner.add_particle(mass, x, v, fixed).map_err(to_py)?,
+        })
+    }
+
+    /// Fixed distance between two particles, Phi = L^2 - |q_a - q_b|^2 (length=None: current).
+    #[pyo3(signature = (a, b, length=None))]
+    fn add_distance(
+        &mut self,
+        a: &Bound<'_, PyAny>,
+        b: &Bound<'_, PyAny>,
+        length: Option<f64>,
+    ) -> PyResult<PyConstraintId> {
+        let (a, b) = (self.particle(a)?, self.particle(b)?);
+        let id = self.inner.add_distance(a, b, length).map_err(to_py)?;
+        Ok(PyConstraintId { index: id.0 })
+    }
+
+    /// Fixed distance from a particle to a prescribed point p(t), Phi = L^2 - |q - p(t)|^2.
+    #[pyo3(signature = (particle, point, length=None))]
+    fn add_distance_to_point(
+        &mut self,
+        particle: &Bound<'_, PyAny>,
+        point: &Bound<'_, PyAny>,
+        length: Option<f64>,
+    ) -> PyResult<PyConstraintId> {
+        let p = self.particle(particle)?;
+        let point = vector(point, "point")?;
+        let id = self
+            .inner
+            .add_distance_to_point(p, point, length)
+            .map_err(to_py)?;
+        Ok(PyConstraintId { index: id.0 })
+    }
+
+    /// Particle on the plane n(t).(q - p0(t)) = 0.
+    fn add_plane(
+        &mut self,
+        particle: &Bound<'_, PyAny>,
+        normal: &Bound<'_, PyAny>,
+        point: &Bound<'_, PyAny>,
+    ) -> PyResult<PyConstraintId> {
+        let p = self.particle(particle)?;
+        let (n, p0) = (
+            vector(normal, "plane normal")?,
+            vector(point, "plane point")?,
+        );
+        let id = self.inner.add_plane(p, n, p0).map_err(to_py)?;
+        Ok(PyConstraintId { index: id.0 })
+    }
+
+    /// q[axis] = value(t); axis 0/1/2 or "x"/"y"/"z"; value=None keeps the current coordinate.
+    #[pyo3(signature = (particle, axis, value=None))]
+    fn add_fixed_coordinate(
+        &mut self,
+        particle: &Bound<'_, PyAny>,
+        axis: &Bound<'_, PyAny>,
+        value: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<PyConstraintId> {
+        let p = self.particle(particle)?;
+        let axis = if let Ok(s) = axis.extract::<String>() {
+            match s.as_str() {
+                "x" => 0,
+                "y" => 1,
+                "z" => 2,
+                _ => return Err(invalid("axis", s, "expected 0, 1, 2 or 'x', 'y', 'z'")),
+            }
+        } else {
+            axis.extract::<usize>()
+                .map_err(|_| invalid("axis", axis, "expected 0, 1, 2 or 'x', 'y', 'z'"))?
+        };
+        let value = value
+            .map(|v| scalar(v, "fixed coordinate value"))
+            .transpose()?;
+        let id = self
+            .inner
+            .add_fixed_coordinate(p, axis, value)
+            .map_err(to_py)?;
+        Ok(PyConstraintId { index: id.0 })
+    }
+
+    /// Linear spring (stiffness, rest_length; None: current distance) with a parallel dashpot.
+    #[pyo3(signature = (a, b, stiffness, damping=0.0, rest_length=None))]
+    fn add_spring_damper(
+        &mut self,
+        a: &Bound<'_, PyAny>,
+        b: &Bound<'_, PyAny>,
+        stiffness: f64,
+        damping: f64,
+        rest_length: Option<f64>,
+    ) -> PyResult<PyForceId> {
+        let (a, b) = (self.particle(a)?, self.particle(b)?);
+        let id = self
+            .inner
+            .add_spring_damper(a, b, stiffness, damping, rest_length)
+            .map_err(to_py)?;
+        Ok(PyForceId { index: id.0 })
+    }
+
+    /// A prescribed force (3 numbers or Laws, N) on a particle.
+    fn add_force(
+        &mut self,
+        particle: &Bound<'_, PyAny>,
+        force: &Bound<'_, PyAny>,
+    ) -> PyResult<PyForceId> {
+        let p = self.particle(particle)?;
+        let f = vector(force, "force")?;
+        let id = self.inner.add_force(p, f).map_err(to_py)?;
+        Ok(PyForceId { index: id.0 })
+    }
+
+    /// Linear drag f = -c v.
+    fn add_linear_drag(
+        &mut self,
+        particle: &Bound<'_, PyAny>,
+        coefficient: f64,
+    ) -> PyResult<PyForceId> {
+        let p = self.particle(particle)?;
+        let id = self.inner.add_linear_drag(p, coefficient).map_err(to_py)?;
+        Ok(PyForceId { index: id.0 })
+    }
+
+    /// Quadratic drag f = -c |v| v.
+    fn add_quadratic_drag(
+        &mut self,
+        particle: &Bound<'_, PyAny>,
+        coefficient: f64,
+    ) -> PyResult<PyForceId> {
+        let p = self.particle(particle)?;
+        let id = self
+            .inner
+            .add_quadratic_drag(p, coefficient)
+            .map_err(to_py)?;
+        Ok(PyForceId { index: id.0 })
+    }
+
+    /// Number of particles.
+    #[getter]
+    fn num_particles(&self) -> usize {
+        self.inner.particles().len()
+    }
+
+    /// Number of constraint equations (length of the multiplier vector).
+    #[getter]
+    fn num_constraints(&self) -> usize {
+        self.inner.constraints().len()
+    }
+
+    /// Gravity vector.
+    #[getter]
+    fn gravity(&self) -> (f64, f64, f64) {
+        let g = self.inner.gravity();
+        (g[0], g[1], g[2])
+    }
+
+    /// Handles of all particles, in order.
+    fn particles(&self) -> PyResult<Vec<PyParticleId>> {
+        (0..self.inner.particles().len())
+            .map(|i| {
+                Ok(PyParticleId {
+                    inner: self.inner.particle_id(i).map_err(to_py)?,
+                })
+            })
+            .collect()
+    }
+
+    /// Masses (n,).
+    fn masses<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        Array1::from_iter(self.inner.particles().iter().map(|p| p.mass)).into_pyarray(py)
+    }
+
+    /// Which particles are fixed (n,).
+    fn fixed<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
+        Array1::from_iter(self.inner.particles().iter().map(|p| p.fixed)).into_pyarray(py)
+    }
+
+    /// Initial positions (n, 3).
+    fn initial_positions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        positions_array(py, &self.inner.initial_positions())
+    }
+
+    /// Initial velocities (n, 3).
+    fn initial_velocities<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        positions_array(py, &self.inner.initial_velocities())
+    }
+
+    /// One readable name per constraint equation.
+    fn constraint_names(&self) -> Vec<String> {
+        self.inner.constraint_names()
+    }
+
+    /// Per equation, s_k such that s_k Phi_k is a length.
+    fn constraint_scales<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        Array1::from_iter(self.inner.constraints().iter().map(|c| c.scale())).into_pyarray(py)
+    }
+
+    /// Characteristic length of the model (tolerances are relative to it).
+    fn length_scale(&self) -> f64 {
+        self.inner.length_scale()
+    }
+
+    /// Phi(q, t) per equation for (n, 3) positions.
+    #[pyo3(signature = (positions, t=0.0))]
+    fn constraint_residual<'py>(
+        &self,
+        py: Python<'py>,
+        positions: PyReadonlyArrayDyn<'py, f64>,
+        t: f64,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let (outer, frames) = self.frames(&positions, "positions")?;
+        if !outer.is_empty() {
+            return Err(invalid(
+                "positions",
+                format!("array with {} leading dimensions", outer.len()),
+                "expected a single (n, 3) frame",
+            ));
+        }
+        Ok(Array1::from(self.inner.constraint_residual(&frames[0], t)).into_pyarray(py))
+    }
+
+    /// Kinetic energy of (..., n, 3) velocities.
+    fn kinetic_energy<'py>(
+        &self,
+        py: Python<'py>,
+        velocities: PyReadonlyArrayDyn<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let (outer, frames) = self.frames(&velocities, "velocities")?;
+        let e: Vec<f64> = frames
+            .iter()
+            .map(|v| self.inner.kinetic_energy(v))
+            .collect();
+        Ok(numpy::ndarray::ArrayD::from_shape_vec(outer, e)
+            .expect("shape")
+            .into_pyarray(py))
+    }
+
+    /// Potential energy (gravity and springs) of (..., n, 3) positions.
+    fn potential_energy<'py>(
+        &self,
+        py: Python<'py>,
+        positions: PyReadonlyArrayDyn<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let (outer, frames) = self.frames(&positions, "positions")?;
+        let e: Vec<f64> = frames
+            .iter()
+            .map(|q| self.inner.potential_energy(q))
+            .collect();
+        Ok(numpy::ndarray::ArrayD::from_shape_vec(outer, e)
+            .expect("shape")
+            .into_pyarray(py))
+    }
+
+    /// Moves the initial state onto the position and velocity constraints with the least
+    /// mass-weighted change; returns how far it moved.
+    #[pyo3(signature = (tolerance=1e-12, max_iterations=50, t=0.0))]
+    fn project_initial_state<'py>(
+        &mut self,
+        py: Python<'py>,
+        tolerance: f64,
+        max_iterations: usize,
+        t: f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        if !(tolerance.is_finite() && tolerance > 0.0) {
+            return Err(invalid("tolerance", tolerance, "must be finite and > 0"));
+        }
+        let system = &mut self.inner;
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            vinculo::initial::project_initial_state(system, t, tolerance, max_iterations)
+        }))
+        .map_err(crate::errors::internal)?;
+        let r = result.map_err(to_py)?;
+        let d = PyDict::new(py);
+        d.set_item("position_change", r.position_change)?;
+        d.set_item("velocity_change", r.velocity_change)?;
+        d.set_item("iterations", r.iterations)?;
+        Ok(d)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "System({} particles, {} constraints, {} forces, gravity={:?})",
+            self.inner.particles().len(),
+            self.inner.constraints().len(),
+            self.inner.forces().len(),
+            self.inner.gravity()
+        )
+    }
+}

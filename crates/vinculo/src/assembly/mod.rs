@@ -1,0 +1,206 @@
+//! The iteration matrix's layout: unknowns, sparsity pattern (computed once per model) and, for
+//! every element, the positions ("slots") of its local blocks in the matrix's value array, so
+//! that each Newton iteration only refills numbers.
+//!
+//! Unknowns are ordered x = (q of the free particles, 3 each; lambda, one per constraint).
+
+mod pattern;
+
+pub use pattern::{Pattern, Storage};
+
+use crate::model::System;
+
+/// Marks an absent block entry (a fixed particle, or no coupling).
+pub const NONE: usize = usize::MAX;
+
+/// Slots of a 3x3 block, row-major.
+pub type Block = [usize; 9];
+
+/// Where each element writes in the matrix.
+#[derive(Debug, Clone)]
+pub struct Layout {
+    /// First unknown of each particle (NONE for fixed particles).
+    pub dof: Vec<usize>,
+    /// Number of free particles.
+    pub free: usize,
+    /// Number of constraint equations.
+    pub constraints: usize,
+    /// Sparsity pattern (or dense storage for small systems).
+    pub pattern: Pattern,
+    /// Diagonal block of each particle (all NONE for fixed particles).
+    pub particle_block: Vec<Block>,
+    /// Per constraint: blocks [a][b] of the Hessian term between its touched particles.
+    pub constraint_hessian: Vec<[[Block; 2]; 2]>,
+    /// Per constraint: slots of -Phi_q^T (rows of particle a, its multiplier's column).
+    pub constraint_column: Vec<[[usize; 3]; 2]>,
+    /// Per constraint: slots of Phi_q (its row, columns of particle a).
+    pub constraint_row: Vec<[[usize; 3]; 2]>,
+    /// Per force: blocks [a][b] of its Jacobian.
+    pub force_block: Vec<[[Block; 2]; 2]>,
+}
+
+impl Layout {
+    /// Numbers the unknowns and computes the pattern and slots of `system`.
+    /// Systems with at most `dense_limit` unknowns use dense storage.
+    pub fn new(system: &System, dense_limit: usize) -> Layout {
+        let mut dof = Vec::with_capacity(system.particles().len());
+        let mut free = 0;
+        for p in system.particles() {
+            if p.fixed {
+                dof.push(NONE);
+            } else {
+                dof.push(3 * free);
+                free += 1;
+            }
+        }
+        let m = system.constraints().len();
+        let n = 3 * free + m;
+        let lambda = |k: usize| 3 * free + k;
+
+        // Structural entries, column by column.
+        let mut entries: Vec<(usize, usize)> = Vec::new();
+        let block = |entries: &mut Vec<(usize, usize)>, a: usize, b: usize| {
+            if a != NONE && b != NONE {
+                for r in 0..3 {
+                    for c in 0..3 {
+                        entries.push((a + r, b + c));
+                    }
+                }
+            }
+        };
+        for &d in &dof {
+            block(&mut entries, d, d);
+        }
+        let pairs = |parts: &[usize]| -> Vec<(usize, usize)> {
+            let mut v = Vec::new();
+            for &a in parts {
+                for &b in parts {
+                    v.push((dof[a], dof[b]));
+                }
+            }
+            v
+        };
+        for (k, c) in system.constraints().iter().enumerate() {
+            for (a, b) in pairs(c.particles()) {
+                block(&mut entries, a, b);
+            }
+            for &p in c.particles() {
+                if dof[p] != NONE {
+                    for r in 0..3 {
+                        entries.push((dof[p] + r, lambda(k)));
+                        entries.push((lambda(k), dof[p] + r));
+                    }
+                }
+            }
+        }
+        for f in system.forces().iter().filter(|f| f.has_jacobian()) {
+            for (a, b) in pairs(f.particles()) {
+                block(&mut entries, a, b);
+            }
+        }
+        let pattern = Pattern::new(n, entries, n <= dense_limit);
+
+        let block_slots = |a: usize, b: usize| -> Block {
+            let mut s = [NONE; 9];
+            if a != NONE && b != NONE {
+                for r in 0..3 {
+                    for c in 0..3 {
+                        s[3 * r + c] = pattern.slot(a + r, b + c);
+                    }
+                }
+            }
+            s
+        };
+        let pair_blocks = |parts: &[usize]| -> [[Block; 2]; 2] {
+            let mut out = [[[NONE; 9]; 2]; 2];
+            for (x, &a) in parts.iter().enumerate() {
+                for (y, &b) in parts.iter().enumerate() {
+                    out[x][y] = block_slots(dof[a], dof[b]);
+                }
+            }
+            out
+        };
+        let particle_block = dof.iter().map(|&d| block_slots(d, d)).collect();
+        let mut constraint_hessian = Vec::with_capacity(m);
+        let mut constraint_column = Vec::with_capacity(m);
+        let mut constraint_row = Vec::with_capacity(m);
+        for (k, c) in system.constraints().iter().enumerate() {
+            constraint_hessian.push(pair_blocks(c.particles()));
+            let mut col = [[NONE; 3]; 2];
+            let mut row = [[NONE; 3]; 2];
+            for (x, &p) in c.particles().iter().enumerate() {
+                if dof[p] != NONE {
+                    for r in 0..3 {
+                        col[x][r] = pattern.slot(dof[p] + r, lambda(k));
+                        row[x][r] = pattern.slot(lambda(k), dof[p] + r);
+                    }
+                }
+            }
+            constraint_column.push(col);
+            constraint_row.push(row);
+        }
+        let force_block = system
+            .forces()
+            .iter()
+            .map(|f| {
+                if f.has_jacobian() {
+                    pair_blocks(f.particles())
+                } else {
+                    [[[NONE; 9]; 2]; 2]
+                }
+            })
+            .collect();
+        Layout {
+            dof,
+            free,
+            constraints: m,
+            pattern,
+            particle_block,
+            constraint_hessian,
+            constraint_column,
+            constraint_row,
+            force_block,
+        }
+    }
+
+    /// Total number of unknowns.
+    pub fn unknowns(&self) -> usize {
+        3 * self.free + self.constraints
+    }
+
+    /// Readable name of unknown / equation `i` (a particle's coordinate or a constraint).
+    pub fn equation_name(&self, system: &System, i: usize) -> String {
+        if i < 3 * self.free {
+            let p = self
+                .dof
+                .iter()
+                .position(|&d| d != NONE && d <= i && i < d + 3)
+                .unwrap_or(0);
+            format!("dynamics of particle {p} ({})", ["x", "y", "z"][i % 3])
+        } else {
+            let k = i - 3 * self.free;
+            system.constraints()[k].name(k)
+        }
+    }
+}
+
+/// Adds `value` at `slot` unless the slot is absent.
+#[inline]
+pub fn add(values: &mut [f64], slot: usize, value: f64) {
+    if slot != NONE {
+        values[slot] += value;
+    }
+}
+
+/// Adds the 3x3 matrix `m` (scaled by `s`) into the block `b`.
+#[inline]
+pub fn add_block(values: &mut [f64], b: &Block, s: f64, m: &crate::math::Mat3) {
+    if b[0] == NONE {
+        return;
+    }
+    for r in 0..3 {
+        for c in 0..3 {
+            values[b[3 * r + c]] += s * m[r][c];
+        }
+    }
+}

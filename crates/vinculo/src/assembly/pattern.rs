@@ -1,0 +1,76 @@
+//! Compressed sparse column pattern of the iteration matrix, or dense column-major storage for
+//! small systems; both give each (row, column) entry a fixed slot in a value array.
+
+/// How the matrix's values are stored.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Storage {
+    /// Compressed sparse columns.
+    Sparse,
+    /// Dense, column-major.
+    Dense,
+}
+
+/// Structure of an n x n matrix.
+#[derive(Debug, Clone)]
+pub struct Pattern {
+    /// Dimension.
+    pub n: usize,
+    /// Column pointers (CSC; for dense storage, k n).
+    pub col_ptr: Vec<usize>,
+    /// Row indices, sorted within each column (CSC; for dense storage, 0..n per column).
+    pub row_idx: Vec<usize>,
+    /// Storage kind.
+    pub storage: Storage,
+}
+
+impl Pattern {
+    /// Builds the pattern from (row, column) entries (duplicates allowed).
+    pub fn new(n: usize, mut entries: Vec<(usize, usize)>, dense: bool) -> Pattern {
+        if dense {
+            return Pattern {
+                n,
+                col_ptr: (0..=n).map(|c| c * n).collect(),
+                row_idx: (0..n * n).map(|k| k % n.max(1)).collect(),
+                storage: Storage::Dense,
+            };
+        }
+        entries.sort_unstable_by_key(|&(r, c)| (c, r));
+        entries.dedup();
+        let mut col_ptr = vec![0; n + 1];
+        for &(_, c) in &entries {
+            col_ptr[c + 1] += 1;
+        }
+        for c in 0..n {
+            col_ptr[c + 1] += col_ptr[c];
+        }
+        Pattern {
+            n,
+            col_ptr,
+            row_idx: entries.into_iter().map(|(r, _)| r).collect(),
+            storage: Storage::Sparse,
+        }
+    }
+
+    /// Number of stored entries.
+    pub fn nnz(&self) -> usize {
+        self.row_idx.len()
+    }
+
+    /// Slot of entry (row, col).
+    ///
+    /// # Panics
+    /// If the entry is not in the pattern (a bug in the layout).
+    #[track_caller]
+    pub fn slot(&self, row: usize, col: usize) -> usize {
+        match self.storage {
+            Storage::Dense => col * self.n + row,
+            Storage::Sparse => {
+                let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
+                match self.row_idx[a..b].binary_search(&row) {
+                    Ok(k) => a + k,
+                    Err(_) => panic!("entry ({row}, {col}) is not in the pattern"),
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,85 @@
+//! Fixed distance between two particles (paper eq. 17).
+//!
+//! With d = q_i - q_j:
+//! - Phi = L^2 - d.d
+//! - Phi_q: dPhi/dq_i = -2 d^T, dPhi/dq_j = +2 d^T
+//! - Hessian: d2Phi/dq_i2 = d2Phi/dq_j2 = -2 I, d2Phi/dq_i dq_j = +2 I
+//! - Phi_t = 0
+//! - Phi'' = -2 d.(a_i - a_j) - 2 |v_i - v_j|^2, so gamma = -2 |v_i - v_j|^2
+//! - scale 1/(2L): Phi/(2L) is, to first order, the change of length.
+//!
+//! The constraint force on i is Phi_q^T lambda = -2 lambda d: lambda > 0 pulls i towards j, and the
+//! tension of the link is 2 lambda L.
+
+use super::{Gradient, Hessian};
+use crate::math::{diag, dot, sub, Vec3};
+
+/// |q_i - q_j| = L.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Distance {
+    /// The two particles.
+    pub particles: [usize; 2],
+    /// The length L > 0.
+    pub length: f64,
+}
+
+impl Distance {
+    pub(crate) fn particles(&self) -> &[usize] {
+        &self.particles
+    }
+
+    pub(crate) fn residual(&self, q: &[Vec3], _t: f64) -> f64 {
+        let d = sub(q[self.particles[0]], q[self.particles[1]]);
+        self.length * self.length - dot(d, d)
+    }
+
+    pub(crate) fn gradient(&self, q: &[Vec3], _t: f64) -> Gradient {
+        let d = sub(q[self.particles[0]], q[self.particles[1]]);
+        [
+            [-2.0 * d[0], -2.0 * d[1], -2.0 * d[2]],
+            [2.0 * d[0], 2.0 * d[1], 2.0 * d[2]],
+        ]
+    }
+
+    pub(crate) fn add_hessian(&self, _q: &[Vec3], _t: f64, w: f64, out: &mut Hessian) {
+        for a in 0..2 {
+            for b in 0..2 {
+                let s = if a == b { -2.0 * w } else { 2.0 * w };
+                let h = diag(s);
+                for r in 0..3 {
+                    out[a][b][r][r] += h[r][r];
+                }
+            }
+        }
+    }
+
+    pub(crate) fn phi_t(&self, _q: &[Vec3], _t: f64) -> f64 {
+        0.0
+    }
+
+    pub(crate) fn gamma(&self, _q: &[Vec3], v: &[Vec3], _t: f64) -> f64 {
+        let w = sub(v[self.particles[0]], v[self.particles[1]]);
+        -2.0 * dot(w, w)
+    }
+
+    pub(crate) fn scale(&self) -> f64 {
+        0.5 / self.length
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{fd, Constraint};
+    use super::*;
+
+    #[test]
+    fn derivatives_match_finite_differences() {
+        let c = Constraint::Distance(Distance {
+            particles: [0, 2],
+            length: 0.7,
+        });
+        let q = [[0.1, 0.2, -0.3], [9.0, 9.0, 9.0], [0.5, -0.4, 0.25]];
+        let v = [[0.3, -1.0, 0.2], [0.0; 3], [-0.6, 0.1, 0.9]];
+        fd::check(&c, &q, &v, 0.3);
+    }
+}

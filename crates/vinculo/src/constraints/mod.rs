@@ -1,0 +1,215 @@
+//! Constraints Phi(q, t) = 0, one equation each, enforced with a Lagrange multiplier.
+//!
+//! Contract of a constraint (one file per kind):
+//! - `particles()`: the particles it touches (one or two);
+//! - `residual(q, t)`: Phi;
+//! - `gradient(q, t)`: dPhi/dq_p for each touched particle p (a row 3-vector each);
+//! - `add_hessian(w, out)`: adds w d2Phi/dq_p dq_r for each pair of touched particles;
+//! - `phi_t(q, t)`: the partial time derivative, so that Phi' = Phi_q v + Phi_t;
+//! - `gamma(q, v, t)`: the part of Phi'' that does not contain the accelerations,
+//!   Phi'' = Phi_q a + gamma;
+//! - `scale()`: s such that s Phi is a length (it scales rows and multipliers of the linear solve).
+//!
+//! `q` and `v` are the positions and velocities of every particle of the system (fixed ones
+//! included). Each kind's doc comment derives its terms; tests check them against finite
+//! differences.
+
+mod distance;
+mod fixed_coordinate;
+mod plane;
+mod point_distance;
+
+pub use distance::Distance;
+pub use fixed_coordinate::FixedCoordinate;
+pub use plane::Plane;
+pub use point_distance::PointDistance;
+
+use crate::math::{Mat3, Vec3};
+
+/// Gradient blocks of one equation, one row 3-vector per touched particle.
+pub type Gradient = [Vec3; 2];
+/// Hessian blocks of one equation, [p][r] = d2Phi/dq_p dq_r.
+pub type Hessian = [[Mat3; 2]; 2];
+
+/// Every built-in constraint kind, dispatched statically.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Constraint {
+    /// Fixed distance between two particles (paper eq. 17).
+    Distance(Distance),
+    /// Fixed distance from a particle to a point moving by a prescribed law.
+    PointDistance(Box<PointDistance>),
+    /// Particle on a plane whose normal and point may move (paper eq. 18).
+    Plane(Box<Plane>),
+    /// One coordinate of a particle follows a prescribed law (constant by default).
+    FixedCoordinate(FixedCoordinate),
+}
+
+macro_rules! dispatch {
+    ($self:ident, $c:ident => $e:expr) => {
+        match $self {
+            Constraint::Distance($c) => $e,
+            Constraint::PointDistance($c) => $e,
+            Constraint::Plane($c) => $e,
+            Constraint::FixedCoordinate($c) => $e,
+        }
+    };
+}
+
+impl Constraint {
+    /// Particles touched by the constraint.
+    #[inline]
+    pub fn particles(&self) -> &[usize] {
+        dispatch!(self, c => c.particles())
+    }
+
+    /// Phi(q, t).
+    #[inline]
+    pub fn residual(&self, q: &[Vec3], t: f64) -> f64 {
+        dispatch!(self, c => c.residual(q, t))
+    }
+
+    /// dPhi/dq for each touched particle.
+    #[inline]
+    pub fn gradient(&self, q: &[Vec3], t: f64) -> Gradient {
+        dispatch!(self, c => c.gradient(q, t))
+    }
+
+    /// Adds `w` times the Hessian d2Phi/dq2 to `out`.
+    #[inline]
+    pub fn add_hessian(&self, q: &[Vec3], t: f64, w: f64, out: &mut Hessian) {
+        dispatch!(self, c => c.add_hessian(q, t, w, out))
+    }
+
+    /// Partial time derivative Phi_t.
+    #[inline]
+    pub fn phi_t(&self, q: &[Vec3], t: f64) -> f64 {
+        dispatch!(self, c => c.phi_t(q, t))
+    }
+
+    /// gamma = Phi'' - Phi_q a.
+    #[inline]
+    pub fn gamma(&self, q: &[Vec3], v: &[Vec3], t: f64) -> f64 {
+        dispatch!(self, c => c.gamma(q, v, t))
+    }
+
+    /// Scale s: s Phi is a length.
+    #[inline]
+    pub fn scale(&self) -> f64 {
+        dispatch!(self, c => c.scale())
+    }
+
+    /// A characteristic length of the constraint (for the model's length scale).
+    pub fn length(&self) -> f64 {
+        match self {
+            Constraint::Distance(c) => c.length,
+            Constraint::PointDistance(c) => c.length,
+            _ => 0.0,
+        }
+    }
+
+    /// The time interval on which the constraint's laws are defined.
+    pub fn domain(&self) -> (f64, f64) {
+        match self {
+            Constraint::Distance(_) => (f64::NEG_INFINITY, f64::INFINITY),
+            Constraint::PointDistance(c) => c.point.domain(),
+            Constraint::Plane(c) => {
+                let (a, b) = c.normal.domain();
+                let (e, f) = c.point.domain();
+                (a.max(e), b.min(f))
+            }
+            Constraint::FixedCoordinate(c) => c.value.domain(),
+        }
+    }
+
+    /// A readable name, e.g. "distance #3 (particles 2-3)".
+    pub fn name(&self, index: usize) -> String {
+        let p = self.particles();
+        match self {
+            Constraint::Distance(_) => format!("distance #{index} (particles {}-{})", p[0], p[1]),
+            Constraint::PointDistance(_) => {
+                format!("distance to a moving point #{index} (particle {})", p[0])
+            }
+            Constraint::Plane(_) => format!("plane #{index} (particle {})", p[0]),
+            Constraint::FixedCoordinate(c) => {
+                format!(
+                    "fixed coordinate #{index} (particle {}, axis {})",
+                    p[0],
+                    ["x", "y", "z"][c.axis]
+                )
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod fd {
+    //! Finite-difference checks shared by the constraint tests.
+    use super::*;
+
+    /// Checks gradient, Hessian, Phi_t and gamma of `c` against central differences at (q, v, t).
+    pub fn check(c: &Constraint, q: &[Vec3], v: &[Vec3], t: f64) {
+        let h = 1e-6;
+        let parts = c.particles().to_vec();
+        let g = c.gradient(q, t);
+        let mut hess: Hessian = Default::default();
+        c.add_hessian(q, t, 1.0, &mut hess);
+        for (a, &pa) in parts.iter().enumerate() {
+            for k in 0..3 {
+                let mut qp = q.to_vec();
+                let mut qm = q.to_vec();
+                qp[pa][k] += h;
+                qm[pa][k] -= h;
+                let fd = (c.residual(&qp, t) - c.residual(&qm, t)) / (2.0 * h);
+                assert!(
+                    (fd - g[a][k]).abs() < 1e-6 * (1.0 + fd.abs()),
+                    "gradient {a},{k}: {} vs fd {fd}",
+                    g[a][k]
+                );
+                let gp = c.gradient(&qp, t);
+                let gm = c.gradient(&qm, t);
+                for b in 0..parts.len() {
+                    for l in 0..3 {
+                        let fd2 = (gp[b][l] - gm[b][l]) / (2.0 * h);
+                        assert!(
+                            (fd2 - hess[b][a][l][k]).abs() < 1e-5 * (1.0 + fd2.abs()),
+                            "hessian"
+                        );
+                    }
+                }
+            }
+        }
+        // Phi_t and gamma from the total derivatives along a trajectory q(t + s) = q + s v + s^2/2 a.
+        let acc: Vec<Vec3> = (0..q.len()).map(|i| [0.3 * i as f64, -0.2, 0.7]).collect();
+        let at = |s: f64| -> Vec<Vec3> {
+            (0..q.len())
+                .map(|i| std::array::from_fn(|k| q[i][k] + s * v[i][k] + 0.5 * s * s * acc[i][k]))
+                .collect()
+        };
+        let hs = 1e-4;
+        let phi = |s: f64| c.residual(&at(s), t + s);
+        let d1 = (phi(hs) - phi(-hs)) / (2.0 * hs);
+        let d2 = (phi(hs) - 2.0 * phi(0.0) + phi(-hs)) / (hs * hs);
+        let gv: f64 = parts
+            .iter()
+            .enumerate()
+            .map(|(a, &p)| crate::math::dot(g[a], v[p]))
+            .sum();
+        let ga: f64 = parts
+            .iter()
+            .enumerate()
+            .map(|(a, &p)| crate::math::dot(g[a], acc[p]))
+            .sum();
+        let pt = c.phi_t(q, t);
+        assert!(
+            (d1 - (gv + pt)).abs() < 1e-6 * (1.0 + d1.abs()),
+            "Phi' {d1} vs {}",
+            gv + pt
+        );
+        let gm = c.gamma(q, v, t);
+        assert!(
+            (d2 - (ga + gm)).abs() < 1e-4 * (1.0 + d2.abs()),
+            "Phi'' {d2} vs {}",
+            ga + gm
+        );
+    }
+}

@@ -1,0 +1,188 @@
+//! The one error type of vinculo. Every variant carries the numbers a user needs to act on it.
+
+use thiserror::Error as ThisError;
+
+/// Result alias used throughout the crate.
+pub type Result<T> = std::result::Result<T, Error>;
+
+/// Everything that can go wrong, from bad input to a step that does not converge.
+#[derive(Debug, Clone, PartialEq, ThisError)]
+pub enum Error {
+    /// A scalar input is outside its valid range (or not finite).
+    #[error("invalid {name}: {value} ({expected})")]
+    InvalidParameter {
+        /// What the value is (e.g. "mass of particle 3").
+        name: String,
+        /// The offending value.
+        value: f64,
+        /// What is expected instead.
+        expected: String,
+    },
+    /// A vector input has a non-finite component or is otherwise invalid.
+    #[error("invalid {name}: {value:?} ({expected})")]
+    InvalidVector {
+        /// What the vector is (e.g. "position of particle 0").
+        name: String,
+        /// The offending vector.
+        value: Vec<f64>,
+        /// What is expected instead.
+        expected: String,
+    },
+    /// A two-particle element was given the same particle twice.
+    #[error("{what} links particle {particle} to itself: give two different particles")]
+    SameParticle {
+        /// The element kind.
+        what: String,
+        /// The particle index.
+        particle: usize,
+    },
+    /// A constraint touches only fixed particles, so it has no unknown to act on.
+    #[error("{what} touches only fixed particles: it cannot be enforced (free one of them or remove it)")]
+    ConstraintOnFixedParticles {
+        /// The constraint's name.
+        what: String,
+    },
+    /// A handle does not belong to this system.
+    #[error("unknown particle handle {index}: this system has {count} particles (was the handle made by another System?)")]
+    UnknownParticle {
+        /// The handle's index.
+        index: usize,
+        /// How many particles the system has.
+        count: usize,
+    },
+    /// A prescribed law is evaluated outside the interval it is defined on.
+    #[error("{what} is defined on [{start}, {end}] s but the run needs it on [{t_start}, {t_end}] s: extend the table or shorten the run")]
+    LawOutOfDomain {
+        /// Where the law is used.
+        what: String,
+        /// First sample time.
+        start: f64,
+        /// Last sample time.
+        end: f64,
+        /// Simulation start.
+        t_start: f64,
+        /// Simulation end.
+        t_end: f64,
+    },
+    /// The initial positions violate a constraint.
+    #[error("initial state violates {constraint}: |Phi| = {violation:.3e} (scaled to a length: {scaled:.3e} m) exceeds the tolerance {tolerance:.1e} m; call System.project_initial_state() to move the particles onto the constraints")]
+    InconsistentInitialState {
+        /// The constraint's name.
+        constraint: String,
+        /// Raw residual |Phi|.
+        violation: f64,
+        /// Residual scaled to a length.
+        scaled: f64,
+        /// The tolerance that was exceeded.
+        tolerance: f64,
+    },
+    /// Projecting the initial state onto the constraints did not converge.
+    #[error("projection onto the constraints did not converge after {iterations} iterations: residual {residual:.3e} m at {equation}")]
+    ProjectionFailed {
+        /// Iterations made.
+        iterations: usize,
+        /// Final scaled residual.
+        residual: f64,
+        /// The dominant equation.
+        equation: String,
+    },
+    /// Newton's method did not converge, even after reducing the step.
+    #[error("Newton iterations did not converge at t = {t:.6} s (step {dt:.3e} s) after {iterations} iterations: residual {residual:.3e} dominated by {equation}")]
+    NewtonFailed {
+        /// Time at the start of the failing step.
+        t: f64,
+        /// The smallest step tried.
+        dt: f64,
+        /// Iterations of the last attempt.
+        iterations: usize,
+        /// Scaled residual norm of the last attempt.
+        residual: f64,
+        /// The equation (particle or constraint) that dominates the residual.
+        equation: String,
+    },
+    /// The iteration matrix could not be factorised.
+    #[error("singular iteration matrix at t = {t:.6} s: {detail}")]
+    SingularMatrix {
+        /// Time at the start of the failing step.
+        t: f64,
+        /// What the linear solver reported.
+        detail: String,
+    },
+    /// The run was stopped by its observer (for instance a keyboard interrupt).
+    #[error("run interrupted at t = {t:.6} s")]
+    Interrupted {
+        /// Time reached.
+        t: f64,
+    },
+}
+
+impl Error {
+    /// Short name of the error family, used to map errors onto exception classes.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Error::InvalidParameter { .. }
+            | Error::InvalidVector { .. }
+            | Error::SameParticle { .. }
+            | Error::ConstraintOnFixedParticles { .. }
+            | Error::LawOutOfDomain { .. } => "InvalidInputError",
+            Error::UnknownParticle { .. } => "UnknownHandleError",
+            Error::InconsistentInitialState { .. } => "InconsistentInitialStateError",
+            Error::ProjectionFailed { .. }
+            | Error::NewtonFailed { .. }
+            | Error::SingularMatrix { .. }
+            | Error::Interrupted { .. } => "ConvergenceError",
+        }
+    }
+}
+
+/// Checks that `value` is finite and strictly positive.
+pub fn positive(name: impl Into<String>, value: f64) -> Result<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::InvalidParameter {
+            name: name.into(),
+            value,
+            expected: "must be finite and > 0".into(),
+        })
+    }
+}
+
+/// Checks that `value` is finite and not negative.
+pub fn non_negative(name: impl Into<String>, value: f64) -> Result<f64> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::InvalidParameter {
+            name: name.into(),
+            value,
+            expected: "must be finite and >= 0".into(),
+        })
+    }
+}
+
+/// Checks that `value` is finite.
+pub fn finite(name: impl Into<String>, value: f64) -> Result<f64> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(Error::InvalidParameter {
+            name: name.into(),
+            value,
+            expected: "must be finite".into(),
+        })
+    }
+}
+
+/// Checks that every component of `value` is finite.
+pub fn finite_vector(name: impl Into<String>, value: [f64; 3]) -> Result<[f64; 3]> {
+    if value.iter().all(|x| x.is_finite()) {
+        Ok(value)
+    } else {
+        Err(Error::InvalidVector {
+            name: name.into(),
+            value: value.to_vec(),
+            expected: "every component must be finite".into(),
+        })
+    }
+}

@@ -1,0 +1,153 @@
+//! Applied forces f(q, v, t) with their analytic Jacobians df/dq and df/dv.
+//!
+//! Contract of a force element (one file per kind):
+//! - `particles()`: the particles it acts on (one or two);
+//! - `force(q, v, t)`: the applied force on each touched particle;
+//! - `add_jacobian(q, v, t, dq, dv)`: adds df_p/dq_r and df_p/dv_r for each pair of touched
+//!   particles;
+//! - `potential(q)`: the potential energy for conservative elements (0 for dissipative ones).
+//!
+//! Uniform gravity acts on every particle and lives in the [`System`](crate::model::System) itself.
+//! The residual of the dynamics uses F = -f (formulation.md), so the assembler subtracts these.
+
+mod applied;
+mod drag;
+mod spring_damper;
+
+pub use applied::AppliedForce;
+pub use drag::{LinearDrag, QuadraticDrag};
+pub use spring_damper::SpringDamper;
+
+use crate::math::{Mat3, Vec3};
+
+/// Forces on the touched particles.
+pub type Local = [Vec3; 2];
+/// Jacobian blocks [p][r] = df_p/dx_r.
+pub type Jacobian = [[Mat3; 2]; 2];
+
+/// Every built-in force kind, dispatched statically.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Force {
+    /// Linear spring and dashpot between two particles.
+    SpringDamper(SpringDamper),
+    /// Prescribed force on a particle.
+    Applied(Box<AppliedForce>),
+    /// f = -c v.
+    LinearDrag(LinearDrag),
+    /// f = -c |v| v.
+    QuadraticDrag(QuadraticDrag),
+}
+
+macro_rules! dispatch {
+    ($self:ident, $f:ident => $e:expr) => {
+        match $self {
+            Force::SpringDamper($f) => $e,
+            Force::Applied($f) => $e,
+            Force::LinearDrag($f) => $e,
+            Force::QuadraticDrag($f) => $e,
+        }
+    };
+}
+
+impl Force {
+    /// Particles the force acts on.
+    #[inline]
+    pub fn particles(&self) -> &[usize] {
+        dispatch!(self, f => f.particles())
+    }
+
+    /// Applied force on each touched particle.
+    #[inline]
+    pub fn force(&self, q: &[Vec3], v: &[Vec3], t: f64) -> Local {
+        dispatch!(self, f => f.force(q, v, t))
+    }
+
+    /// Adds df/dq into `dq` and df/dv into `dv`.
+    #[inline]
+    pub fn add_jacobian(
+        &self,
+        q: &[Vec3],
+        v: &[Vec3],
+        t: f64,
+        dq: &mut Jacobian,
+        dv: &mut Jacobian,
+    ) {
+        dispatch!(self, f => f.add_jacobian(q, v, t, dq, dv))
+    }
+
+    /// Potential energy (0 for non-conservative elements).
+    pub fn potential(&self, q: &[Vec3]) -> f64 {
+        match self {
+            Force::SpringDamper(f) => f.potential(q),
+            _ => 0.0,
+        }
+    }
+
+    /// True when the Jacobian is identically zero (the element adds nothing to the matrix).
+    pub fn has_jacobian(&self) -> bool {
+        !matches!(self, Force::Applied(_))
+    }
+
+    /// The time interval on which the force's laws are defined.
+    pub fn domain(&self) -> (f64, f64) {
+        match self {
+            Force::Applied(f) => f.force.domain(),
+            _ => (f64::NEG_INFINITY, f64::INFINITY),
+        }
+    }
+
+    /// A readable name.
+    pub fn name(&self, index: usize) -> String {
+        let p = self.particles();
+        match self {
+            Force::SpringDamper(_) => {
+                format!("spring-damper #{index} (particles {}-{})", p[0], p[1])
+            }
+            Force::Applied(_) => format!("applied force #{index} (particle {})", p[0]),
+            Force::LinearDrag(_) => format!("linear drag #{index} (particle {})", p[0]),
+            Force::QuadraticDrag(_) => format!("quadratic drag #{index} (particle {})", p[0]),
+        }
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod fd {
+    //! Finite-difference check shared by the force tests.
+    use super::*;
+
+    /// Checks df/dq and df/dv of `f` against central differences at (q, v, t).
+    pub fn check(f: &Force, q: &[Vec3], v: &[Vec3], t: f64) {
+        let h = 1e-6;
+        let parts = f.particles().to_vec();
+        let mut dq: Jacobian = Default::default();
+        let mut dv: Jacobian = Default::default();
+        f.add_jacobian(q, v, t, &mut dq, &mut dv);
+        for (r, &pr) in parts.iter().enumerate() {
+            for k in 0..3 {
+                for (which, jac) in [(0, &dq), (1, &dv)] {
+                    let mut xp = if which == 0 { q.to_vec() } else { v.to_vec() };
+                    let mut xm = xp.clone();
+                    xp[pr][k] += h;
+                    xm[pr][k] -= h;
+                    let (fp, fm) = if which == 0 {
+                        (f.force(&xp, v, t), f.force(&xm, v, t))
+                    } else {
+                        (f.force(q, &xp, t), f.force(q, &xm, t))
+                    };
+                    for p in 0..parts.len() {
+                        for l in 0..3 {
+                            let fd = (fp[p][l] - fm[p][l]) / (2.0 * h);
+                            let an = jac[p][r][l][k];
+                            assert!(
+                                (fd - an).abs() < 1e-6 * (1.0 + fd.abs()),
+                                "{} d f[{p}][{l}] / d{}[{r}][{k}]: analytic {an} vs fd {fd}",
+                                f.name(0),
+                                if which == 0 { "q" } else { "v" }
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+}

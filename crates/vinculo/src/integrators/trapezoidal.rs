@@ -1,0 +1,428 @@
+//! The generalised trapezoidal rule (paper eq. 24) on the index-3 DAE (paper eq. 21).
+//!
+//! For a step of size h from (t_n, q_n, v_n), with q = q_{n+1} and lambda the unknowns:
+//!
+//! ```text
+//! v_{n+1} = ((q - q_n)/h - (1 - alpha) v_n) / alpha        (kinematics, exact)
+//! q_a = (1 - alpha) q_n + alpha q,  v_a = (q - q_n)/h,  t_a = t_n + alpha h
+//! R_dyn = M (v_{n+1} - v_n)/h - M g - f(q_a, v_a, t_a) - Phi_q(q_a, t_a)^T lambda
+//! R_con = Phi(q, t_{n+1})                                   (constraints hold at the step end)
+//! ```
+//!
+//! The kinematic equation v_a = (q - q_n)/h is linear, so the velocities are eliminated exactly
+//! and Newton runs on (q, lambda) (formulation.md, "Linear solves"). The Jacobian is
+//!
+//! ```text
+//! dR_dyn/dq      = M/(alpha h^2) - alpha df/dq - (1/h) df/dv - alpha sum_k lambda_k d2Phi_k/dq2 (q_a)
+//! dR_dyn/dlambda = -Phi_q(q_a)^T
+//! dR_con/dq      = Phi_q(q)
+//! ```
+//!
+//! Scaling (so that entries of size m/h^2 and O(1) do not mix): dynamics rows are multiplied by
+//! sigma = alpha h^2 / m_ref, constraint row k by s_k (s_k Phi_k is a length), and multiplier k is
+//! solved for in the unit lambda_k sigma / s_k. The scaled matrix is
+//! `[M/m_ref + O(h^2), -s G^T; s G, 0]`, and every scaled residual and increment is a length.
+
+use super::newton::{self, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport};
+use crate::assembly::{add, add_block, Layout, NONE};
+use crate::forces::Jacobian;
+use crate::linear::{for_pattern, LinearSolver};
+use crate::math::{Mat3, Vec3};
+use crate::model::System;
+
+/// The scheme and its parameter alpha in [1/2, 1] (1/2: trapezoidal, 1: backward Euler).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GeneralizedTrapezoidal {
+    /// Weight of the new state in the evaluation point.
+    pub alpha: f64,
+}
+
+/// Matrices, solver and buffers reused by every step of a run (no allocation per step).
+pub struct StepWorkspace {
+    /// Unknown numbering, pattern and slots.
+    pub layout: Layout,
+    /// The factorisation of the iteration matrix.
+    pub solver: Box<dyn LinearSolver>,
+    /// Matrix values in pattern order.
+    pub values: Vec<f64>,
+    /// Residual / increment.
+    pub r: Vec<f64>,
+    /// The new state and evaluation-point buffers.
+    pub state: StepBuffers,
+    /// Reference mass used in the scaling (mean mass of the free particles).
+    pub mass_ref: f64,
+    /// s_k of each constraint.
+    pub scales: Vec<f64>,
+}
+
+/// Per-particle arrays of a step.
+#[derive(Debug, Clone)]
+pub struct StepBuffers {
+    /// q_{n+1} (the Newton iterate).
+    pub q: Vec<Vec3>,
+    /// v_{n+1}.
+    pub v: Vec<Vec3>,
+    /// Multipliers.
+    pub lambda: Vec<f64>,
+    q_alpha: Vec<Vec3>,
+    v_alpha: Vec<Vec3>,
+}
+
+impl StepWorkspace {
+    /// Analyses the system once.
+    pub fn new(system: &System, dense_limit: usize) -> StepWorkspace {
+        let layout = Layout::new(system, dense_limit);
+        let solver = for_pattern(&layout.pattern);
+        let n = system.particles().len();
+        let free: Vec<f64> = system
+            .particles()
+            .iter()
+            .filter(|p| !p.fixed)
+            .map(|p| p.mass)
+            .collect();
+        let mass_ref = if free.is_empty() {
+            1.0
+        } else {
+            free.iter().sum::<f64>() / free.len() as f64
+        };
+        StepWorkspace {
+            values: vec![0.0; layout.pattern.nnz()],
+            r: vec![0.0; layout.unknowns()],
+            solver,
+            state: StepBuffers {
+                q: vec![[0.0; 3]; n],
+                v: vec![[0.0; 3]; n],
+                lambda: vec![0.0; layout.constraints],
+                q_alpha: vec![[0.0; 3]; n],
+                v_alpha: vec![[0.0; 3]; n],
+            },
+            scales: system.constraints().iter().map(|c| c.scale()).collect(),
+            mass_ref,
+            layout,
+        }
+    }
+}
+
+/// One step's nonlinear problem.
+pub struct StepProblem<'a> {
+    system: &'a System,
+    layout: &'a Layout,
+    buffers: &'a mut StepBuffers,
+    scales: &'a [f64],
+    q_n: &'a [Vec3],
+    v_n: &'a [Vec3],
+    t_n: f64,
+    h: f64,
+    alpha: f64,
+    sigma: f64,
+}
+
+impl StepProblem<'_> {
+    /// Updates v_{n+1}, q_a, v_a from the iterate q.
+    fn kinematics(&mut self) {
+        let (a, h) = (self.alpha, self.h);
+        let b = &mut *self.buffers;
+        for i in 0..b.q.len() {
+            for k in 0..3 {
+                let va = (b.q[i][k] - self.q_n[i][k]) / h;
+                b.v_alpha[i][k] = va;
+                b.v[i][k] = (va - (1.0 - a) * self.v_n[i][k]) / a;
+                b.q_alpha[i][k] = (1.0 - a) * self.q_n[i][k] + a * b.q[i][k];
+            }
+        }
+    }
+
+    fn t_alpha(&self) -> f64 {
+        self.t_n + self.alpha * self.h
+    }
+}
+
+impl NewtonProblem for StepProblem<'_> {
+    fn residual(&mut self, r: &mut [f64]) {
+        self.kinematics();
+        let (system, layout, h, sigma) = (self.system, self.layout, self.h, self.sigma);
+        let ta = self.t_alpha();
+        let g = system.gravity();
+        let b = &*self.buffers;
+        for (i, p) in system.particles().iter().enumerate() {
+            let d = layout.dof[i];
+            if d != NONE {
+                for k in 0..3 {
+                    r[d + k] = sigma * p.mass * ((b.v[i][k] - self.v_n[i][k]) / h - g[k]);
+                }
+            }
+        }
+        for f in system.forces() {
+            let fl = f.force(&b.q_alpha, &b.v_alpha, ta);
+            for (x, &p) in f.particles().iter().enumerate() {
+                let d = layout.dof[p];
+                if d != NONE {
+                    for k in 0..3 {
+                        r[d + k] -= sigma * fl[x][k];
+                    }
+                }
+            }
+        }
+        let t1 = self.t_n + h;
+        let m3 = 3 * layout.free;
+        for (c, con) in system.constraints().iter().enumerate() {
+            let grad = con.gradient(&b.q_alpha, ta);
+            for (x, &p) in con.particles().iter().enumerate() {
+                let d = layout.dof[p];
+                if d != NONE {
+                    for k in 0..3 {
+                        r[d + k] -= sigma * grad[x][k] * b.lambda[c];
+                    }
+                }
+            }
+            r[m3 + c] = self.scales[c] * con.residual(&b.q, t1);
+        }
+    }
+
+    fn jacobian(&mut self, values: &mut [f64]) {
+        let (system, layout, h, a, sigma) =
+            (self.system, self.layout, self.h, self.alpha, self.sigma);
+        let ta = self.t_alpha();
+        let t1 = self.t_n + h;
+        let b = &*self.buffers;
+        for (i, p) in system.particles().iter().enumerate() {
+            let blk = &layout.particle_block[i];
+            if blk[0] != NONE {
+                let m = sigma * p.mass / (a * h * h);
+                for k in 0..3 {
+                    values[blk[4 * k]] += m;
+                }
+            }
+        }
+        for (fi, f) in system.forces().iter().enumerate() {
+            if !f.has_jacobian() {
+                continue;
+            }
+            let mut dq: Jacobian = Default::default();
+            let mut dv: Jacobian = Default::default();
+            f.add_jacobian(&b.q_alpha, &b.v_alpha, ta, &mut dq, &mut dv);
+            let n = f.particles().len();
+            for x in 0..n {
+                for y in 0..n {
+                    let blk = &layout.force_block[fi][x][y];
+                    add_block(values, blk, -sigma * a, &dq[x][y]);
+                    add_block(values, blk, -sigma / h, &dv[x][y]);
+                }
+            }
+        }
+        for (c, con) in system.constraints().iter().enumerate() {
+            let n = con.particles().len();
+            let mut hess: [[Mat3; 2]; 2] = Default::default();
+            con.add_hessian(&b.q_alpha, ta, -sigma * a * b.lambda[c], &mut hess);
+            for x in 0..n {
+                for y in 0..n {
+                    add_block(
+                        values,
+                        &layout.constraint_hessian[c][x][y],
+                        1.0,
+                        &hess[x][y],
+                    );
+                }
+            }
+            let s = self.scales[c];
+            let grad_a = con.gradient(&b.q_alpha, ta);
+            let grad_1 = con.gradient(&b.q, t1);
+            for x in 0..n {
+                for k in 0..3 {
+                    add(values, layout.constraint_column[c][x][k], -s * grad_a[x][k]);
+                    add(values, layout.constraint_row[c][x][k], s * grad_1[x][k]);
+                }
+            }
+        }
+    }
+
+    fn update(&mut self, dx: &[f64]) {
+        let layout = self.layout;
+        let b = &mut *self.buffers;
+        for (i, q) in b.q.iter_mut().enumerate() {
+            let d = layout.dof[i];
+            if d != NONE {
+                for k in 0..3 {
+                    q[k] -= dx[d + k];
+                }
+            }
+        }
+        let m3 = 3 * layout.free;
+        for (c, l) in b.lambda.iter_mut().enumerate() {
+            *l -= dx[m3 + c] * self.scales[c] / self.sigma;
+        }
+    }
+}
+
+impl GeneralizedTrapezoidal {
+    /// Order of accuracy of the positions: 2 for alpha = 1/2, otherwise 1.
+    pub fn order(&self) -> usize {
+        if (self.alpha - 0.5).abs() < 1e-12 {
+            2
+        } else {
+            1
+        }
+    }
+
+    /// Takes one step of size `h` from (t_n, q_n, v_n). The caller sets the predictor in
+    /// `ws.state.q` and `ws.state.lambda`; on success they hold q_{n+1}, lambda and `ws.state.v`
+    /// holds v_{n+1}.
+    #[allow(clippy::too_many_arguments)]
+    pub fn step(
+        &self,
+        system: &System,
+        ws: &mut StepWorkspace,
+        t_n: f64,
+        q_n: &[Vec3],
+        v_n: &[Vec3],
+        h: f64,
+        options: &NewtonOptions,
+    ) -> Result<NewtonReport, NewtonFailure> {
+        let sigma = self.alpha * h * h / ws.mass_ref;
+        let mut problem = StepProblem {
+            system,
+            layout: &ws.layout,
+            buffers: &mut ws.state,
+            scales: &ws.scales,
+            q_n,
+            v_n,
+            t_n,
+            h,
+            alpha: self.alpha,
+            sigma,
+        };
+        let report = newton::solve(
+            &mut problem,
+            ws.solver.as_mut(),
+            &mut ws.values,
+            &mut ws.r,
+            options,
+        )?;
+        problem.kinematics();
+        Ok(report)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::laws::{Law, VectorLaw};
+
+    /// The assembled Jacobian equals finite differences of the assembled residual, for a system
+    /// with every constraint and force kind, fixed particles and non-zero multipliers.
+    #[test]
+    fn jacobian_matches_finite_differences_of_the_residual() {
+        let mut s = System::new([0.1, -0.2, -9.81]);
+        let a = s
+            .add_particle(1.0, [0.0, 0.0, 0.0], [0.0; 3], true)
+            .unwrap();
+        let b = s
+            .add_particle(0.7, [0.5, 0.1, -0.2], [0.3, 0.1, 0.0], false)
+            .unwrap();
+        let c = s
+            .add_particle(1.3, [0.9, -0.1, -0.4], [-0.2, 0.4, 0.1], false)
+            .unwrap();
+        let d = s
+            .add_particle(0.4, [0.2, 0.6, 0.1], [0.0, -0.3, 0.5], false)
+            .unwrap();
+        s.add_distance(a, b, None).unwrap();
+        s.add_distance(b, c, None).unwrap();
+        let point = VectorLaw([
+            Law::sine(0.1, 0.7, 0.0, 0.0, 0.0, 0.0).unwrap(),
+            Law::Constant(0.6),
+            Law::Constant(0.5),
+        ]);
+        s.add_distance_to_point(d, point, None).unwrap();
+        s.add_plane(
+            c,
+            VectorLaw::constant([0.0, 0.3, 1.0]),
+            VectorLaw::constant([0.9, -0.1, -0.4]),
+        )
+        .unwrap();
+        s.add_fixed_coordinate(d, 0, None).unwrap();
+        s.add_spring_damper(c, d, 40.0, 1.5, Some(0.5)).unwrap();
+        s.add_quadratic_drag(b, 0.8).unwrap();
+        s.add_linear_drag(c, 0.3).unwrap();
+        s.add_force(
+            d,
+            VectorLaw([
+                Law::Constant(1.0),
+                Law::sine(2.0, 1.0, 0.0, 0.0, 0.0, 0.0).unwrap(),
+                Law::Constant(0.0),
+            ]),
+        )
+        .unwrap();
+
+        for dense_limit in [0, 1000] {
+            let mut ws = StepWorkspace::new(&s, dense_limit);
+            let q_n = s.initial_positions();
+            let v_n = s.initial_velocities();
+            let (h, alpha) = (0.01, 0.6);
+            let sigma = alpha * h * h / ws.mass_ref;
+            // A perturbed iterate and non-zero multipliers.
+            ws.state.q = q_n
+                .iter()
+                .enumerate()
+                .map(|(i, x)| {
+                    if i == 0 {
+                        *x
+                    } else {
+                        [x[0] + 0.01, x[1] - 0.02 * i as f64, x[2] + 0.005]
+                    }
+                })
+                .collect();
+            ws.state.lambda = vec![0.8, -1.2, 0.5, 2.0, -0.7];
+            let n = ws.layout.unknowns();
+            let mut problem = StepProblem {
+                system: &s,
+                layout: &ws.layout,
+                buffers: &mut ws.state,
+                scales: &ws.scales,
+                q_n: &q_n,
+                v_n: &v_n,
+                t_n: 0.3,
+                h,
+                alpha,
+                sigma,
+            };
+            let mut values = vec![0.0; ws.layout.pattern.nnz()];
+            problem.jacobian_at(&mut values);
+            let mut dense = vec![vec![0.0; n]; n];
+            for col in 0..n {
+                for k in ws.layout.pattern.col_ptr[col]..ws.layout.pattern.col_ptr[col + 1] {
+                    dense[ws.layout.pattern.row_idx[k]][col] += values[k];
+                }
+            }
+            let eps = 1e-7;
+            for col in 0..n {
+                let mut dx = vec![0.0; n];
+                dx[col] = -eps; // update() subtracts
+                let mut rp = vec![0.0; n];
+                let mut rm = vec![0.0; n];
+                problem.update(&dx);
+                problem.residual(&mut rp);
+                dx[col] = 2.0 * eps;
+                problem.update(&dx);
+                problem.residual(&mut rm);
+                dx[col] = -eps;
+                problem.update(&dx);
+                for row in 0..n {
+                    let fd = (rp[row] - rm[row]) / (2.0 * eps);
+                    assert!(
+                        (fd - dense[row][col]).abs() < 1e-6 * (1.0 + fd.abs()),
+                        "J[{row}][{col}] = {} but finite differences give {fd} (dense_limit {dense_limit})",
+                        dense[row][col]
+                    );
+                }
+            }
+        }
+    }
+
+    impl StepProblem<'_> {
+        fn jacobian_at(&mut self, values: &mut [f64]) {
+            let mut r = vec![0.0; self.layout.unknowns()];
+            self.residual(&mut r); // refreshes the evaluation point
+            self.jacobian(values);
+        }
+    }
+}

@@ -1,0 +1,263 @@
+//! Prescribed functions of time (motions of anchors, planes, applied forces), evaluated by the
+//! core itself together with their first and second derivatives so that constraints can supply
+//! Phi_t and the acceleration terms exactly.
+
+mod spline;
+
+pub use spline::CubicSpline;
+
+use crate::error::{finite, non_negative, Error, Result};
+use std::f64::consts::PI;
+
+/// A scalar law of time with analytic first and second derivatives.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Law {
+    /// A constant value.
+    Constant(f64),
+    /// c0 + c1 t + c2 t^2 + ... (coefficients in increasing powers of t).
+    Polynomial(Vec<f64>),
+    /// offset + amplitude s(t) sin(2 pi frequency (t - t_start) + phase).
+    ///
+    /// `s` is 1 when `ramp_time` is 0; otherwise the C2 quintic ramp
+    /// s = 10 tau^3 - 15 tau^4 + 6 tau^5, tau = (t - t_start) / ramp_time clamped to [0, 1],
+    /// which starts the motion with zero value, velocity and acceleration.
+    Sine {
+        /// Amplitude.
+        amplitude: f64,
+        /// Frequency in Hz.
+        frequency: f64,
+        /// Phase in radians.
+        phase: f64,
+        /// Constant offset.
+        offset: f64,
+        /// Duration of the smooth ramp-up in seconds (0: no ramp).
+        ramp_time: f64,
+        /// Time at which the sine (and its ramp) starts.
+        t_start: f64,
+    },
+    /// Natural cubic spline through tabulated samples (C2, defined on the sample range only).
+    Tabulated(CubicSpline),
+}
+
+/// (value, first derivative, second derivative)
+pub type Derivatives = (f64, f64, f64);
+
+impl Law {
+    /// A constant, validated.
+    pub fn constant(value: f64) -> Result<Law> {
+        Ok(Law::Constant(finite("constant law value", value)?))
+    }
+
+    /// A polynomial in increasing powers, validated.
+    pub fn polynomial(coefficients: Vec<f64>) -> Result<Law> {
+        if coefficients.is_empty() {
+            return Err(Error::InvalidParameter {
+                name: "number of polynomial coefficients".into(),
+                value: 0.0,
+                expected: "give at least one coefficient".into(),
+            });
+        }
+        for (k, c) in coefficients.iter().enumerate() {
+            finite(format!("polynomial coefficient c{k}"), *c)?;
+        }
+        Ok(Law::Polynomial(coefficients))
+    }
+
+    /// A sine with optional smooth ramp, validated.
+    pub fn sine(
+        amplitude: f64,
+        frequency: f64,
+        phase: f64,
+        offset: f64,
+        ramp_time: f64,
+        t_start: f64,
+    ) -> Result<Law> {
+        Ok(Law::Sine {
+            amplitude: finite("sine amplitude", amplitude)?,
+            frequency: non_negative("sine frequency", frequency)?,
+            phase: finite("sine phase", phase)?,
+            offset: finite("sine offset", offset)?,
+            ramp_time: non_negative("sine ramp_time", ramp_time)?,
+            t_start: finite("sine t_start", t_start)?,
+        })
+    }
+
+    /// A natural cubic spline through samples, validated.
+    pub fn tabulated(times: Vec<f64>, values: Vec<f64>) -> Result<Law> {
+        Ok(Law::Tabulated(CubicSpline::new(times, values)?))
+    }
+
+    /// Value at `t`.
+    #[inline]
+    pub fn value(&self, t: f64) -> f64 {
+        self.eval(t).0
+    }
+
+    /// Value, first and second derivative at `t`.
+    pub fn eval(&self, t: f64) -> Derivatives {
+        match self {
+            Law::Constant(c) => (*c, 0.0, 0.0),
+            Law::Polynomial(c) => {
+                // Horner's scheme for p, p', p'' together.
+                let (mut p, mut d1, mut d2) = (0.0, 0.0, 0.0);
+                for &ck in c.iter().rev() {
+                    d2 = d2 * t + 2.0 * d1;
+                    d1 = d1 * t + p;
+                    p = p * t + ck;
+                }
+                (p, d1, d2)
+            }
+            Law::Sine {
+                amplitude,
+                frequency,
+                phase,
+                offset,
+                ramp_time,
+                t_start,
+            } => {
+                let w = 2.0 * PI * frequency;
+                let arg = w * (t - t_start) + phase;
+                let (sn, cs) = arg.sin_cos();
+                let (g, g1, g2) = (sn, w * cs, -w * w * sn);
+                let (s, s1, s2) = ramp(t - t_start, *ramp_time);
+                (
+                    offset + amplitude * s * g,
+                    amplitude * (s1 * g + s * g1),
+                    amplitude * (s2 * g + 2.0 * s1 * g1 + s * g2),
+                )
+            }
+            Law::Tabulated(spline) => spline.eval(t),
+        }
+    }
+
+    /// Interval of time on which the law is defined.
+    pub fn domain(&self) -> (f64, f64) {
+        match self {
+            Law::Tabulated(s) => s.domain(),
+            _ => (f64::NEG_INFINITY, f64::INFINITY),
+        }
+    }
+
+    /// True when the law does not depend on time.
+    pub fn is_constant(&self) -> bool {
+        match self {
+            Law::Constant(_) => true,
+            Law::Polynomial(c) => c.len() == 1,
+            _ => false,
+        }
+    }
+}
+
+/// The C2 quintic ramp s(tau) and its time derivatives for elapsed time `dt` over `duration`.
+fn ramp(elapsed: f64, duration: f64) -> Derivatives {
+    if duration <= 0.0 {
+        return (1.0, 0.0, 0.0);
+    }
+    if elapsed <= 0.0 {
+        return (0.0, 0.0, 0.0);
+    }
+    if elapsed >= duration {
+        return (1.0, 0.0, 0.0);
+    }
+    let tau = elapsed / duration;
+    let t2 = tau * tau;
+    let t3 = t2 * tau;
+    (
+        t3 * (10.0 - 15.0 * tau + 6.0 * t2),
+        30.0 * t2 * (1.0 - 2.0 * tau + t2) / duration,
+        60.0 * tau * (1.0 - 3.0 * tau + 2.0 * t2) / (duration * duration),
+    )
+}
+
+/// A prescribed vector: one scalar law per component.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VectorLaw(pub [Law; 3]);
+
+impl VectorLaw {
+    /// A constant vector.
+    pub fn constant(v: [f64; 3]) -> VectorLaw {
+        VectorLaw([
+            Law::Constant(v[0]),
+            Law::Constant(v[1]),
+            Law::Constant(v[2]),
+        ])
+    }
+
+    /// Value, first and second derivatives at `t`.
+    #[inline]
+    pub fn eval(&self, t: f64) -> ([f64; 3], [f64; 3], [f64; 3]) {
+        let mut p = [0.0; 3];
+        let mut d1 = [0.0; 3];
+        let mut d2 = [0.0; 3];
+        for k in 0..3 {
+            (p[k], d1[k], d2[k]) = self.0[k].eval(t);
+        }
+        (p, d1, d2)
+    }
+
+    /// Value at `t`.
+    #[inline]
+    pub fn value(&self, t: f64) -> [f64; 3] {
+        [self.0[0].value(t), self.0[1].value(t), self.0[2].value(t)]
+    }
+
+    /// Intersection of the components' domains.
+    pub fn domain(&self) -> (f64, f64) {
+        self.0
+            .iter()
+            .fold((f64::NEG_INFINITY, f64::INFINITY), |(a, b), l| {
+                let (c, d) = l.domain();
+                (a.max(c), b.min(d))
+            })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Central finite differences of the value and of the first derivative.
+    fn check_fd(law: &Law, t: f64) {
+        let h = 1e-5;
+        let (_, d1, d2) = law.eval(t);
+        let fd1 = (law.value(t + h) - law.value(t - h)) / (2.0 * h);
+        let fd2 = (law.eval(t + h).1 - law.eval(t - h).1) / (2.0 * h);
+        let scale = 1.0 + d1.abs() + d2.abs();
+        assert!((d1 - fd1).abs() < 1e-6 * scale, "d1 {d1} vs fd {fd1}");
+        assert!((d2 - fd2).abs() < 1e-6 * scale, "d2 {d2} vs fd {fd2}");
+    }
+
+    #[test]
+    fn polynomial_derivatives_match_closed_form() {
+        // p = 1 + 2t + 3t^2 + 4t^3: p' = 2 + 6t + 12t^2, p'' = 6 + 24t.
+        let p = Law::polynomial(vec![1.0, 2.0, 3.0, 4.0]).unwrap();
+        let t = 0.7;
+        let (v, d1, d2) = p.eval(t);
+        assert!((v - (1.0 + 2.0 * t + 3.0 * t * t + 4.0 * t * t * t)).abs() < 1e-14);
+        assert!((d1 - (2.0 + 6.0 * t + 12.0 * t * t)).abs() < 1e-14);
+        assert!((d2 - (6.0 + 24.0 * t)).abs() < 1e-14);
+    }
+
+    #[test]
+    fn ramped_sine_derivatives_match_finite_differences() {
+        let s = Law::sine(0.005, 0.9, 0.3, 0.1, 2.0, 0.5).unwrap();
+        for &t in &[0.6, 1.0, 1.7, 2.4, 3.0] {
+            check_fd(&s, t);
+        }
+        // Before the start: offset only, at rest.
+        assert_eq!(s.eval(0.2), (0.1, 0.0, 0.0));
+        // After the ramp: the plain sine.
+        let t = 3.1;
+        let w = 2.0 * PI * 0.9;
+        assert!((s.value(t) - (0.1 + 0.005 * (w * (t - 0.5) + 0.3).sin())).abs() < 1e-15);
+    }
+
+    #[test]
+    fn ramp_is_c2_at_both_ends() {
+        // s, s', s'' are continuous at tau = 0 and tau = 1 (values 0,0,0 and 1,0,0).
+        let (a, b, c) = ramp(1e-9, 1.0);
+        assert!(a.abs() < 1e-20 && b.abs() < 1e-15 && c.abs() < 1e-7);
+        let (a, b, c) = ramp(1.0 - 1e-9, 1.0);
+        assert!((a - 1.0).abs() < 1e-15 && b.abs() < 1e-15 && c.abs() < 1e-7);
+    }
+}

@@ -1,0 +1,372 @@
+//! The system: particles, constraints and forces in arenas, reached through typed handles.
+
+use super::particle::{ConstraintId, ForceId, Particle, ParticleId};
+use crate::constraints::{Constraint, Distance, FixedCoordinate, Plane, PointDistance};
+use crate::error::{finite_vector, non_negative, positive, Error, Result};
+use crate::forces::{AppliedForce, Force, LinearDrag, QuadraticDrag, SpringDamper};
+use crate::laws::{Law, VectorLaw};
+use crate::math::{dot, norm, sub, Vec3};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+static NEXT_SYSTEM: AtomicU64 = AtomicU64::new(1);
+
+/// A constrained particle system under uniform gravity.
+#[derive(Debug, Clone)]
+pub struct System {
+    id: u64,
+    gravity: Vec3,
+    particles: Vec<Particle>,
+    constraints: Vec<Constraint>,
+    forces: Vec<Force>,
+}
+
+impl System {
+    /// An empty system with gravity `g` (m/s^2), e.g. `[0.0, 0.0, -9.81]`.
+    ///
+    /// # Panics
+    /// If `gravity` is not finite; use [`System::try_new`] to get an error instead.
+    #[track_caller]
+    pub fn new(gravity: Vec3) -> System {
+        System::try_new(gravity).expect("gravity must be finite")
+    }
+
+    /// An empty system; errors if `gravity` has a non-finite component.
+    pub fn try_new(gravity: Vec3) -> Result<System> {
+        Ok(System {
+            id: NEXT_SYSTEM.fetch_add(1, Ordering::Relaxed),
+            gravity: finite_vector("gravity", gravity)?,
+            particles: Vec::new(),
+            constraints: Vec::new(),
+            forces: Vec::new(),
+        })
+    }
+
+    /// Adds a particle. `fixed` particles never move.
+    pub fn add_particle(
+        &mut self,
+        mass: f64,
+        position: Vec3,
+        velocity: Vec3,
+        fixed: bool,
+    ) -> Result<ParticleId> {
+        let index = self.particles.len();
+        let mass = positive(format!("mass of particle {index}"), mass)?;
+        let position = finite_vector(format!("position of particle {index}"), position)?;
+        let velocity = finite_vector(format!("velocity of particle {index}"), velocity)?;
+        let velocity = if fixed { [0.0; 3] } else { velocity };
+        self.particles.push(Particle {
+            mass,
+            position,
+            velocity,
+            fixed,
+        });
+        Ok(ParticleId {
+            system: self.id,
+            index,
+        })
+    }
+
+    /// Checks that a handle belongs to this system and returns its index.
+    pub fn check(&self, id: ParticleId) -> Result<usize> {
+        if id.system != self.id || id.index >= self.particles.len() {
+            return Err(Error::UnknownParticle {
+                index: id.index,
+                count: self.particles.len(),
+            });
+        }
+        Ok(id.index)
+    }
+
+    /// Looks a particle up by index, as a handle (errors if out of range).
+    pub fn particle_id(&self, index: usize) -> Result<ParticleId> {
+        self.check(ParticleId {
+            system: self.id,
+            index,
+        })
+        .map(|index| ParticleId {
+            system: self.id,
+            index,
+        })
+    }
+
+    fn push_constraint(&mut self, c: Constraint) -> Result<ConstraintId> {
+        let index = self.constraints.len();
+        if c.particles().iter().all(|&p| self.particles[p].fixed) {
+            return Err(Error::ConstraintOnFixedParticles {
+                what: c.name(index),
+            });
+        }
+        self.constraints.push(c);
+        Ok(ConstraintId(index))
+    }
+
+    /// Fixed distance between `a` and `b` (paper eq. 17). `length = None` takes the current distance.
+    pub fn add_distance(
+        &mut self,
+        a: ParticleId,
+        b: ParticleId,
+        length: Option<f64>,
+    ) -> Result<ConstraintId> {
+        let (i, j) = (self.check(a)?, self.check(b)?);
+        let index = self.constraints.len();
+        if i == j {
+            return Err(Error::SameParticle {
+                what: format!("distance #{index}"),
+                particle: i,
+            });
+        }
+        let current = norm(sub(self.particles[i].position, self.particles[j].position));
+        let length = positive(
+            format!("length of distance #{index} (particles {i}-{j})"),
+            length.unwrap_or(current),
+        )?;
+        self.push_constraint(Constraint::Distance(Distance {
+            particles: [i, j],
+            length,
+        }))
+    }
+
+    /// Fixed distance from `p` to a point moving by `point(t)`. `length = None`: the current distance.
+    pub fn add_distance_to_point(
+        &mut self,
+        p: ParticleId,
+        point: VectorLaw,
+        length: Option<f64>,
+    ) -> Result<ConstraintId> {
+        let i = self.check(p)?;
+        let index = self.constraints.len();
+        let current = norm(sub(self.particles[i].position, point.value(0.0)));
+        let length = positive(
+            format!("length of distance to a moving point #{index} (particle {i})"),
+            length.unwrap_or(current),
+        )?;
+        self.push_constraint(Constraint::PointDistance(Box::new(PointDistance {
+            particles: [i],
+            point,
+            length,
+        })))
+    }
+
+    /// Particle `p` on the plane n(t).(q - p0(t)) = 0.
+    pub fn add_plane(
+        &mut self,
+        p: ParticleId,
+        normal: VectorLaw,
+        point: VectorLaw,
+    ) -> Result<ConstraintId> {
+        let i = self.check(p)?;
+        let index = self.constraints.len();
+        let n0 = normal.value(0.0);
+        let length = positive(format!("length of the normal of plane #{index}"), norm(n0))?;
+        self.push_constraint(Constraint::Plane(Box::new(Plane {
+            particles: [i],
+            normal,
+            point,
+            inverse_normal_length: 1.0 / length,
+        })))
+    }
+
+    /// Coordinate `axis` (0, 1, 2) of `p` follows `value` (None: stays where it is).
+    pub fn add_fixed_coordinate(
+        &mut self,
+        p: ParticleId,
+        axis: usize,
+        value: Option<Law>,
+    ) -> Result<ConstraintId> {
+        let i = self.check(p)?;
+        if axis > 2 {
+            return Err(Error::InvalidParameter {
+                name: "axis of a fixed coordinate".into(),
+                value: axis as f64,
+                expected: "must be 0, 1 or 2 (x, y or z)".into(),
+            });
+        }
+        let value = value.unwrap_or(Law::Constant(self.particles[i].position[axis]));
+        self.push_constraint(Constraint::FixedCoordinate(FixedCoordinate {
+            particles: [i],
+            axis,
+            value,
+        }))
+    }
+
+    /// Spring (stiffness k, rest length L0; None: the current distance) with a parallel dashpot c.
+    pub fn add_spring_damper(
+        &mut self,
+        a: ParticleId,
+        b: ParticleId,
+        stiffness: f64,
+        damping: f64,
+        rest_length: Option<f64>,
+    ) -> Result<ForceId> {
+        let (i, j) = (self.check(a)?, self.check(b)?);
+        let index = self.forces.len();
+        if i == j {
+            return Err(Error::SameParticle {
+                what: format!("spring-damper #{index}"),
+                particle: i,
+            });
+        }
+        let stiffness = non_negative(format!("stiffness of spring-damper #{index}"), stiffness)?;
+        let damping = non_negative(format!("damping of spring-damper #{index}"), damping)?;
+        let current = norm(sub(self.particles[i].position, self.particles[j].position));
+        let rest_length = non_negative(
+            format!("rest length of spring-damper #{index}"),
+            rest_length.unwrap_or(current),
+        )?;
+        self.forces.push(Force::SpringDamper(SpringDamper {
+            particles: [i, j],
+            stiffness,
+            damping,
+            rest_length,
+        }));
+        Ok(ForceId(index))
+    }
+
+    /// A prescribed force F(t) on `p`.
+    pub fn add_force(&mut self, p: ParticleId, force: VectorLaw) -> Result<ForceId> {
+        let i = self.check(p)?;
+        self.forces.push(Force::Applied(Box::new(AppliedForce {
+            particles: [i],
+            force,
+        })));
+        Ok(ForceId(self.forces.len() - 1))
+    }
+
+    /// Linear drag f = -c v on `p`.
+    pub fn add_linear_drag(&mut self, p: ParticleId, coefficient: f64) -> Result<ForceId> {
+        let i = self.check(p)?;
+        let index = self.forces.len();
+        let coefficient =
+            non_negative(format!("coefficient of linear drag #{index}"), coefficient)?;
+        self.forces.push(Force::LinearDrag(LinearDrag {
+            particles: [i],
+            coefficient,
+        }));
+        Ok(ForceId(index))
+    }
+
+    /// Quadratic drag f = -c |v| v on `p`.
+    pub fn add_quadratic_drag(&mut self, p: ParticleId, coefficient: f64) -> Result<ForceId> {
+        let i = self.check(p)?;
+        let index = self.forces.len();
+        let coefficient = non_negative(
+            format!("coefficient of quadratic drag #{index}"),
+            coefficient,
+        )?;
+        self.forces.push(Force::QuadraticDrag(QuadraticDrag {
+            particles: [i],
+            coefficient,
+        }));
+        Ok(ForceId(index))
+    }
+
+    /// Identifier of this system (handles remember it).
+    pub fn id(&self) -> u64 {
+        self.id
+    }
+
+    /// Gravity vector.
+    pub fn gravity(&self) -> Vec3 {
+        self.gravity
+    }
+
+    /// The particles.
+    pub fn particles(&self) -> &[Particle] {
+        &self.particles
+    }
+
+    /// The constraints (one equation each).
+    pub fn constraints(&self) -> &[Constraint] {
+        &self.constraints
+    }
+
+    /// The force elements.
+    pub fn forces(&self) -> &[Force] {
+        &self.forces
+    }
+
+    /// Replaces the initial positions and velocities (used by the projection).
+    pub fn set_initial_state(&mut self, positions: &[Vec3], velocities: &[Vec3]) {
+        for (p, (x, v)) in self
+            .particles
+            .iter_mut()
+            .zip(positions.iter().zip(velocities))
+        {
+            p.position = *x;
+            p.velocity = if p.fixed { [0.0; 3] } else { *v };
+        }
+    }
+
+    /// Initial positions.
+    pub fn initial_positions(&self) -> Vec<Vec3> {
+        self.particles.iter().map(|p| p.position).collect()
+    }
+
+    /// Initial velocities.
+    pub fn initial_velocities(&self) -> Vec<Vec3> {
+        self.particles.iter().map(|p| p.velocity).collect()
+    }
+
+    /// Readable names of the constraint equations.
+    pub fn constraint_names(&self) -> Vec<String> {
+        self.constraints
+            .iter()
+            .enumerate()
+            .map(|(k, c)| c.name(k))
+            .collect()
+    }
+
+    /// A length that characterises the model: the largest constraint length or extent of the
+    /// initial positions (1 m if the model has neither). Newton tolerances are relative to it.
+    pub fn length_scale(&self) -> f64 {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in &self.particles {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p.position[k]);
+                hi[k] = hi[k].max(p.position[k]);
+            }
+        }
+        let extent = if self.particles.is_empty() {
+            0.0
+        } else {
+            norm(sub(hi, lo))
+        };
+        let longest = self
+            .constraints
+            .iter()
+            .map(|c| c.length())
+            .fold(0.0, f64::max);
+        let l = extent.max(longest);
+        if l > 0.0 {
+            l
+        } else {
+            1.0
+        }
+    }
+
+    /// Kinetic energy sum 1/2 m |v|^2.
+    pub fn kinetic_energy(&self, v: &[Vec3]) -> f64 {
+        self.particles
+            .iter()
+            .zip(v)
+            .map(|(p, v)| 0.5 * p.mass * dot(*v, *v))
+            .sum()
+    }
+
+    /// Potential energy of gravity and springs.
+    pub fn potential_energy(&self, q: &[Vec3]) -> f64 {
+        let gravity: f64 = self
+            .particles
+            .iter()
+            .zip(q)
+            .map(|(p, x)| -p.mass * dot(self.gravity, *x))
+            .sum();
+        gravity + self.forces.iter().map(|f| f.potential(q)).sum::<f64>()
+    }
+
+    /// Constraint residuals Phi(q, t), one per equation.
+    pub fn constraint_residual(&self, q: &[Vec3], t: f64) -> Vec<f64> {
+        self.constraints.iter().map(|c| c.residual(q, t)).collect()
+    }
+}

@@ -1,0 +1,285 @@
+//! The entry point: validate, start consistently, march in time with step retries, keep
+//! everything computed even when a step fails.
+
+use crate::error::{Error, Result};
+use crate::initial::{consistent_accelerations, scaled_violation};
+use crate::integrators::{GeneralizedTrapezoidal, NewtonFailure, NewtonOptions, StepWorkspace};
+use crate::math::Vec3;
+use crate::model::System;
+use crate::solution::{Solution, StepStats};
+
+/// Options of a run. Tolerances are relative to the model's length scale
+/// ([`System::length_scale`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimulationOptions {
+    /// Start time (s).
+    pub t_start: f64,
+    /// End time (s).
+    pub t_end: f64,
+    /// Nominal step (s).
+    pub dt: f64,
+    /// Parameter of the generalised trapezoidal rule, in [1/2, 1].
+    pub alpha: f64,
+    /// Newton options (tolerance relative to the length scale).
+    pub newton: NewtonOptions,
+    /// How many times a failing step may be halved before the run stops.
+    pub max_halvings: usize,
+    /// Largest scaled initial constraint violation accepted, relative to the length scale.
+    pub initial_tolerance: f64,
+    /// Store every k-th step (the last step is always stored).
+    pub save_every: usize,
+    /// Systems with at most this many unknowns use a dense LU.
+    pub dense_limit: usize,
+}
+
+impl Default for SimulationOptions {
+    fn default() -> Self {
+        SimulationOptions {
+            t_start: 0.0,
+            t_end: 1.0,
+            dt: 1e-3,
+            alpha: 0.5,
+            newton: NewtonOptions::default(),
+            max_halvings: 4,
+            initial_tolerance: 1e-8,
+            save_every: 1,
+            dense_limit: 48,
+        }
+    }
+}
+
+/// Receives progress and may stop a run.
+pub trait Observer {
+    /// Called after each accepted step; return false to stop the run.
+    fn step(&mut self, t: f64, t_end: f64) -> bool;
+}
+
+struct Silent;
+impl Observer for Silent {
+    fn step(&mut self, _t: f64, _t_end: f64) -> bool {
+        true
+    }
+}
+
+fn check_options(system: &System, o: &SimulationOptions) -> Result<()> {
+    let bad = |name: &str, value: f64, expected: &str| Error::InvalidParameter {
+        name: name.into(),
+        value,
+        expected: expected.into(),
+    };
+    if !o.t_start.is_finite() {
+        return Err(bad("t_start", o.t_start, "must be finite"));
+    }
+    if !(o.t_end.is_finite() && o.t_end >= 0.0) {
+        return Err(bad("t_end", o.t_end, "must be finite and >= 0"));
+    }
+    if o.t_end < o.t_start {
+        return Err(bad(
+            "t_end",
+            o.t_end,
+            &format!("must be >= t_start = {}", o.t_start),
+        ));
+    }
+    if !(o.dt.is_finite() && o.dt > 0.0) {
+        return Err(bad("dt", o.dt, "must be finite and > 0"));
+    }
+    if !(0.5..=1.0).contains(&o.alpha) {
+        return Err(bad(
+            "alpha",
+            o.alpha,
+            "must be in [0.5, 1] (0.5: trapezoidal, 1: backward Euler)",
+        ));
+    }
+    if !(o.newton.tolerance.is_finite() && o.newton.tolerance > 0.0) {
+        return Err(bad(
+            "tolerance",
+            o.newton.tolerance,
+            "must be finite and > 0",
+        ));
+    }
+    if o.newton.max_iterations == 0 {
+        return Err(bad("max_iterations", 0.0, "must be >= 1"));
+    }
+    if !(o.initial_tolerance.is_finite() && o.initial_tolerance > 0.0) {
+        return Err(bad(
+            "initial_tolerance",
+            o.initial_tolerance,
+            "must be finite and > 0",
+        ));
+    }
+    if o.save_every == 0 {
+        return Err(bad("save_every", 0.0, "must be >= 1"));
+    }
+    let covers = |(a, b): (f64, f64)| a <= o.t_start && b >= o.t_end;
+    for (k, c) in system.constraints().iter().enumerate() {
+        if !covers(c.domain()) {
+            let (start, end) = c.domain();
+            return Err(Error::LawOutOfDomain {
+                what: format!("the law of {}", c.name(k)),
+                start,
+                end,
+                t_start: o.t_start,
+                t_end: o.t_end,
+            });
+        }
+    }
+    for (k, f) in system.forces().iter().enumerate() {
+        if !covers(f.domain()) {
+            let (start, end) = f.domain();
+            return Err(Error::LawOutOfDomain {
+                what: format!("the law of {}", f.name(k)),
+                start,
+                end,
+                t_start: o.t_start,
+                t_end: o.t_end,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Integrates `system` from `options.t_start` to `options.t_end`.
+///
+/// Errors in the input are returned as `Err`. A run that stops part-way (Newton failure after
+/// every allowed step halving, singular matrix) returns `Ok` with everything computed so far
+/// and the cause in [`Solution::status`].
+pub fn simulate(system: &System, options: &SimulationOptions) -> Result<Solution> {
+    simulate_with_observer(system, options, &mut Silent)
+}
+
+/// [`simulate`] with an observer that sees each step and may stop the run.
+pub fn simulate_with_observer(
+    system: &System,
+    options: &SimulationOptions,
+    observer: &mut dyn Observer,
+) -> Result<Solution> {
+    check_options(system, options)?;
+    let length = system.length_scale();
+    let t0 = options.t_start;
+    let mut q = system.initial_positions();
+    let mut v = system.initial_velocities();
+    let (worst, k) = scaled_violation(system, &q, t0);
+    if worst.is_nan() || worst > options.initial_tolerance * length {
+        let c = &system.constraints()[k];
+        return Err(Error::InconsistentInitialState {
+            constraint: c.name(k),
+            violation: c.residual(&q, t0).abs(),
+            scaled: worst,
+            tolerance: options.initial_tolerance * length,
+        });
+    }
+
+    let mut ws = StepWorkspace::new(system, options.dense_limit);
+    let scheme = GeneralizedTrapezoidal {
+        alpha: options.alpha,
+    };
+    let newton = NewtonOptions {
+        tolerance: options.newton.tolerance * length,
+        ..options.newton
+    };
+    let mut sol = Solution::new(q.len(), system.constraints().len(), ws.solver.name());
+    let (mut acc, mut lambda) = match consistent_accelerations(system, &mut ws, &q, &v, t0) {
+        Ok(x) => x,
+        Err(e) => {
+            sol.push(
+                t0,
+                &q,
+                &v,
+                &vec![f64::NAN; sol.constraints],
+                worst,
+                StepStats::default(),
+            );
+            sol.status = Err(e);
+            return Ok(sol);
+        }
+    };
+    sol.push(t0, &q, &v, &lambda, worst, StepStats::default());
+
+    let mut t = t0;
+    let mut h = options.dt;
+    let mut step = 0usize;
+    let min_step = options.dt / f64::powi(2.0, options.max_halvings as i32);
+    let mut q_new: Vec<Vec3> = q.clone();
+    while t < options.t_end {
+        // Land exactly on t_end; avoid a sliver of a last step.
+        let remaining = options.t_end - t;
+        let mut h_try = h.min(remaining);
+        if remaining - h_try < 1e-9 * options.dt {
+            h_try = remaining;
+        }
+        // Predictor: constant-acceleration extrapolation, last multipliers.
+        for i in 0..q.len() {
+            for k in 0..3 {
+                ws.state.q[i][k] = q[i][k] + h_try * v[i][k] + 0.5 * h_try * h_try * acc[i][k];
+            }
+        }
+        ws.state.lambda.copy_from_slice(&lambda);
+        sol.steps_taken += 1;
+        match scheme.step(system, &mut ws, t, &q, &v, h_try, &newton) {
+            Ok(report) => {
+                for i in 0..q.len() {
+                    for k in 0..3 {
+                        acc[i][k] = (ws.state.v[i][k] - v[i][k]) / h_try;
+                    }
+                }
+                q_new.copy_from_slice(&ws.state.q);
+                std::mem::swap(&mut q, &mut q_new);
+                v.copy_from_slice(&ws.state.v);
+                lambda.copy_from_slice(&ws.state.lambda);
+                t = if h_try == remaining {
+                    options.t_end
+                } else {
+                    t + h_try
+                };
+                step += 1;
+                if step % options.save_every == 0 || t >= options.t_end {
+                    let stats = StepStats {
+                        newton_iterations: report.iterations,
+                        step_size: h_try,
+                        residual_norm: report.residual,
+                        increment_norm: report.increment,
+                    };
+                    sol.push(t, &q, &v, &lambda, scaled_violation(system, &q, t).0, stats);
+                }
+                // Grow back towards the nominal step after a reduction.
+                h = (2.0 * h).min(options.dt);
+                if !observer.step(t, options.t_end) {
+                    sol.status = Err(Error::Interrupted { t });
+                    break;
+                }
+            }
+            Err(failure) => {
+                sol.steps_rejected += 1;
+                if h_try > min_step * 1.5 {
+                    h = 0.5 * h_try;
+                    continue;
+                }
+                sol.status = Err(match failure {
+                    NewtonFailure::NotConverged {
+                        iterations,
+                        residual,
+                        worst,
+                    } => Error::NewtonFailed {
+                        t,
+                        dt: h_try,
+                        iterations,
+                        residual,
+                        equation: ws.layout.equation_name(system, worst),
+                    },
+                    NewtonFailure::Singular(s) => {
+                        let near = s
+                            .column
+                            .map(|c| format!(" near {}", ws.layout.equation_name(system, c)))
+                            .unwrap_or_default();
+                        Error::SingularMatrix {
+                            t,
+                            detail: format!("{}{near}", s.detail),
+                        }
+                    }
+                });
+                break;
+            }
+        }
+    }
+    Ok(sol)
+}

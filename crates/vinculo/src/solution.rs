@@ -1,0 +1,114 @@
+//! What a run returns: stored states, multipliers, constraint health and per-step statistics.
+
+use crate::error::Error;
+
+/// Statistics of one stored step.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StepStats {
+    /// Newton iterations of the step (0 for the initial state).
+    pub newton_iterations: usize,
+    /// Step size used (0 for the initial state).
+    pub step_size: f64,
+    /// Final scaled residual norm (m).
+    pub residual_norm: f64,
+    /// Last scaled Newton increment norm (m).
+    pub increment_norm: f64,
+}
+
+/// The result of [`simulate`](crate::simulate). Arrays are flat, row-major:
+/// `positions[(s * n + i) * 3 + k]` is coordinate k of particle i at stored time s.
+#[derive(Debug, Clone)]
+pub struct Solution {
+    /// Number of particles.
+    pub particles: usize,
+    /// Number of constraint equations.
+    pub constraints: usize,
+    /// Stored times.
+    pub times: Vec<f64>,
+    /// Positions, steps x particles x 3.
+    pub positions: Vec<f64>,
+    /// Velocities, steps x particles x 3.
+    pub velocities: Vec<f64>,
+    /// Multipliers, steps x constraints (row 0: from the consistent initial accelerations).
+    pub multipliers: Vec<f64>,
+    /// max_k |s_k Phi_k| at each stored time (a length, m).
+    pub constraint_residual: Vec<f64>,
+    /// Per stored step.
+    pub stats: Vec<StepStats>,
+    /// Steps taken (stored or not), including retries with smaller steps.
+    pub steps_taken: usize,
+    /// Steps rejected because Newton failed (then retried with half the step).
+    pub steps_rejected: usize,
+    /// Name of the linear solver used.
+    pub linear_solver: &'static str,
+    /// `Ok` when the run reached its end; otherwise the error that stopped it (the arrays hold
+    /// everything computed before).
+    pub status: Result<(), Error>,
+}
+
+impl Solution {
+    /// An empty solution for `particles` particles and `constraints` equations.
+    pub fn new(particles: usize, constraints: usize, linear_solver: &'static str) -> Solution {
+        Solution {
+            particles,
+            constraints,
+            times: Vec::new(),
+            positions: Vec::new(),
+            velocities: Vec::new(),
+            multipliers: Vec::new(),
+            constraint_residual: Vec::new(),
+            stats: Vec::new(),
+            steps_taken: 0,
+            steps_rejected: 0,
+            linear_solver,
+            status: Ok(()),
+        }
+    }
+
+    /// Number of stored states.
+    pub fn len(&self) -> usize {
+        self.times.len()
+    }
+
+    /// True when nothing was stored.
+    pub fn is_empty(&self) -> bool {
+        self.times.is_empty()
+    }
+
+    /// Position of particle `i` at stored state `s`.
+    pub fn position(&self, s: usize, i: usize) -> [f64; 3] {
+        let b = (s * self.particles + i) * 3;
+        [
+            self.positions[b],
+            self.positions[b + 1],
+            self.positions[b + 2],
+        ]
+    }
+
+    /// Velocity of particle `i` at stored state `s`.
+    pub fn velocity(&self, s: usize, i: usize) -> [f64; 3] {
+        let b = (s * self.particles + i) * 3;
+        [
+            self.velocities[b],
+            self.velocities[b + 1],
+            self.velocities[b + 2],
+        ]
+    }
+
+    pub(crate) fn push(
+        &mut self,
+        t: f64,
+        q: &[[f64; 3]],
+        v: &[[f64; 3]],
+        lambda: &[f64],
+        residual: f64,
+        stats: StepStats,
+    ) {
+        self.times.push(t);
+        self.positions.extend(q.iter().flatten());
+        self.velocities.extend(v.iter().flatten());
+        self.multipliers.extend_from_slice(lambda);
+        self.constraint_residual.push(residual);
+        self.stats.push(stats);
+    }
+}

@@ -1,0 +1,54 @@
+"""vinculo: point masses linked by constraints, simulated as index-3 DAEs.
+
+Build a :class:`System` of particles, constraints and forces, integrate it with :func:`simulate`
+(generalised trapezoidal rule, Newton's method with the analytic Jacobian), and read the
+trajectories, Lagrange multipliers and statistics from the returned :class:`Solution`.
+
+Example:
+    >>> import vinculo
+    >>> system = vinculo.System(gravity=(0.0, 0.0, -9.81))
+    >>> bob = system.add_particle(mass=1.0, position=(1.0, 0.0, 0.0))
+    >>> rod = system.add_distance_to_point(bob, (0.0, 0.0, 0.0), length=1.0)
+    >>> solution = vinculo.simulate(system, t_end=2.0, dt=1e-3)
+"""
+
+from importlib.metadata import PackageNotFoundError, version
+
+from vinculo._core import ConstraintId, ForceId, Law, ParticleId, System
+from vinculo.errors import (
+    ConvergenceError,
+    InconsistentInitialStateError,
+    InternalError,
+    InvalidInputError,
+    UnknownHandleError,
+    VinculoError,
+)
+from vinculo.laws import constant, polynomial, sine, tabulated
+from vinculo.simulate import simulate
+from vinculo.solution import Solution
+
+try:
+    __version__ = version("vinculo")
+except PackageNotFoundError:  # running from a source tree that was never installed
+    __version__ = "0+unknown"
+
+__all__ = [
+    "ConstraintId",
+    "ConvergenceError",
+    "ForceId",
+    "InconsistentInitialStateError",
+    "InternalError",
+    "InvalidInputError",
+    "Law",
+    "ParticleId",
+    "Solution",
+    "System",
+    "UnknownHandleError",
+    "VinculoError",
+    "__version__",
+    "constant",
+    "polynomial",
+    "simulate",
+    "sine",
+    "tabulated",
+]

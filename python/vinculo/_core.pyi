@@ -1,0 +1,106 @@
+"""Type stubs of vinculo's compiled core (the PyO3 extension ``vinculo._core``).
+
+Users import from ``vinculo``; this module is the thin layer the Python package is built on.
+"""
+from typing import Callable, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+
+class Law:
+    """A prescribed scalar function of time with its first and second derivatives.
+
+    Built by the constructors ``Law.constant``, ``Law.polynomial``, ``Law.sine`` and ``Law.tabulated``.
+    """
+    @staticmethod
+    def constant(value: float) -> "Law": ...
+    @staticmethod
+    def polynomial(coefficients: Sequence[float]) -> "Law":
+        """c0 + c1 t + c2 t^2 + ...  (coefficients in increasing powers)."""
+    @staticmethod
+    def sine(amplitude: float, frequency: float, phase: float = 0.0, offset: float = 0.0,
+             ramp_time: float = 0.0, t_start: float = 0.0) -> "Law":
+        """offset + amplitude s(t) sin(2 pi frequency (t - t_start) + phase); s is a C2 quintic ramp
+        from 0 at t_start to 1 at t_start + ramp_time (s = 1 when ramp_time = 0)."""
+    @staticmethod
+    def tabulated(times: Sequence[float], values: Sequence[float]) -> "Law":
+        """Natural cubic spline through the samples (C2). Defined on [times[0], times[-1]] only."""
+    def __call__(self, t: float) -> float: ...
+    def derivatives(self, t: float) -> tuple[float, float, float]:
+        """(value, first derivative, second derivative) at t."""
+    def domain(self) -> tuple[float, float]:
+        """Interval of time on which the law is defined (-inf, inf for analytic laws)."""
+
+Scalar = Union[float, Law]
+Vector = Sequence[Scalar]
+
+class ParticleId:
+    index: int
+class ConstraintId:
+    index: int
+    """Index of the constraint's first equation in the multiplier array."""
+class ForceId:
+    index: int
+
+class System:
+    def __init__(self, gravity: Sequence[float] = (0.0, 0.0, 0.0)) -> None: ...
+    def add_particle(self, mass: float, position: Sequence[float],
+                     velocity: Sequence[float] = (0.0, 0.0, 0.0), fixed: bool = False) -> ParticleId: ...
+    def add_distance(self, a: ParticleId, b: ParticleId, length: float | None = None) -> ConstraintId:
+        """Phi = L^2 - |q_a - q_b|^2 (paper eq. 17). length=None: the current distance."""
+    def add_distance_to_point(self, particle: ParticleId, point: Vector,
+                              length: float | None = None) -> ConstraintId:
+        """Phi = L^2 - |q - p(t)|^2 with a prescribed point p(t)."""
+    def add_plane(self, particle: ParticleId, normal: Vector, point: Vector) -> ConstraintId:
+        """Phi = n(t) . (q - p0(t)) (paper eq. 18); n need not be unit (it is normalised at t=0 for scaling)."""
+    def add_fixed_coordinate(self, particle: ParticleId, axis: int | str,
+                             value: Scalar | None = None) -> ConstraintId:
+        """Phi = q[axis] - value(t); value=None keeps the current coordinate."""
+    def add_spring_damper(self, a: ParticleId, b: ParticleId, stiffness: float, damping: float = 0.0,
+                          rest_length: float | None = None) -> ForceId: ...
+    def add_force(self, particle: ParticleId, force: Vector) -> ForceId: ...
+    def add_linear_drag(self, particle: ParticleId, coefficient: float) -> ForceId:
+        """f = -c v."""
+    def add_quadratic_drag(self, particle: ParticleId, coefficient: float) -> ForceId:
+        """f = -c |v| v."""
+    @property
+    def num_particles(self) -> int: ...
+    @property
+    def num_constraints(self) -> int:
+        """Number of constraint equations (= length of the multiplier vector)."""
+    @property
+    def gravity(self) -> tuple[float, float, float]: ...
+    def masses(self) -> npt.NDArray[np.float64]: ...
+    def fixed(self) -> npt.NDArray[np.bool_]: ...
+    def initial_positions(self) -> npt.NDArray[np.float64]:
+        """(n, 3)."""
+    def initial_velocities(self) -> npt.NDArray[np.float64]: ...
+    def constraint_names(self) -> list[str]:
+        """One readable name per constraint equation, e.g. 'distance #0 (particles 0-1)'."""
+    def constraint_scales(self) -> npt.NDArray[np.float64]:
+        """Per equation: the factor s_k such that s_k Phi_k is a length (1/(2L) for a distance)."""
+    def constraint_residual(self, positions: npt.ArrayLike, t: float = 0.0) -> npt.NDArray[np.float64]:
+        """Phi(q, t) for an (n, 3) array of positions, per equation (unscaled)."""
+    def kinetic_energy(self, velocities: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """Sum 1/2 m |v|^2 for (..., n, 3) velocities; returns shape (...)."""
+    def potential_energy(self, positions: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """Gravity and spring potential for (..., n, 3) positions; returns shape (...)."""
+    def project_initial_state(self, tolerance: float = 1e-12, max_iterations: int = 50) -> dict[str, float]:
+        """Move the initial positions and velocities onto Phi = 0 and Phi_q v + Phi_t = 0 with the
+        least mass-weighted change; returns {'position_change': max |dq|, 'velocity_change': max |dv|,
+        'iterations': n}."""
+
+def simulate(system: System, t_end: float, dt: float, alpha: float = 0.5, t_start: float = 0.0,
+             tolerance: float = 1e-10, max_iterations: int = 25, max_halvings: int = 4,
+             initial_tolerance: float = 1e-8,
+             progress: Callable[[float, float], None] | None = None) -> dict:
+    """Integrate; returns a dict of numpy arrays:
+    times (s,), positions (s, n, 3), velocities (s, n, 3), multipliers (s, m),
+    constraint_residual (s,) [max_k |s_k Phi_k| at each stored time, metres],
+    newton_iterations (s,) int, step_sizes (s,), residual_norms (s,), increment_norms (s,)
+    (row 0 is the initial state: 0 iterations, step 0, multipliers from the consistent
+    initial accelerations), and
+    'error': None, or a dict {'kind', 'message', 'time', 'step_size', 'residual', 'iterations',
+    'equation'} when the run stopped early (the arrays then hold every step completed).
+    progress(t, t_end) is called about twice a second of wall time.
+    Raises the vinculo.errors classes for bad input."""

@@ -1,0 +1,126 @@
+"""The exceptions vinculo raises.
+
+Every exception derives from :class:`VinculoError`, so ``except vinculo.VinculoError`` catches
+anything vinculo reports on purpose. Each class also derives from the built-in exception a Python
+user would expect (``ValueError`` for bad input, ``LookupError`` for an unknown handle,
+``RuntimeError`` for a failed solve), so generic handlers keep working.
+
+Every constructor has the signature ``(message, **details)``: the message is the text shown to the
+user, and each detail is stored as an attribute of the same name (and in the ``details`` dict).
+The compiled core raises these classes by name, as ``cls(message, name=..., value=...)``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+__all__ = [
+    "ConvergenceError",
+    "InconsistentInitialStateError",
+    "InternalError",
+    "InvalidInputError",
+    "UnknownHandleError",
+    "VinculoError",
+]
+
+# Attribute names that a detail must not overwrite (they belong to the exception machinery).
+_RESERVED = frozenset({"args", "message", "details", "with_traceback", "add_note", "__notes__"})
+
+
+def _rebuild(cls: type[VinculoError], message: str, details: dict[str, Any]) -> VinculoError:
+    """Recreate an exception from its message and details (used by pickle)."""
+    return cls(message, **details)
+
+
+class VinculoError(Exception):
+    """Root of every exception vinculo raises.
+
+    Raised directly only for conditions no subclass describes; catch it to handle any vinculo error.
+
+    Arguments:
+        message: what went wrong, with the offending value, and what to do about it.
+        **details: machine-readable facts about the error (for example ``name`` and ``value`` of a
+            bad argument); each is stored as an attribute and in :attr:`details`.
+    """
+
+    def __init__(self, message: str = "", **details: Any) -> None:
+        super().__init__(message)
+        self.message = message
+        self.details: dict[str, Any] = dict(details)
+        for key, value in details.items():
+            if key not in _RESERVED:
+                setattr(self, key, value)
+
+    def __str__(self) -> str:
+        return self.message
+
+    def __repr__(self) -> str:
+        parts = [repr(self.message)]
+        parts += [f"{key}={value!r}" for key, value in self.details.items() if key != "solution"]
+        return f"{type(self).__name__}({', '.join(parts)})"
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (_rebuild, (type(self), self.message, self.details))
+
+
+class InvalidInputError(VinculoError, ValueError):
+    """An argument is out of its domain.
+
+    Raised when building a model or starting a run with a value that cannot be simulated: a mass
+    that is not finite and positive, a position or velocity containing NaN or infinity, a distance
+    length that is not positive, a distance from a particle to itself, a plane with a zero normal,
+    ``t_end`` before ``t_start``, a step ``dt`` that is not positive, ``alpha`` outside [1/2, 1],
+    a non-positive tolerance, a tabulated law with too few or unsorted samples, and so on.
+    Details usually include ``name`` (the argument) and ``value`` (what was given).
+    """
+
+
+class UnknownHandleError(VinculoError, LookupError):
+    """A handle does not refer to anything in this system.
+
+    Raised when a ``ParticleId``, ``ConstraintId`` or ``ForceId`` belongs to another system or is
+    out of range, or when a raw integer is passed where a handle is expected.
+    """
+
+
+class InconsistentInitialStateError(InvalidInputError):
+    """The initial positions or velocities violate a constraint.
+
+    Raised by ``simulate`` when ``|s_k Phi_k|`` at the start exceeds ``initial_tolerance`` for some
+    constraint equation ``k`` (or the velocities violate ``Phi_q v + Phi_t = 0``). The message names
+    the constraint. Call ``System.project_initial_state()`` to move the initial state onto the
+    constraints with the least mass-weighted change, or fix the model.
+    """
+
+
+class ConvergenceError(VinculoError, RuntimeError):
+    """A time step could not be completed.
+
+    Raised by :func:`vinculo.simulate` when Newton's method does not converge even after the allowed
+    number of step halvings (or the Jacobian is singular). Nothing computed is lost: ``solution``
+    holds every step completed before the failure.
+
+    Attributes:
+        time: the time at the start of the step that failed (s).
+        step_size: the last (smallest) step size tried (s).
+        residual: the residual norm when Newton stopped.
+        iterations: the Newton iterations of the last attempt.
+        equation: name of the equation with the largest residual (a constraint or a particle's
+            dynamics), where the core could tell.
+        solution: the partial :class:`vinculo.Solution` up to the last completed step.
+    """
+
+    time: float | None = None
+    step_size: float | None = None
+    residual: float | None = None
+    iterations: int | None = None
+    equation: str | None = None
+    solution: Any = None
+
+
+class InternalError(VinculoError):
+    """Something that should never happen happened inside vinculo.
+
+    Raised when the core detects a broken internal invariant (a bug, not a user error). Please
+    report it with the smallest model that reproduces it.
+    """

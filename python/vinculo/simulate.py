@@ -1,0 +1,147 @@
+"""The one entry point that integrates a system in time."""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections.abc import Callable
+from typing import IO, Any
+
+from vinculo import _core, errors
+from vinculo._core import System
+from vinculo.solution import Solution
+
+__all__ = ["ProgressBar", "simulate"]
+
+ProgressCallback = Callable[[float, float], None]
+
+
+class ProgressBar:
+    """A one-line text progress bar, redrawn in place (used by ``simulate(progress=True)``).
+
+    Arguments:
+        stream: where to draw it (standard error by default).
+        width: number of characters of the bar itself.
+    """
+
+    def __init__(self, stream: IO[str] | None = None, width: int = 30) -> None:
+        self.stream = stream if stream is not None else sys.stderr
+        self.width = width
+        self.started = time.perf_counter()
+        self.drawn = False
+
+    def __call__(self, t: float, t_end: float) -> None:
+        """Draw the bar for simulated time ``t`` out of ``t_end``."""
+        fraction = 1.0 if t_end <= 0 else min(max(t / t_end, 0.0), 1.0)
+        filled = round(fraction * self.width)
+        bar = "#" * filled + "-" * (self.width - filled)
+        elapsed = time.perf_counter() - self.started
+        self.stream.write(
+            f"\rvinculo [{bar}] {100 * fraction:5.1f}%  t = {t:.4g} / {t_end:.4g} s  "
+            f"({elapsed:.1f} s)"
+        )
+        self.stream.flush()
+        self.drawn = True
+
+    def close(self) -> None:
+        """End the line the bar is drawn on (if anything was drawn)."""
+        if self.drawn:
+            self.stream.write("\n")
+            self.stream.flush()
+            self.drawn = False
+
+
+def simulate(
+    system: System,
+    t_end: float,
+    dt: float,
+    alpha: float = 0.5,
+    *,
+    t_start: float = 0.0,
+    tolerance: float = 1e-10,
+    max_iterations: int = 25,
+    max_halvings: int = 4,
+    initial_tolerance: float = 1e-8,
+    progress: bool | ProgressCallback = False,
+) -> Solution:
+    """Integrate a constrained system from ``t_start`` to ``t_end``.
+
+    The equations ``M v' + F(q, v, t) - Phi_q^T lambda = 0``, ``v = q'``, ``Phi(q, t) = 0`` are
+    discretised by the generalised trapezoidal rule with parameter ``alpha`` and solved step by step
+    with Newton's method. A step that does not converge is retried with half the step size, up to
+    ``max_halvings`` times.
+
+    Arguments:
+        system: the model (its initial positions and velocities are the initial state).
+        t_end: final time, in s (not before ``t_start``).
+        dt: step size, in s (positive).
+        alpha: 1/2 is the trapezoidal rule (second order, no numerical damping), 1 is backward Euler
+            (first order, strongly damped); values between add damping.
+        t_start: initial time, in s.
+        tolerance: Newton stops when the scaled residual is below this.
+        max_iterations: Newton iterations allowed per attempt.
+        max_halvings: how many times a failing step may be halved before giving up.
+        initial_tolerance: largest constraint violation ``|s_k Phi_k|`` (m) accepted in the initial
+            state.
+        progress: True draws a progress bar on standard error; a callable is called as
+            ``progress(t, t_end)`` about twice a second of wall time.
+
+    Returns:
+        The :class:`Solution`.
+
+    Raises:
+        InvalidInputError: a bad argument (``dt <= 0``, ``t_end < t_start``, ``alpha`` outside
+            [1/2, 1], a non-positive tolerance, ...).
+        InconsistentInitialStateError: the initial state violates a constraint by more than
+            ``initial_tolerance`` (see ``System.project_initial_state``).
+        ConvergenceError: a step failed even at the smallest step size; its ``solution`` attribute
+            holds every step completed before.
+    """
+    bar: ProgressBar | None = None
+    callback: ProgressCallback | None
+    if progress is True:
+        bar = ProgressBar()
+        callback = bar
+    elif progress is False or progress is None:
+        callback = None
+    elif callable(progress):
+        callback = progress
+    else:
+        raise errors.InvalidInputError(
+            f"progress must be True, False or a callable progress(t, t_end), got {progress!r}",
+            name="progress",
+            value=progress,
+        )
+    try:
+        data = _core.simulate(
+            system,
+            t_end,
+            dt,
+            alpha,
+            t_start=t_start,
+            tolerance=tolerance,
+            max_iterations=max_iterations,
+            max_halvings=max_halvings,
+            initial_tolerance=initial_tolerance,
+            progress=callback,
+        )
+    finally:
+        if bar is not None:
+            bar.close()
+    solution = Solution.from_core(data, system)
+    if solution.error is not None:
+        raise _convergence_error(solution.error, solution)
+    return solution
+
+
+def _convergence_error(error: dict[str, Any], solution: Solution) -> errors.VinculoError:
+    """The exception for a run the core stopped early, carrying the partial solution."""
+    details = {key: value for key, value in error.items() if key != "message"}
+    message = str(error.get("message") or "the simulation stopped early")
+    kind = details.get("kind")
+    # The core names the failure; a name of one of our classes selects it, anything else
+    # (a description of a Newton failure) is a ConvergenceError.
+    cls = getattr(errors, str(kind), None) if kind else None
+    if not (isinstance(cls, type) and issubclass(cls, errors.VinculoError)):
+        cls = errors.ConvergenceError
+    return cls(message, **details, solution=solution)

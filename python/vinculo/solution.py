@@ -1,0 +1,246 @@
+"""The result of a simulation: trajectories, multipliers and solver statistics."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from vinculo._core import ConstraintId, ParticleId, System
+from vinculo.errors import UnknownHandleError
+
+__all__ = ["Solution"]
+
+_ARRAY_FIELDS = (
+    "times",
+    "positions",
+    "velocities",
+    "multipliers",
+    "constraint_residual",
+    "newton_iterations",
+    "step_sizes",
+    "residual_norms",
+    "increment_norms",
+)
+
+
+def _frozen(array: Any, dtype: Any) -> np.ndarray:
+    """A read-only copy of ``array`` with the given dtype."""
+    result = np.array(array, dtype=dtype, copy=True)
+    result.flags.writeable = False
+    return result
+
+
+@dataclass(frozen=True, eq=False)
+class Solution:
+    """Everything one call of :func:`vinculo.simulate` computed.
+
+    Row 0 of every array is the initial state (0 Newton iterations, step size 0, multipliers from
+    the consistent initial accelerations); row ``k`` is the state after step ``k``. The arrays are
+    read-only.
+
+    Attributes:
+        times: (s,) times of the stored states, in s.
+        positions: (s, n, 3) particle positions, in m.
+        velocities: (s, n, 3) particle velocities, in m/s.
+        multipliers: (s, m) Lagrange multipliers, one column per constraint equation. The force of
+            constraint k on the particles is ``Phi_q[k]^T lambda_k``.
+        constraint_residual: (s,) ``max_k |s_k Phi_k|`` at each stored time, in m (``s_k`` is the
+            constraint's scale, see ``System.constraint_scales``).
+        newton_iterations: (s,) Newton iterations of each step.
+        step_sizes: (s,) size of each step, in s (smaller than ``dt`` where steps were halved).
+        residual_norms: (s,) final residual norm of each step's Newton solve.
+        increment_norms: (s,) norm of each step's last Newton increment.
+        error: None after a complete run; for the partial solution carried by a
+            :class:`vinculo.ConvergenceError`, the core's description of the failure (keys
+            'kind', 'message', 'time', 'step_size', 'residual', 'iterations', 'equation').
+        system: the :class:`vinculo.System` that was simulated.
+    """
+
+    times: np.ndarray
+    positions: np.ndarray
+    velocities: np.ndarray
+    multipliers: np.ndarray
+    constraint_residual: np.ndarray
+    newton_iterations: np.ndarray
+    step_sizes: np.ndarray
+    residual_norms: np.ndarray
+    increment_norms: np.ndarray
+    error: dict[str, Any] | None
+    system: System
+
+    @classmethod
+    def from_core(cls, data: dict[str, Any], system: System) -> Solution:
+        """Build a solution from the dict returned by ``vinculo._core.simulate``.
+
+        Arguments:
+            data: the dict of arrays (and 'error') returned by the core.
+            system: the system that was simulated.
+
+        Returns:
+            The solution, with read-only copies of the arrays.
+        """
+        arrays = {
+            name: _frozen(data[name], np.int64 if name == "newton_iterations" else np.float64)
+            for name in _ARRAY_FIELDS
+        }
+        error = data.get("error")
+        return cls(**arrays, error=dict(error) if error is not None else None, system=system)
+
+    @property
+    def success(self) -> bool:
+        """True if the run reached ``t_end``."""
+        return self.error is None
+
+    @property
+    def num_steps(self) -> int:
+        """Number of completed steps (the stored states less the initial one)."""
+        return max(len(self.times) - 1, 0)
+
+    def particle(self, particle: ParticleId) -> np.ndarray:
+        """Trajectory of one particle.
+
+        Arguments:
+            particle: the handle returned by ``System.add_particle``.
+
+        Returns:
+            (s, 3) positions of that particle at the stored times (a read-only view).
+
+        Raises:
+            UnknownHandleError: if ``particle`` is not a ParticleId of this system.
+        """
+        index = self._index(particle, ParticleId, self.positions.shape[1], "particle")
+        return self.positions[:, index, :]
+
+    def particle_velocity(self, particle: ParticleId) -> np.ndarray:
+        """Velocity history of one particle.
+
+        Arguments:
+            particle: the handle returned by ``System.add_particle``.
+
+        Returns:
+            (s, 3) velocities of that particle at the stored times (a read-only view).
+
+        Raises:
+            UnknownHandleError: if ``particle`` is not a ParticleId of this system.
+        """
+        index = self._index(particle, ParticleId, self.velocities.shape[1], "particle")
+        return self.velocities[:, index, :]
+
+    def multiplier(self, constraint: ConstraintId) -> np.ndarray:
+        """Lagrange multiplier of a constraint's first equation.
+
+        Arguments:
+            constraint: the handle returned by ``System.add_*`` for a constraint.
+
+        Returns:
+            (s,) multiplier history. For a distance constraint ``Phi = L^2 - |q_a - q_b|^2`` a
+            positive value is tension; see :meth:`distance_tension`.
+
+        Raises:
+            UnknownHandleError: if ``constraint`` is not a ConstraintId of this system.
+        """
+        index = self._index(constraint, ConstraintId, self.multipliers.shape[1], "constraint")
+        return self.multipliers[:, index]
+
+    def distance_tension(self, constraint: ConstraintId, length: float) -> np.ndarray:
+        """Tension in a distance constraint (a massless rigid link).
+
+        With ``Phi = L^2 - |q_a - q_b|^2`` the constraint force on ``a`` is
+        ``-2 lambda (q_a - q_b)``, of magnitude ``2 lambda L``: positive values pull the two ends
+        together (tension), negative values push them apart (compression).
+
+        Arguments:
+            constraint: the handle returned by ``add_distance`` or ``add_distance_to_point``.
+            length: the constraint's length L, in m.
+
+        Returns:
+            (s,) tension in N.
+
+        Raises:
+            UnknownHandleError: if ``constraint`` is not a ConstraintId of this system.
+        """
+        return 2.0 * self.multiplier(constraint) * float(length)
+
+    def kinetic_energy(self) -> np.ndarray:
+        """Kinetic energy ``sum 1/2 m |v|^2`` at each stored time.
+
+        Returns:
+            (s,) energies in J.
+        """
+        return np.asarray(self.system.kinetic_energy(self.velocities), dtype=np.float64)
+
+    def potential_energy(self) -> np.ndarray:
+        """Potential energy of gravity and springs at each stored time.
+
+        Returns:
+            (s,) energies in J (gravity relative to the origin).
+        """
+        return np.asarray(self.system.potential_energy(self.positions), dtype=np.float64)
+
+    def energy(self) -> np.ndarray:
+        """Total mechanical energy (kinetic plus potential) at each stored time.
+
+        Returns:
+            (s,) energies in J. Without dissipative or time-dependent forces and constraints it is
+            conserved by the exact motion; alpha > 1/2 makes it decay.
+        """
+        return self.kinetic_energy() + self.potential_energy()
+
+    def summary(self) -> str:
+        """A short readable account of the run.
+
+        Returns:
+            Several lines: outcome, steps, the largest constraint residual, Newton iterations per
+            step and the smallest step size.
+        """
+        lines = []
+        if self.success:
+            lines.append(f"completed: t = {self.times[0]:.6g} .. {self.times[-1]:.6g} s")
+        else:
+            assert self.error is not None
+            stop = self.times[-1] if len(self.times) else float("nan")
+            lines.append(f"FAILED at t = {stop:.6g} s: {self.error.get('message', '')}")
+        lines.append(
+            f"steps: {self.num_steps} ({self.system.num_particles} particles, "
+            f"{self.system.num_constraints} constraint equations)"
+        )
+        if self.num_steps > 0:
+            iterations = self.newton_iterations[1:]
+            lines.append(
+                f"max constraint residual: {np.max(self.constraint_residual):.3e} m"
+            )
+            lines.append(
+                f"Newton iterations per step: mean {np.mean(iterations):.2f}, "
+                f"max {int(np.max(iterations))}"
+            )
+            lines.append(f"min step size: {np.min(self.step_sizes[1:]):.6g} s")
+        return "\n".join(lines)
+
+    def __repr__(self) -> str:
+        status = "success" if self.success else "failed"
+        return (
+            f"Solution({status}, steps={self.num_steps}, particles={self.positions.shape[1]}, "
+            f"constraint equations={self.multipliers.shape[1]})"
+        )
+
+    @staticmethod
+    def _index(handle: Any, kind: type, size: int, what: str) -> int:
+        """Check a handle's type and range and return its index."""
+        if not isinstance(handle, kind):
+            raise UnknownHandleError(
+                f"expected a {kind.__name__}, got {handle!r} ({type(handle).__name__}); "
+                f"use the handle returned when the {what} was added",
+                name=what,
+                value=handle,
+            )
+        index = int(handle.index)
+        if not 0 <= index < size:
+            raise UnknownHandleError(
+                f"{kind.__name__} with index {index} is not in this solution "
+                f"(it has {size}); was the handle made by another System?",
+                name=what,
+                value=index,
+            )
+        return index
