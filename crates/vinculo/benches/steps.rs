@@ -1,0 +1,78 @@
+//! Steps per second of the simulation loop on the reference models.
+//!
+//! Run with `cargo bench -p vinculo --bench steps`. Times only `simulate` (model building and
+//! analysis included, output included), after one warm-up run.
+
+use std::time::Instant;
+use vinculo::model::System;
+use vinculo::{simulate, SimulationOptions};
+
+fn pendulum() -> System {
+    let mut s = System::new([0.0, 0.0, -9.81]);
+    let a = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
+    let b = s
+        .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], false)
+        .unwrap();
+    s.add_distance(a, b, None).unwrap();
+    s
+}
+
+fn chain(n: usize, link: f64, hanging: bool) -> System {
+    let mut s = System::new([0.0, 0.0, -9.81]);
+    let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
+    for i in 1..=n {
+        let x = i as f64 * link;
+        let pos = if hanging {
+            [0.0, 0.0, -x]
+        } else {
+            [x, 0.0, 0.0]
+        };
+        let p = s.add_particle(0.1, pos, [0.0; 3], false).unwrap();
+        s.add_distance(prev, p, None).unwrap();
+        prev = p;
+    }
+    s
+}
+
+fn measure(name: &str, system: &System, t_end: f64, dt: f64) {
+    let options = SimulationOptions {
+        t_end,
+        dt,
+        ..Default::default()
+    };
+    simulate(system, &options).unwrap();
+    let start = Instant::now();
+    let sol = simulate(system, &options).unwrap();
+    let elapsed = start.elapsed().as_secs_f64();
+    assert!(sol.status.is_ok());
+    let steps = sol.len() - 1;
+    let iterations: usize = sol.stats.iter().map(|s| s.newton_iterations).sum();
+    println!(
+        "{name:<42} {steps:>7} steps  {:>10.0} steps/s  {:>5.2} Newton it./step  ({})",
+        steps as f64 / elapsed,
+        iterations as f64 / steps as f64,
+        sol.linear_solver
+    );
+}
+
+fn main() {
+    measure("pendulum, dt = 1e-3, 10 s", &pendulum(), 10.0, 1e-3);
+    measure(
+        "hanging chain N = 1000, 0.1 m links, 1 s",
+        &chain(1000, 0.1, true),
+        1.0,
+        1e-3,
+    );
+    measure(
+        "swinging chain N = 1000, 0.1 m links, 1 s",
+        &chain(1000, 0.1, false),
+        1.0,
+        1e-3,
+    );
+    measure(
+        "swinging chain N = 300, 1 m long, 1 s",
+        &chain(300, 1.0 / 300.0, false),
+        1.0,
+        1e-3,
+    );
+}
