@@ -36,11 +36,13 @@ pub fn details<'py>(py: Python<'py>, e: &Error) -> PyResult<Bound<'py, PyDict>> 
         Error::UnknownParticle { index, .. } => d.set_item("value", index)?,
         Error::LawOutOfDomain { what, .. } => d.set_item("name", what)?,
         Error::InconsistentInitialState {
+            level,
             constraint,
             violation,
             tolerance,
             ..
         } => {
+            d.set_item("level", level)?;
             d.set_item("constraint", constraint)?;
             d.set_item("violation", violation)?;
             d.set_item("tolerance", tolerance)?;

@@ -64,14 +64,18 @@ pub enum Error {
         /// Simulation end.
         t_end: f64,
     },
-    /// The initial positions violate a constraint.
-    #[error("initial state violates {constraint}: |Phi| = {violation:.3e} (scaled to a length: {scaled:.3e} m) exceeds the tolerance {tolerance:.1e} m; call System.project_initial_state() to move the particles onto the constraints")]
+    /// The initial positions (Phi) or velocities (Phi_q v + Phi_t) violate a constraint.
+    #[error("initial {level} violate {constraint}: |{quantity}| = {violation:.3e} (scaled: {scaled:.3e}) exceeds the tolerance {tolerance:.1e}; call System.project_initial_state() to move the state onto the constraints")]
     InconsistentInitialState {
+        /// "positions" or "velocities".
+        level: String,
+        /// The violated quantity ("Phi" or "Phi_q v + Phi_t").
+        quantity: String,
         /// The constraint's name.
         constraint: String,
         /// Raw residual |Phi|.
         violation: f64,
-        /// Residual scaled to a length.
+        /// Residual scaled to a length (m) or a speed (m/s).
         scaled: f64,
         /// The tolerance that was exceeded.
         tolerance: f64,

@@ -146,6 +146,25 @@ pub fn scaled_violation(system: &System, q: &[Vec3], t: f64) -> (f64, usize) {
     worst
 }
 
+/// Largest scaled velocity-constraint residual max_k |s_k (Phi_q v + Phi_t)| and its index.
+pub fn scaled_velocity_violation(system: &System, q: &[Vec3], v: &[Vec3], t: f64) -> (f64, usize) {
+    let mut worst = (0.0, 0);
+    for (k, c) in system.constraints().iter().enumerate() {
+        let g = c.gradient(q, t);
+        let gv: f64 = c
+            .particles()
+            .iter()
+            .enumerate()
+            .map(|(x, &p)| dot(g[x], v[p]))
+            .sum();
+        let r = (c.scale() * (gv + c.phi_t(q, t))).abs();
+        if r > worst.0 || r.is_nan() {
+            worst = (r, k);
+        }
+    }
+    worst
+}
+
 /// Moves the system's initial positions and velocities onto Phi = 0 and G v + Phi_t = 0 at time t
 /// with the least mass-weighted change. `tolerance` is relative to the model's length scale.
 pub fn project_initial_state(

@@ -2,7 +2,7 @@
 //! everything computed even when a step fails.
 
 use crate::error::{Error, Result};
-use crate::initial::{consistent_accelerations, scaled_violation};
+use crate::initial::{consistent_accelerations, scaled_velocity_violation, scaled_violation};
 use crate::integrators::{GeneralizedTrapezoidal, NewtonFailure, NewtonOptions, StepWorkspace};
 use crate::math::Vec3;
 use crate::model::System;
@@ -162,10 +162,33 @@ pub fn simulate_with_observer(
     if worst.is_nan() || worst > options.initial_tolerance * length {
         let c = &system.constraints()[k];
         return Err(Error::InconsistentInitialState {
+            level: "positions".into(),
+            quantity: "Phi".into(),
             constraint: c.name(k),
             violation: c.residual(&q, t0).abs(),
             scaled: worst,
             tolerance: options.initial_tolerance * length,
+        });
+    }
+
+    // Velocities: compared with a speed scale of the model, the largest initial speed or the
+    // speed of a fall through its length scale, sqrt(|g| l).
+    let g = system.gravity();
+    let speed = v
+        .iter()
+        .map(|x| crate::math::norm(*x))
+        .fold((crate::math::norm(g) * length).sqrt(), f64::max);
+    let speed = if speed > 0.0 { speed } else { length };
+    let (worst_v, k) = scaled_velocity_violation(system, &q, &v, t0);
+    if worst_v.is_nan() || worst_v > options.initial_tolerance * speed {
+        let c = &system.constraints()[k];
+        return Err(Error::InconsistentInitialState {
+            level: "velocities".into(),
+            quantity: "Phi_q v + Phi_t".into(),
+            constraint: c.name(k),
+            violation: worst_v / c.scale(),
+            scaled: worst_v,
+            tolerance: options.initial_tolerance * speed,
         });
     }
 
