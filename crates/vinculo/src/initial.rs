@@ -73,6 +73,18 @@ fn solve_saddle(system: &System, ws: &mut StepWorkspace, q: &[Vec3], t: f64) -> 
     Ok(())
 }
 
+/// Adds the free-particle part of `x` (3 unknowns per free particle) to `out`.
+fn add_free(layout: &Layout, x: &[f64], out: &mut [Vec3]) {
+    for (i, o) in out.iter_mut().enumerate() {
+        let d = layout.dof[i];
+        if d != NONE {
+            for k in 0..3 {
+                o[k] += x[d + k];
+            }
+        }
+    }
+}
+
 /// Accelerations and multipliers consistent with (q, v) at time t.
 pub fn consistent_accelerations(
     system: &System,
@@ -107,16 +119,8 @@ pub fn consistent_accelerations(
         ws.r[m3 + c] = -ws.scales[c] * con.gamma(q, v, t);
     }
     solve_saddle(system, ws, q, t)?;
-    let a = (0..q.len())
-        .map(|i| {
-            let d = ws.layout.dof[i];
-            if d == NONE {
-                [0.0; 3]
-            } else {
-                [ws.r[d], ws.r[d + 1], ws.r[d + 2]]
-            }
-        })
-        .collect();
+    let mut a = vec![[0.0; 3]; q.len()];
+    add_free(&ws.layout, &ws.r, &mut a);
     let lambda = (0..system.constraints().len())
         .map(|c| ws.r[m3 + c] * ws.scales[c] * ws.mass_ref)
         .collect();
@@ -198,14 +202,7 @@ pub fn project_initial_state(
             ws.r[m3 + c] = -ws.scales[c] * con.residual(&q, t);
         }
         solve_saddle(system, &mut ws, &q, t)?;
-        for (i, x) in q.iter_mut().enumerate() {
-            let d = ws.layout.dof[i];
-            if d != NONE {
-                for k in 0..3 {
-                    x[k] += ws.r[d + k];
-                }
-            }
-        }
+        add_free(&ws.layout, &ws.r, &mut q);
         iterations += 1;
     }
     ws.r.fill(0.0);
@@ -220,14 +217,7 @@ pub fn project_initial_state(
         ws.r[m3 + c] = -ws.scales[c] * (gv + con.phi_t(&q, t));
     }
     solve_saddle(system, &mut ws, &q, t)?;
-    for (i, x) in v.iter_mut().enumerate() {
-        let d = ws.layout.dof[i];
-        if d != NONE {
-            for k in 0..3 {
-                x[k] += ws.r[d + k];
-            }
-        }
-    }
+    add_free(&ws.layout, &ws.r, &mut v);
     let change = |a: &[Vec3], b: &[Vec3]| {
         a.iter()
             .zip(b)

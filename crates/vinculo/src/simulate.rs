@@ -110,24 +110,20 @@ fn check_options(system: &System, o: &SimulationOptions) -> Result<()> {
     if o.save_every == 0 {
         return Err(bad("save_every", 0.0, "must be >= 1"));
     }
-    let covers = |(a, b): (f64, f64)| a <= o.t_start && b >= o.t_end;
-    for (k, c) in system.constraints().iter().enumerate() {
-        if !covers(c.domain()) {
-            let (start, end) = c.domain();
+    let constraints = system
+        .constraints()
+        .iter()
+        .enumerate()
+        .map(|(k, c)| (c.name(k), c.domain()));
+    let forces = system
+        .forces()
+        .iter()
+        .enumerate()
+        .map(|(k, f)| (f.name(k), f.domain()));
+    for (name, (start, end)) in constraints.chain(forces) {
+        if start > o.t_start || end < o.t_end {
             return Err(Error::LawOutOfDomain {
-                what: format!("the law of {}", c.name(k)),
-                start,
-                end,
-                t_start: o.t_start,
-                t_end: o.t_end,
-            });
-        }
-    }
-    for (k, f) in system.forces().iter().enumerate() {
-        if !covers(f.domain()) {
-            let (start, end) = f.domain();
-            return Err(Error::LawOutOfDomain {
-                what: format!("the law of {}", f.name(k)),
+                what: format!("the law of {name}"),
                 start,
                 end,
                 t_start: o.t_start,
