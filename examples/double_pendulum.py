@@ -1,4 +1,4 @@
-"""A small-amplitude double pendulum (equal masses, equal 1 m rods): its two normal-mode frequencies.
+"""A small-amplitude double pendulum (equal masses, equal 1 m rods): its normal-mode frequencies.
 
 Linearised theory gives omega^2 = (2 -/+ sqrt 2) g / l. The rod angles are projected onto the two
 normal modes and each modal coordinate's frequency is measured from its zero crossings.

@@ -21,10 +21,14 @@ def main() -> None:
 
     model = demos.build_inclined_plane(angle=np.radians(args.angle))
     result = demos.run_inclined_plane(model=model)
-    print(f"acceleration: {result.acceleration:.10f} m/s^2 "
-          f"(exact g sin th = {result.exact_acceleration:.10f})")
-    print(f"normal force: {np.mean(result.normal_force):.10f} N "
-          f"(exact m g cos th = {result.exact_normal_force:.10f})")
+    print(
+        f"acceleration: {result.acceleration:.10f} m/s^2 "
+        f"(exact g sin th = {result.exact_acceleration:.10f})"
+    )
+    print(
+        f"normal force: {np.mean(result.normal_force):.10f} N "
+        f"(exact m g cos th = {result.exact_normal_force:.10f})"
+    )
     if args.plot:
         from vinculo.plotting import plot_inclined_plane
 

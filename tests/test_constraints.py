@@ -1,5 +1,7 @@
 """Constraints hold along the motion: distances, moving points, moving planes, fixed coordinates."""
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -20,7 +22,7 @@ def test_chain_constraint_residual_stays_at_round_off():
 
     # Checked independently of the core's own residual, from the stored positions.
     chain = [model.anchor, *model.particles]
-    for a, b in zip(chain[:-1], chain[1:], strict=True):
+    for a, b in itertools.pairwise(chain):
         gap = np.linalg.norm(solution.particle(a) - solution.particle(b), axis=1)
         assert np.max(np.abs(gap - link)) < 1e-12 * link
     # The reported residual is max_k |s_k Phi_k| with s_k = 1/(2L) for a distance.
@@ -135,4 +137,5 @@ def test_fixed_coordinate_following_a_law():
         0.5 * (multiplier[:-1] + multiplier[1:]), 0.5 * (force[:-1] + force[1:]), atol=1e-4 * peak
     )
     # Row 0 comes from the consistent initial accelerations: m x''(0) = 0 for a sine at phase 0.
-    assert solution.multiplier(driver)[0] == pytest.approx(mass * law.derivatives(0.0)[2], abs=1e-12)
+    initial_force = mass * law.derivatives(0.0)[2]
+    assert solution.multiplier(driver)[0] == pytest.approx(initial_force, abs=1e-12)

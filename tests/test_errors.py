@@ -164,7 +164,7 @@ def test_raw_index_is_not_a_handle(not_a_handle):
 
 
 def test_solution_rejects_foreign_handles():
-    system, bob, rod = pendulum_system()
+    system, bob, _ = pendulum_system()
     solution = vinculo.simulate(system, 0.01, 1e-3)
     with pytest.raises(vinculo.UnknownHandleError):
         solution.particle(0)

@@ -73,14 +73,14 @@ def test_sine_with_ramp_matches_closed_form_and_finite_differences():
     for t in np.linspace(start, start + ramp + 1.0, 23):
         s, s1, s2 = quintic_ramp((t - start) / ramp)
         s1, s2 = s1 / ramp, s2 / ramp**2
-        g, g1, g2 = np.sin(w * (t - start)), w * np.cos(w * (t - start)), -(w**2) * np.sin(
-            w * (t - start)
-        )
+        phase = w * (t - start)
+        g, g1, g2 = np.sin(phase), w * np.cos(phase), -(w**2) * np.sin(phase)
         value, first, second = law.derivatives(t)
         scale = amplitude * w**2
         assert value == pytest.approx(amplitude * s * g, abs=1e-15)
         assert first == pytest.approx(amplitude * (s1 * g + s * g1), abs=1e-14 * scale)
-        assert second == pytest.approx(amplitude * (s2 * g + 2 * s1 * g1 + s * g2), abs=1e-13 * scale)
+        expected_second = amplitude * (s2 * g + 2 * s1 * g1 + s * g2)
+        assert second == pytest.approx(expected_second, abs=1e-13 * scale)
         # The analytic derivatives agree with differences of the values (O(h^2) ~ 1e-8 here).
         d1, d2 = finite_differences(law, t, h=1e-4)
         assert first == pytest.approx(d1, abs=1e-7 * scale)

@@ -24,7 +24,8 @@ class Law:
         from 0 at t_start to 1 at t_start + ramp_time (s = 1 when ramp_time = 0)."""
     @staticmethod
     def tabulated(times: Sequence[float], values: Sequence[float]) -> "Law":
-        """Natural cubic spline through the samples (C2). Defined on [times[0], times[-1]] only."""
+        """Natural cubic spline through the samples (C2). Runs must stay within [times[0], times[-1]];
+        evaluated outside, the spline continues along its end tangents."""
     def __call__(self, t: float) -> float: ...
     def derivatives(self, t: float) -> tuple[float, float, float]:
         """(value, first derivative, second derivative) at t."""
@@ -79,6 +80,9 @@ class System:
         """One readable name per constraint equation, e.g. 'distance #0 (particles 0-1)'."""
     def constraint_scales(self) -> npt.NDArray[np.float64]:
         """Per equation: the factor s_k such that s_k Phi_k is a length (1/(2L) for a distance)."""
+    def length_scale(self) -> float:
+        """Characteristic length of the model: Newton and initial tolerances are relative to it."""
+    def particles(self) -> list[ParticleId]: ...
     def constraint_residual(self, positions: npt.ArrayLike, t: float = 0.0) -> npt.NDArray[np.float64]:
         """Phi(q, t) for an (n, 3) array of positions, per equation (unscaled)."""
     def kinetic_energy(self, velocities: npt.ArrayLike) -> npt.NDArray[np.float64]:
@@ -92,14 +96,16 @@ class System:
 
 def simulate(system: System, t_end: float, dt: float, alpha: float = 0.5, t_start: float = 0.0,
              tolerance: float = 1e-10, max_iterations: int = 25, max_halvings: int = 4,
-             initial_tolerance: float = 1e-8,
+             initial_tolerance: float = 1e-8, save_every: int = 1,
              progress: Callable[[float, float], None] | None = None) -> dict:
     """Integrate; returns a dict of numpy arrays:
     times (s,), positions (s, n, 3), velocities (s, n, 3), multipliers (s, m),
     constraint_residual (s,) [max_k |s_k Phi_k| at each stored time, metres],
     newton_iterations (s,) int, step_sizes (s,), residual_norms (s,), increment_norms (s,)
     (row 0 is the initial state: 0 iterations, step 0, multipliers from the consistent
-    initial accelerations), and
+    initial accelerations; row n > 0 holds the multipliers of the step that ends at times[n], which
+    act at t_{n-1} + alpha dt, where the scheme evaluates the dynamics),
+    steps_taken, steps_rejected (int), linear_solver (str), and
     'error': None, or a dict {'kind', 'message', 'time', 'step_size', 'residual', 'iterations',
     'equation'} when the run stopped early (the arrays then hold every step completed).
     progress(t, t_end) is called about twice a second of wall time.

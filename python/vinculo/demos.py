@@ -436,9 +436,7 @@ def run_double_pendulum(
     project = shapes.T @ mass
     modal = angles @ project.T
     modal_rates = rates @ project.T
-    periods = [
-        crossing_period(solution.times, modal[:, k], modal_rates[:, k]) for k in range(2)
-    ]
+    periods = [crossing_period(solution.times, modal[:, k], modal_rates[:, k]) for k in range(2)]
     frequencies = (2 * np.pi / periods[0], 2 * np.pi / periods[1])
     exact = normal_mode_frequencies(model.length, model.gravity)
     return DoublePendulumResult(model, solution, angles, modal, frequencies, exact)

@@ -76,8 +76,8 @@ def sine(
 ) -> Law:
     """A harmonic law with an optional smooth start.
 
-    The value is ``offset + amplitude * s(t) * sin(2 pi frequency (t - t_start) + phase)``, where the
-    ramp ``s`` rises from 0 at ``t_start`` to 1 at ``t_start + ramp_time`` as the C2 quintic
+    The value is ``offset + amplitude * s(t) * sin(2 pi frequency (t - t_start) + phase)``, where
+    the ramp ``s`` rises from 0 at ``t_start`` to 1 at ``t_start + ramp_time`` as the C2 quintic
     ``10 u^3 - 15 u^4 + 6 u^5`` with ``u = (t - t_start) / ramp_time`` (``s = 1`` when
     ``ramp_time = 0``, the abrupt start).
 

@@ -28,6 +28,11 @@ __all__ = [
 ]
 
 
+def _legend_outside(axes) -> None:
+    """Put the legend to the right of the axes, where it hides no curve."""
+    axes.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
+
+
 def _save(figure: Figure, path: str | Path) -> Path:
     """Write a figure as PNG, creating the folder if needed."""
     path = Path(path)
@@ -49,7 +54,7 @@ def plot_pendulum(result: PendulumResult, path: str | Path) -> Path:
     """
     model, solution = result.model, result.solution
     t, q = solution.times, solution.particle(model.bob)
-    figure = Figure(figsize=(8, 6), layout="constrained")
+    figure = Figure(figsize=(10, 6), layout="constrained")
     top, bottom = figure.subplots(2, 1, sharex=True)
     top.plot(t, q[:, 0], label="x")
     top.plot(t, q[:, 2], label="z")
@@ -58,12 +63,12 @@ def plot_pendulum(result: PendulumResult, path: str | Path) -> Path:
         f"Pendulum L = {model.length:g} m: period {result.period:.7f} s "
         f"(exact {result.exact_period:.7f} s)"
     )
-    top.legend(loc="upper right")
+    _legend_outside(top)
     bottom.plot(t, solution.distance_tension(model.rod, model.length), label="2 lambda L")
     bottom.plot(t, pendulum_tension(model, q), "--", label="m g (3 cos th - 2 cos th0)")
     bottom.set_xlabel("time (s)")
     bottom.set_ylabel("rod tension (N)")
-    bottom.legend(loc="upper right")
+    _legend_outside(bottom)
     return _save(figure, path)
 
 
@@ -78,19 +83,19 @@ def plot_double_pendulum(result: DoublePendulumResult, path: str | Path) -> Path
         The path written.
     """
     t = result.solution.times
-    figure = Figure(figsize=(8, 6), layout="constrained")
+    figure = Figure(figsize=(10, 6), layout="constrained")
     top, bottom = figure.subplots(2, 1, sharex=True)
     top.plot(t, result.angles[:, 0], label="upper rod")
     top.plot(t, result.angles[:, 1], label="lower rod")
     top.set_ylabel("angle from vertical (rad)")
     top.set_title("Double pendulum, small amplitude")
-    top.legend(loc="upper right")
+    _legend_outside(top)
     (w1, w2), (e1, e2) = result.frequencies, result.exact_frequencies
-    bottom.plot(t, result.modal[:, 0], label=f"slow mode: {w1:.5f} rad/s (exact {e1:.5f})")
-    bottom.plot(t, result.modal[:, 1], label=f"fast mode: {w2:.5f} rad/s (exact {e2:.5f})")
+    bottom.plot(t, result.modal[:, 0], label=f"slow: {w1:.5f} rad/s\n(exact {e1:.5f})")
+    bottom.plot(t, result.modal[:, 1], label=f"fast: {w2:.5f} rad/s\n(exact {e2:.5f})")
     bottom.set_xlabel("time (s)")
     bottom.set_ylabel("modal coordinate")
-    bottom.legend(loc="upper right")
+    _legend_outside(bottom)
     return _save(figure, path)
 
 
@@ -146,5 +151,8 @@ def plot_inclined_plane(result: InclinedPlaneResult, path: str | Path) -> Path:
     bottom.axhline(result.exact_normal_force, ls="--", color="C1", label="m g cos(th)")
     bottom.set_xlabel("time (s)")
     bottom.set_ylabel("normal force (N)")
+    # Show the force on a scale from zero: its ~1e-9 relative round-off is not worth magnifying.
+    largest = float(np.max(np.abs(result.normal_force))) or 1.0
+    bottom.set_ylim(min(0.0, 1.25 * float(np.min(result.normal_force))), 1.25 * largest)
     bottom.legend(loc="lower right")
     return _save(figure, path)

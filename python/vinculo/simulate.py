@@ -62,6 +62,7 @@ def simulate(
     max_iterations: int = 25,
     max_halvings: int = 4,
     initial_tolerance: float = 1e-8,
+    save_every: int = 1,
     progress: bool | ProgressCallback = False,
 ) -> Solution:
     """Integrate a constrained system from ``t_start`` to ``t_end``.
@@ -78,11 +79,16 @@ def simulate(
         alpha: 1/2 is the trapezoidal rule (second order, no numerical damping), 1 is backward Euler
             (first order, strongly damped); values between add damping.
         t_start: initial time, in s.
-        tolerance: Newton stops when the scaled residual is below this.
+        tolerance: Newton stops when the scaled residual and the last increment (both lengths, see
+            formulation.md) are below ``tolerance * system.length_scale()``.
         max_iterations: Newton iterations allowed per attempt.
         max_halvings: how many times a failing step may be halved before giving up.
-        initial_tolerance: largest constraint violation ``|s_k Phi_k|`` (m) accepted in the initial
-            state.
+        initial_tolerance: largest initial violation accepted, relative to the model's scales:
+            ``|s_k Phi_k| <= initial_tolerance * length_scale`` for positions and
+            ``|s_k (Phi_q v + Phi_t)| <= initial_tolerance * speed`` for velocities, the speed being
+            the largest initial speed or ``sqrt(|g| length_scale)``.
+        save_every: store every k-th step (the last step is always stored); long runs of large
+            models need it to keep the output in memory.
         progress: True draws a progress bar on standard error; a callable is called as
             ``progress(t, t_end)`` about twice a second of wall time.
 
@@ -123,6 +129,7 @@ def simulate(
             max_iterations=max_iterations,
             max_halvings=max_halvings,
             initial_tolerance=initial_tolerance,
+            save_every=save_every,
             progress=callback,
         )
     finally:

@@ -208,9 +208,7 @@ class Solution:
         )
         if self.num_steps > 0:
             iterations = self.newton_iterations[1:]
-            lines.append(
-                f"max constraint residual: {np.max(self.constraint_residual):.3e} m"
-            )
+            lines.append(f"max constraint residual: {np.max(self.constraint_residual):.3e} m")
             lines.append(
                 f"Newton iterations per step: mean {np.mean(iterations):.2f}, "
                 f"max {int(np.max(iterations))}"

@@ -69,9 +69,9 @@ pub fn details<'py>(py: Python<'py>, e: &Error) -> PyResult<Bound<'py, PyDict>> 
             d.set_item("residual", residual)?;
             d.set_item("equation", equation)?;
         }
-        Error::SingularMatrix { t, detail } => {
+        Error::SingularMatrix { t, equation, .. } => {
             d.set_item("time", t)?;
-            d.set_item("equation", detail)?;
+            d.set_item("equation", equation)?;
         }
         Error::Interrupted { t } => d.set_item("time", t)?,
     }

@@ -105,10 +105,12 @@ pub enum Error {
         equation: String,
     },
     /// The iteration matrix could not be factorised.
-    #[error("singular iteration matrix at t = {t:.6} s: {detail}")]
+    #[error("singular iteration matrix at t = {t:.6} s near {equation}: {detail}; the constraints may be redundant or leave the model under-determined")]
     SingularMatrix {
         /// Time at the start of the failing step.
         t: f64,
+        /// The equation (particle or constraint) where elimination found no pivot, if known.
+        equation: String,
         /// What the linear solver reported.
         detail: String,
     },

@@ -43,17 +43,16 @@ fn fill_saddle(system: &System, ws: &mut StepWorkspace, q: &[Vec3], t: f64) {
     }
 }
 
-fn singular_error(system: &System, layout: &Layout, t: f64, s: Singular) -> Error {
-    let near = match s.column {
-        Some(c) if c < layout.unknowns() => format!(" near {}", layout.equation_name(system, c)),
-        _ => String::new(),
+/// The error for a failed factorisation, naming the equation where it failed.
+pub(crate) fn singular_error(system: &System, layout: &Layout, t: f64, s: Singular) -> Error {
+    let equation = match s.column {
+        Some(c) if c < layout.unknowns() => layout.equation_name(system, c),
+        _ => "an unidentified equation".into(),
     };
     Error::SingularMatrix {
         t,
-        detail: format!(
-            "{}{near}; the constraints may be redundant or the model under-determined",
-            s.detail
-        ),
+        equation,
+        detail: s.detail,
     }
 }
 
@@ -67,6 +66,7 @@ fn solve_saddle(system: &System, ws: &mut StepWorkspace, q: &[Vec3], t: f64) -> 
     if ws.r.iter().any(|x| !x.is_finite()) {
         return Err(Error::SingularMatrix {
             t,
+            equation: "an unidentified equation".into(),
             detail: "the solution is not finite".into(),
         });
     }

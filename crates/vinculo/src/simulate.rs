@@ -2,7 +2,9 @@
 //! everything computed even when a step fails.
 
 use crate::error::{Error, Result};
-use crate::initial::{consistent_accelerations, scaled_velocity_violation, scaled_violation};
+use crate::initial::{
+    consistent_accelerations, scaled_velocity_violation, scaled_violation, singular_error,
+};
 use crate::integrators::{GeneralizedTrapezoidal, NewtonFailure, NewtonOptions, StepWorkspace};
 use crate::math::Vec3;
 use crate::model::System;
@@ -30,6 +32,8 @@ pub struct SimulationOptions {
     pub save_every: usize,
     /// Systems with at most this many unknowns use a dense LU.
     pub dense_limit: usize,
+    /// Largest memory the stored states may take (bytes); larger runs are refused up front.
+    pub max_output_bytes: f64,
 }
 
 impl Default for SimulationOptions {
@@ -44,6 +48,7 @@ impl Default for SimulationOptions {
             initial_tolerance: 1e-8,
             save_every: 1,
             dense_limit: 48,
+            max_output_bytes: 8.0 * (1u64 << 30) as f64,
         }
     }
 }
@@ -214,18 +219,21 @@ pub fn simulate_with_observer(
     };
     sol.push(t0, &q, &v, &lambda, worst, StepStats::default());
 
+    // Times are kept on an exact grid: every step is dt / 2^j, an integer number of the smallest
+    // allowed step, so t = t_start + units * unit never accumulates round-off. The last step is
+    // stretched or shortened (by at most a millionth of a step, or to what remains) to land on t_end.
+    let top = options.max_halvings as u32;
+    let unit = options.dt / f64::powi(2.0, top as i32);
+    let mut units: u64 = 0;
+    let mut level = top;
     let mut t = t0;
-    let mut h = options.dt;
     let mut step = 0usize;
-    let min_step = options.dt / f64::powi(2.0, options.max_halvings as i32);
     let mut q_new: Vec<Vec3> = q.clone();
     while t < options.t_end {
-        // Land exactly on t_end; avoid a sliver of a last step.
+        let h_nominal = unit * (1u64 << level) as f64;
         let remaining = options.t_end - t;
-        let mut h_try = h.min(remaining);
-        if remaining - h_try < 1e-9 * options.dt {
-            h_try = remaining;
-        }
+        let last = remaining <= h_nominal * (1.0 + 1e-6);
+        let h_try = if last { remaining } else { h_nominal };
         // Predictor: constant-acceleration extrapolation, last multipliers.
         for i in 0..q.len() {
             for k in 0..3 {
@@ -245,13 +253,14 @@ pub fn simulate_with_observer(
                 std::mem::swap(&mut q, &mut q_new);
                 v.copy_from_slice(&ws.state.v);
                 lambda.copy_from_slice(&ws.state.lambda);
-                t = if h_try == remaining {
+                units += 1u64 << level;
+                t = if last {
                     options.t_end
                 } else {
-                    t + h_try
+                    t0 + units as f64 * unit
                 };
                 step += 1;
-                if step % options.save_every == 0 || t >= options.t_end {
+                if step % options.save_every == 0 || last {
                     let stats = StepStats {
                         newton_iterations: report.iterations,
                         step_size: h_try,
@@ -261,7 +270,7 @@ pub fn simulate_with_observer(
                     sol.push(t, &q, &v, &lambda, scaled_violation(system, &q, t).0, stats);
                 }
                 // Grow back towards the nominal step after a reduction.
-                h = (2.0 * h).min(options.dt);
+                level = (level + 1).min(top);
                 if !observer.step(t, options.t_end) {
                     sol.status = Err(Error::Interrupted { t });
                     break;
@@ -269,8 +278,8 @@ pub fn simulate_with_observer(
             }
             Err(failure) => {
                 sol.steps_rejected += 1;
-                if h_try > min_step * 1.5 {
-                    h = 0.5 * h_try;
+                if level > 0 {
+                    level -= 1;
                     continue;
                 }
                 sol.status = Err(match failure {
@@ -285,16 +294,7 @@ pub fn simulate_with_observer(
                         residual,
                         equation: ws.layout.equation_name(system, worst),
                     },
-                    NewtonFailure::Singular(s) => {
-                        let near = s
-                            .column
-                            .map(|c| format!(" near {}", ws.layout.equation_name(system, c)))
-                            .unwrap_or_default();
-                        Error::SingularMatrix {
-                            t,
-                            detail: format!("{}{near}", s.detail),
-                        }
-                    }
+                    NewtonFailure::Singular(s) => singular_error(system, &ws.layout, t, s),
                 });
                 break;
             }

@@ -35,7 +35,8 @@ pub enum Law {
         /// Time at which the sine (and its ramp) starts.
         t_start: f64,
     },
-    /// Natural cubic spline through tabulated samples (C2, defined on the sample range only).
+    /// Natural cubic spline through tabulated samples (C2). Runs must stay within the sample range
+    /// ([`Law::domain`]); evaluated outside it, the spline continues along its end tangents.
     Tabulated(CubicSpline),
 }
 
