@@ -12,6 +12,7 @@
 //!   `[M, -G^T; G, 0] [dv; mu] = [0; -(G v + Phi_t)]`.
 
 use crate::assembly::{add, Layout, NONE};
+use crate::constraints::Constraint;
 use crate::error::{Error, Result};
 use crate::integrators::StepWorkspace;
 use crate::linear::Singular;
@@ -138,35 +139,48 @@ pub struct ProjectionReport {
     pub iterations: usize,
 }
 
-/// Largest scaled constraint residual max_k |s_k Phi_k(q, t)| and its index.
-pub fn scaled_violation(system: &System, q: &[Vec3], t: f64) -> (f64, usize) {
+/// The largest absolute value and its index (a NaN counts as the largest).
+fn worst(values: impl Iterator<Item = f64>) -> (f64, usize) {
     let mut worst = (0.0, 0);
-    for (k, c) in system.constraints().iter().enumerate() {
-        let v = (c.scale() * c.residual(q, t)).abs();
-        if v > worst.0 || v.is_nan() {
-            worst = (v, k);
+    for (k, x) in values.enumerate() {
+        let a = x.abs();
+        if a > worst.0 || a.is_nan() {
+            worst = (a, k);
         }
     }
     worst
 }
 
+/// Phi' = Phi_q v + Phi_t of one constraint.
+pub fn velocity_residual(c: &Constraint, q: &[Vec3], v: &[Vec3], t: f64) -> f64 {
+    let g = c.gradient(q, t);
+    let gv: f64 = c
+        .particles()
+        .iter()
+        .enumerate()
+        .map(|(x, &p)| dot(g[x], v[p]))
+        .sum();
+    gv + c.phi_t(q, t)
+}
+
+/// Largest scaled constraint residual max_k |s_k Phi_k(q, t)| and its index.
+pub fn scaled_violation(system: &System, q: &[Vec3], t: f64) -> (f64, usize) {
+    worst(
+        system
+            .constraints()
+            .iter()
+            .map(|c| c.scale() * c.residual(q, t)),
+    )
+}
+
 /// Largest scaled velocity-constraint residual max_k |s_k (Phi_q v + Phi_t)| and its index.
 pub fn scaled_velocity_violation(system: &System, q: &[Vec3], v: &[Vec3], t: f64) -> (f64, usize) {
-    let mut worst = (0.0, 0);
-    for (k, c) in system.constraints().iter().enumerate() {
-        let g = c.gradient(q, t);
-        let gv: f64 = c
-            .particles()
+    worst(
+        system
+            .constraints()
             .iter()
-            .enumerate()
-            .map(|(x, &p)| dot(g[x], v[p]))
-            .sum();
-        let r = (c.scale() * (gv + c.phi_t(q, t))).abs();
-        if r > worst.0 || r.is_nan() {
-            worst = (r, k);
-        }
-    }
-    worst
+            .map(|c| c.scale() * velocity_residual(c, q, v, t)),
+    )
 }
 
 /// Moves the system's initial positions and velocities onto Phi = 0 and G v + Phi_t = 0 at time t
@@ -207,14 +221,7 @@ pub fn project_initial_state(
     }
     ws.r.fill(0.0);
     for (c, con) in system.constraints().iter().enumerate() {
-        let g = con.gradient(&q, t);
-        let gv: f64 = con
-            .particles()
-            .iter()
-            .enumerate()
-            .map(|(x, &p)| dot(g[x], v[p]))
-            .sum();
-        ws.r[m3 + c] = -ws.scales[c] * (gv + con.phi_t(&q, t));
+        ws.r[m3 + c] = -ws.scales[c] * velocity_residual(con, &q, &v, t);
     }
     solve_saddle(system, &mut ws, &q, t)?;
     add_free(&ws.layout, &ws.r, &mut v);
@@ -255,14 +262,8 @@ mod tests {
         let v = s.initial_velocities();
         assert!(scaled_violation(&s, &q, 0.0).0 < 1e-14, "position residual");
         for con in s.constraints() {
-            let g = con.gradient(&q, 0.0);
-            let gv: f64 = con
-                .particles()
-                .iter()
-                .enumerate()
-                .map(|(x, &p)| dot(g[x], v[p]))
-                .sum();
-            assert!(gv.abs() < 1e-13, "velocity constraint residual {gv}");
+            let r = velocity_residual(con, &q, &v, 0.0);
+            assert!(r.abs() < 1e-13, "velocity constraint residual {r}");
         }
         assert!(
             (report.position_change - 0.1).abs() < 0.05,

@@ -159,38 +159,37 @@ pub fn simulate_with_observer(
     let t0 = options.t_start;
     let mut q = system.initial_positions();
     let mut v = system.initial_velocities();
-    let (worst, k) = scaled_violation(system, &q, t0);
-    if worst.is_nan() || worst > options.initial_tolerance * length {
-        let c = &system.constraints()[k];
-        return Err(Error::InconsistentInitialState {
-            level: "positions".into(),
-            quantity: "Phi".into(),
-            constraint: c.name(k),
-            violation: c.residual(&q, t0).abs(),
-            scaled: worst,
-            tolerance: options.initial_tolerance * length,
-        });
-    }
-
-    // Velocities: compared with a speed scale of the model, the largest initial speed or the
-    // speed of a fall through its length scale, sqrt(|g| l).
+    // Positions are compared with the model's length scale; velocities with a speed scale, the
+    // largest initial speed or the speed of a fall through the length scale, sqrt(|g| l).
     let g = system.gravity();
     let speed = v
         .iter()
         .map(|x| crate::math::norm(*x))
         .fold((crate::math::norm(g) * length).sqrt(), f64::max);
     let speed = if speed > 0.0 { speed } else { length };
-    let (worst_v, k) = scaled_velocity_violation(system, &q, &v, t0);
-    if worst_v.is_nan() || worst_v > options.initial_tolerance * speed {
-        let c = &system.constraints()[k];
-        return Err(Error::InconsistentInitialState {
-            level: "velocities".into(),
-            quantity: "Phi_q v + Phi_t".into(),
-            constraint: c.name(k),
-            violation: worst_v / c.scale(),
-            scaled: worst_v,
-            tolerance: options.initial_tolerance * speed,
-        });
+    let (worst, k) = scaled_violation(system, &q, t0);
+    let checks = [
+        ("positions", "Phi", (worst, k), length),
+        (
+            "velocities",
+            "Phi_q v + Phi_t",
+            scaled_velocity_violation(system, &q, &v, t0),
+            speed,
+        ),
+    ];
+    for (level, quantity, (violation, k), scale) in checks {
+        let tolerance = options.initial_tolerance * scale;
+        if violation.is_nan() || violation > tolerance {
+            let c = &system.constraints()[k];
+            return Err(Error::InconsistentInitialState {
+                level: level.into(),
+                quantity: quantity.into(),
+                constraint: c.name(k),
+                violation: violation / c.scale(),
+                scaled: violation,
+                tolerance,
+            });
+        }
     }
 
     let mut ws = StepWorkspace::new(system, options.dense_limit);

@@ -82,18 +82,13 @@ impl CubicSpline {
     /// Value, slope and curvature at `t`. Outside the samples the spline continues as the straight
     /// line tangent at the end (its curvature is zero there, so the extension stays C2).
     pub fn eval(&self, t: f64) -> (f64, f64, f64) {
-        let n = self.t.len();
-        for end in [0, n - 1] {
-            let outside = if end == 0 {
-                t < self.t[0]
-            } else {
-                t > self.t[n - 1]
-            };
-            if outside {
-                let (y, slope, _) = self.eval(self.t[end]);
-                return (y + slope * (t - self.t[end]), slope, 0.0);
-            }
+        let (first, last) = self.domain();
+        if t < first || t > last {
+            let end = t.clamp(first, last);
+            let (y, slope, _) = self.eval(end);
+            return (y + slope * (t - end), slope, 0.0);
         }
+        let n = self.t.len();
         let i = match self.t.partition_point(|&x| x <= t) {
             0 => 0,
             k if k >= n => n - 2,
