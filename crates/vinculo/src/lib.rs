@@ -44,5 +44,6 @@ pub mod simulate;
 pub mod solution;
 
 pub use error::{Error, Result};
+pub use linear::SparseSolver;
 pub use simulate::{simulate, simulate_with_observer, Observer, SimulationOptions};
 pub use solution::{Solution, StepStats};

@@ -6,6 +6,7 @@ use crate::initial::{
     consistent_accelerations, scaled_velocity_violation, scaled_violation, singular_error,
 };
 use crate::integrators::{GeneralizedTrapezoidal, NewtonFailure, NewtonOptions, StepWorkspace};
+use crate::linear::SparseSolver;
 use crate::math::Vec3;
 use crate::model::System;
 use crate::solution::{Solution, StepStats};
@@ -32,6 +33,9 @@ pub struct SimulationOptions {
     pub save_every: usize,
     /// Systems with at most this many unknowns use a dense LU.
     pub dense_limit: usize,
+    /// Solver for larger systems: tree elimination when the constraint graph is a forest
+    /// (`Auto`), or always the general sparse LU. [`Solution::linear_solver`] names the one used.
+    pub sparse_solver: SparseSolver,
     /// Largest memory the stored states may take (bytes); larger runs are refused up front.
     pub max_output_bytes: f64,
 }
@@ -48,6 +52,7 @@ impl Default for SimulationOptions {
             initial_tolerance: 1e-8,
             save_every: 1,
             dense_limit: 48,
+            sparse_solver: SparseSolver::Auto,
             max_output_bytes: 8.0 * (1u64 << 30) as f64,
         }
     }
@@ -192,7 +197,7 @@ pub fn simulate_with_observer(
         }
     }
 
-    let mut ws = StepWorkspace::new(system, options.dense_limit);
+    let mut ws = StepWorkspace::with_solver(system, options.dense_limit, options.sparse_solver);
     let scheme = GeneralizedTrapezoidal {
         alpha: options.alpha,
     };

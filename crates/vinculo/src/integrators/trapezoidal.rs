@@ -26,7 +26,7 @@
 use super::newton::{self, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport};
 use crate::assembly::{add, add_block, Layout, NONE};
 use crate::forces::Jacobian;
-use crate::linear::{for_pattern, LinearSolver};
+use crate::linear::{for_layout, LinearSolver, SparseSolver};
 use crate::math::{Mat3, Vec3};
 use crate::model::System;
 
@@ -69,10 +69,15 @@ pub struct StepBuffers {
 }
 
 impl StepWorkspace {
-    /// Analyses the system once.
+    /// Analyses the system once (solver chosen automatically).
     pub fn new(system: &System, dense_limit: usize) -> StepWorkspace {
+        StepWorkspace::with_solver(system, dense_limit, SparseSolver::Auto)
+    }
+
+    /// Analyses the system once, with the given choice of sparse solver.
+    pub fn with_solver(system: &System, dense_limit: usize, sparse: SparseSolver) -> StepWorkspace {
         let layout = Layout::new(system, dense_limit);
-        let solver = for_pattern(&layout.pattern);
+        let solver = for_layout(&layout.pattern, 3 * layout.free, sparse);
         let n = system.particles().len();
         let free: Vec<f64> = system
             .particles()

@@ -4,9 +4,11 @@
 
 mod dense_lu;
 mod sparse_lu;
+mod tree_elimination;
 
 pub use dense_lu::DenseLu;
 pub use sparse_lu::SparseLu;
+pub use tree_elimination::TreeElimination;
 
 use crate::assembly::{Pattern, Storage};
 
@@ -29,12 +31,41 @@ pub trait LinearSolver: Send {
     fn name(&self) -> &'static str;
 }
 
-/// The solver that suits the pattern's storage.
-pub fn for_pattern(pattern: &Pattern) -> Box<dyn LinearSolver> {
-    match pattern.storage {
-        Storage::Dense => Box::new(DenseLu::new(pattern.n)),
-        Storage::Sparse => Box::new(SparseLu::new(pattern)),
+/// Which solver a sparse pattern gets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SparseSolver {
+    /// Tree elimination when the constraint graph is a forest (linear cost), otherwise the
+    /// general sparse LU.
+    #[default]
+    Auto,
+    /// Always the general sparse LU.
+    SparseLu,
+}
+
+/// The solver that suits the pattern's storage: dense LU for dense storage; for sparse storage,
+/// block elimination along the tree when the pattern allows it (see [`TreeElimination`]) and
+/// `choice` is `Auto`, else the general sparse LU. The first `particle_unknowns` unknowns are
+/// the free particles' coordinates, 3 each.
+pub fn for_layout(
+    pattern: &Pattern,
+    particle_unknowns: usize,
+    choice: SparseSolver,
+) -> Box<dyn LinearSolver> {
+    match (pattern.storage, choice) {
+        (Storage::Dense, _) => Box::new(DenseLu::new(pattern.n)),
+        (Storage::Sparse, SparseSolver::SparseLu) => Box::new(SparseLu::new(pattern)),
+        (Storage::Sparse, SparseSolver::Auto) => {
+            match TreeElimination::analyse(pattern, particle_unknowns) {
+                Some(tree) => Box::new(tree),
+                None => Box::new(SparseLu::new(pattern)),
+            }
+        }
     }
+}
+
+/// The solver that suits the pattern's storage (dense LU or general sparse LU).
+pub fn for_pattern(pattern: &Pattern) -> Box<dyn LinearSolver> {
+    for_layout(pattern, 0, SparseSolver::SparseLu)
 }
 
 #[cfg(test)]

@@ -1,0 +1,635 @@
+//! Block elimination along a tree: linear cost for chains, ropes, tethers and branched strings.
+//!
+//! The unknowns are grouped into blocks: one per free particle (its 3 coordinates), to which
+//! are added the multipliers of the constraints that touch only that particle. A constraint
+//! between two particles is an edge of the particle graph; so is a force with a Jacobian
+//! between two particles. When that graph is a forest, every tree is rooted and each
+//! two-particle multiplier joins the block of the edge's child particle. Then block b couples
+//! only with itself and with the 3 coordinates of its parent particle P:
+//!
+//! ```text
+//! [ D_b   A_bP ] [x_b]   [r_b]
+//! [ A_Pb  D_P  ] [x_P] = [r_P]
+//! ```
+//!
+//! and eliminating the leaves first never creates fill outside the blocks: with
+//! `W_b = D_b^-1 A_bP`, the parent's block becomes the Schur complement `D_P - A_Pb W_b`
+//! (only its 3x3 particle part changes). Each D_b is factorised by a dense LU with partial
+//! pivoting inside the block (a KKT block such as `[M, -s g^T; s g, 0]` has a zero diagonal
+//! entry). The solve is a forward sweep (leaves to roots, `z_b = D_b^-1 r_b`,
+//! `r_P -= A_Pb z_b`) and a backward sweep (roots to leaves, `x_b = z_b - W_b x_P`).
+//!
+//! The analysis works on the matrix pattern alone and checks that every structural entry lies
+//! inside a block or between a block and its parent's particle part; otherwise (a loop, a
+//! constraint on three particles, coupled multipliers) it declines and the caller falls back to
+//! the general sparse LU.
+
+use super::{LinearSolver, Singular};
+use crate::assembly::{Pattern, Storage};
+
+const ABSENT: u32 = u32::MAX;
+const ROOT: u32 = u32::MAX;
+
+/// Tree-structured block LU (see the module documentation).
+pub struct TreeElimination {
+    /// First local unknown of each block, in elimination order (one past the end last).
+    start: Vec<usize>,
+    /// First entry of each block's diagonal storage (n_b^2 entries each).
+    diag_at: Vec<usize>,
+    /// Position of each block's parent block in the elimination order (ROOT for roots).
+    parent: Vec<u32>,
+    /// Global unknown of each local unknown.
+    unknowns: Vec<u32>,
+    /// Slots of D_b (row-major), A_Pb (3 x n_b, row-major) and A_bP (n_b x 3, row-major).
+    diag_slots: Vec<u32>,
+    low_slots: Vec<u32>,
+    up_slots: Vec<u32>,
+    /// LU factors of D_b, A_Pb, and W_b = D_b^-1 A_bP.
+    diag: Vec<f64>,
+    low: Vec<f64>,
+    w: Vec<f64>,
+    /// Row interchanges of each block's LU (local indices).
+    perm: Vec<u32>,
+    /// Work vector in local (block) order.
+    z: Vec<f64>,
+    factored: bool,
+}
+
+/// Union-find root with path halving.
+fn find(set: &mut [usize], mut i: usize) -> usize {
+    while set[i] != i {
+        set[i] = set[set[i]];
+        i = set[i];
+    }
+    i
+}
+
+/// Slot of entry (row, col) if it is in the pattern.
+fn slot(pattern: &Pattern, row: usize, col: usize) -> u32 {
+    let (a, b) = (pattern.col_ptr[col], pattern.col_ptr[col + 1]);
+    match pattern.row_idx[a..b].binary_search(&row) {
+        Ok(k) => (a + k) as u32,
+        Err(_) => ABSENT,
+    }
+}
+
+impl TreeElimination {
+    /// Analyses a sparse pattern whose first `particle_unknowns` unknowns come in groups of 3
+    /// (one group per free particle) and whose other unknowns are single multipliers.
+    /// Returns `None` when the block graph is not a forest (the caller then uses a general
+    /// sparse LU).
+    pub fn analyse(pattern: &Pattern, particle_unknowns: usize) -> Option<TreeElimination> {
+        let n = pattern.n;
+        if pattern.storage != Storage::Sparse
+            || particle_unknowns % 3 != 0
+            || particle_unknowns > n
+            || pattern.nnz() >= ABSENT as usize
+        {
+            return None;
+        }
+        let np = particle_unknowns / 3;
+        let nl = n - particle_unknowns;
+        let particle = |u: usize| (u < particle_unknowns).then_some(u / 3);
+
+        // Particles touched by each multiplier (at most 2), and particle-particle couplings.
+        let mut touched = vec![[ABSENT; 2]; nl];
+        let mut edges: Vec<(u32, u32)> = Vec::new();
+        for col in 0..n {
+            for &row in &pattern.row_idx[pattern.col_ptr[col]..pattern.col_ptr[col + 1]] {
+                match (particle(row), particle(col)) {
+                    (Some(a), Some(b)) if a < b => edges.push((a as u32, b as u32)),
+                    (Some(_), Some(_)) => {}
+                    (Some(p), None) | (None, Some(p)) => {
+                        let k =
+                            if row >= particle_unknowns { row } else { col } - particle_unknowns;
+                        let t = &mut touched[k];
+                        if t[0] == p as u32 || t[1] == p as u32 {
+                        } else if t[0] == ABSENT {
+                            t[0] = p as u32;
+                        } else if t[1] == ABSENT {
+                            t[1] = p as u32;
+                        } else {
+                            return None; // a multiplier on three particles
+                        }
+                    }
+                    (None, None) if row != col => return None, // coupled multipliers
+                    (None, None) => {}
+                }
+            }
+        }
+        for t in &touched {
+            match *t {
+                [ABSENT, _] => return None, // a multiplier on no free particle
+                [a, b] if b != ABSENT => edges.push((a.min(b), a.max(b))),
+                _ => {}
+            }
+        }
+        edges.sort_unstable();
+        edges.dedup();
+        // A forest has no edge joining two particles already connected.
+        let mut set: Vec<usize> = (0..np).collect();
+        for &(a, b) in &edges {
+            let (ra, rb) = (find(&mut set, a as usize), find(&mut set, b as usize));
+            if ra == rb {
+                return None;
+            }
+            set[ra] = rb;
+        }
+        drop(set);
+
+        // Adjacency (CSR), then breadth-first order from the lowest particle of each tree.
+        let mut adj_ptr = vec![0usize; np + 1];
+        for &(a, b) in &edges {
+            adj_ptr[a as usize + 1] += 1;
+            adj_ptr[b as usize + 1] += 1;
+        }
+        for i in 0..np {
+            adj_ptr[i + 1] += adj_ptr[i];
+        }
+        let mut fill = adj_ptr.clone();
+        let mut adj = vec![0u32; 2 * edges.len()];
+        for &(a, b) in &edges {
+            adj[fill[a as usize]] = b;
+            fill[a as usize] += 1;
+            adj[fill[b as usize]] = a;
+            fill[b as usize] += 1;
+        }
+        drop(fill);
+        drop(edges);
+        let mut parent_particle = vec![ROOT; np];
+        let mut seen = vec![false; np];
+        let mut order: Vec<u32> = Vec::with_capacity(np);
+        for root in 0..np {
+            if seen[root] {
+                continue;
+            }
+            seen[root] = true;
+            let mut head = order.len();
+            order.push(root as u32);
+            while head < order.len() {
+                let p = order[head] as usize;
+                head += 1;
+                for &c in &adj[adj_ptr[p]..adj_ptr[p + 1]] {
+                    if !seen[c as usize] {
+                        seen[c as usize] = true;
+                        parent_particle[c as usize] = p as u32;
+                        order.push(c);
+                    }
+                }
+            }
+        }
+        drop(adj);
+        drop(seen);
+        // Leaves first: the reverse breadth-first order puts every child before its parent.
+        order.reverse();
+        let mut position = vec![0u32; np];
+        for (b, &p) in order.iter().enumerate() {
+            position[p as usize] = b as u32;
+        }
+
+        // Each multiplier joins its particle, or the child of its edge.
+        let owner = |t: [u32; 2]| -> usize {
+            if t[1] == ABSENT || parent_particle[t[0] as usize] == t[1] {
+                t[0] as usize
+            } else {
+                t[1] as usize
+            }
+        };
+        let mut size = vec![3usize; np];
+        for t in &touched {
+            size[owner(*t)] += 1;
+        }
+        let mut start = vec![0usize; np + 1];
+        let mut diag_at = vec![0usize; np + 1];
+        for (b, &p) in order.iter().enumerate() {
+            let s = size[p as usize];
+            start[b + 1] = start[b] + s;
+            diag_at[b + 1] = diag_at[b] + s * s;
+        }
+        let mut unknowns = vec![0u32; n];
+        let mut next: Vec<usize> = (0..np).map(|b| start[b] + 3).collect();
+        for (b, &p) in order.iter().enumerate() {
+            for r in 0..3 {
+                unknowns[start[b] + r] = 3 * p + r as u32;
+            }
+        }
+        for (k, t) in touched.iter().enumerate() {
+            let b = position[owner(*t)] as usize;
+            unknowns[next[b]] = (particle_unknowns + k) as u32;
+            next[b] += 1;
+        }
+        drop(next);
+        drop(touched);
+        let parent: Vec<u32> = order
+            .iter()
+            .map(|&p| match parent_particle[p as usize] {
+                ROOT => ROOT,
+                q => position[q as usize],
+            })
+            .collect();
+        drop(order);
+        drop(position);
+        drop(parent_particle);
+
+        // Slots of every block and coupling; the entries they cover must be the whole pattern.
+        let blocks = np;
+        let mut diag_slots = vec![ABSENT; diag_at[blocks]];
+        let mut low_slots = vec![ABSENT; 3 * n];
+        let mut up_slots = vec![ABSENT; 3 * n];
+        let mut covered = 0usize;
+        for b in 0..blocks {
+            let local = &unknowns[start[b]..start[b + 1]];
+            let nb = local.len();
+            for (i, &ui) in local.iter().enumerate() {
+                for (j, &uj) in local.iter().enumerate() {
+                    let s = slot(pattern, ui as usize, uj as usize);
+                    covered += (s != ABSENT) as usize;
+                    diag_slots[diag_at[b] + i * nb + j] = s;
+                }
+            }
+            if parent[b] != ROOT {
+                let pb = parent[b] as usize;
+                for r in 0..3 {
+                    let up = unknowns[start[pb] + r] as usize;
+                    for (j, &uj) in local.iter().enumerate() {
+                        let lo = slot(pattern, up, uj as usize);
+                        let hi = slot(pattern, uj as usize, up);
+                        covered += (lo != ABSENT) as usize + (hi != ABSENT) as usize;
+                        low_slots[3 * start[b] + r * nb + j] = lo;
+                        up_slots[3 * start[b] + j * 3 + r] = hi;
+                    }
+                }
+            }
+        }
+        if covered != pattern.nnz() {
+            return None;
+        }
+        Some(TreeElimination {
+            diag: vec![0.0; diag_at[blocks]],
+            low: vec![0.0; 3 * n],
+            w: vec![0.0; 3 * n],
+            perm: vec![0; n],
+            z: vec![0.0; n],
+            start,
+            diag_at,
+            parent,
+            unknowns,
+            diag_slots,
+            low_slots,
+            up_slots,
+            factored: false,
+        })
+    }
+
+    /// Number of blocks (free particles).
+    pub fn blocks(&self) -> usize {
+        self.parent.len()
+    }
+}
+
+/// Gathers `values` at `slots` into `out` (absent entries are zero).
+fn gather(out: &mut [f64], slots: &[u32], values: &[f64]) {
+    for (o, &s) in out.iter_mut().zip(slots) {
+        *o = if s == ABSENT { 0.0 } else { values[s as usize] };
+    }
+}
+
+/// In-place LU with partial pivoting of the n x n row-major matrix `a`; returns the local
+/// column of a negligible pivot.
+#[inline]
+fn lu_in_place(a: &mut [f64], n: usize, perm: &mut [u32]) -> Result<(), usize> {
+    let largest = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let tiny = largest * 1e3 * f64::EPSILON * n as f64;
+    for k in 0..n {
+        let mut p = k;
+        for i in k + 1..n {
+            if a[i * n + k].abs() > a[p * n + k].abs() {
+                p = i;
+            }
+        }
+        perm[k] = p as u32;
+        if p != k {
+            for j in 0..n {
+                a.swap(k * n + j, p * n + j);
+            }
+        }
+        let pivot = a[k * n + k];
+        if !pivot.is_finite() || pivot.abs() <= tiny {
+            return Err(k);
+        }
+        let inv = 1.0 / pivot;
+        for i in k + 1..n {
+            let l = a[i * n + k] * inv;
+            a[i * n + k] = l;
+            if l != 0.0 {
+                for j in k + 1..n {
+                    a[i * n + j] -= l * a[k * n + j];
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Solves with the factors of `lu_in_place` for the n x m row-major right-hand side `x`.
+#[inline]
+fn lu_solve(a: &[f64], n: usize, perm: &[u32], x: &mut [f64], m: usize) {
+    for k in 0..n {
+        let p = perm[k] as usize;
+        if p != k {
+            for c in 0..m {
+                x.swap(k * m + c, p * m + c);
+            }
+        }
+    }
+    for i in 1..n {
+        for j in 0..i {
+            let l = a[i * n + j];
+            if l != 0.0 {
+                for c in 0..m {
+                    x[i * m + c] -= l * x[j * m + c];
+                }
+            }
+        }
+    }
+    for i in (0..n).rev() {
+        for j in i + 1..n {
+            let u = a[i * n + j];
+            for c in 0..m {
+                x[i * m + c] -= u * x[j * m + c];
+            }
+        }
+        let inv = 1.0 / a[i * n + i];
+        for c in 0..m {
+            x[i * m + c] *= inv;
+        }
+    }
+}
+
+impl LinearSolver for TreeElimination {
+    fn factor(&mut self, values: &[f64]) -> Result<(), Singular> {
+        self.factored = false;
+        gather(&mut self.diag, &self.diag_slots, values);
+        gather(&mut self.low, &self.low_slots, values);
+        gather(&mut self.w, &self.up_slots, values);
+        for b in 0..self.blocks() {
+            let (s, nb) = (self.start[b], self.start[b + 1] - self.start[b]);
+            let (da, db) = (self.diag_at[b], self.diag_at[b + 1]);
+            let (own, rest) = self.diag.split_at_mut(db);
+            let d = &mut own[da..];
+            if let Err(k) = lu_in_place(d, nb, &mut self.perm[s..s + nb]) {
+                let column = self.unknowns[s + k] as usize;
+                return Err(Singular {
+                    column: Some(column),
+                    detail: format!(
+                        "negligible pivot in the block of unknown {column} (tree elimination)"
+                    ),
+                });
+            }
+            let pb = self.parent[b];
+            if pb == ROOT {
+                continue;
+            }
+            let w = &mut self.w[3 * s..3 * s + 3 * nb];
+            lu_solve(d, nb, &self.perm[s..s + nb], w, 3);
+            // Schur complement on the parent's particle part: D_P[0..3, 0..3] -= A_Pb W_b.
+            let pb = pb as usize;
+            let np = self.start[pb + 1] - self.start[pb];
+            let dp = &mut rest[self.diag_at[pb] - db..];
+            let low = &self.low[3 * s..3 * s + 3 * nb];
+            for r in 0..3 {
+                for c in 0..3 {
+                    let mut acc = 0.0;
+                    for j in 0..nb {
+                        acc += low[r * nb + j] * w[j * 3 + c];
+                    }
+                    dp[r * np + c] -= acc;
+                }
+            }
+        }
+        self.factored = true;
+        Ok(())
+    }
+
+    fn solve_in_place(&mut self, rhs: &mut [f64]) {
+        assert!(self.factored, "solve before a successful factorisation");
+        for (z, &u) in self.z.iter_mut().zip(&self.unknowns) {
+            *z = rhs[u as usize];
+        }
+        for b in 0..self.blocks() {
+            let (s, e) = (self.start[b], self.start[b + 1]);
+            let nb = e - s;
+            let d = &self.diag[self.diag_at[b]..self.diag_at[b + 1]];
+            let (head, tail) = self.z.split_at_mut(e);
+            let zb = &mut head[s..];
+            lu_solve(d, nb, &self.perm[s..e], zb, 1);
+            let pb = self.parent[b];
+            if pb != ROOT {
+                let zp = &mut tail[self.start[pb as usize] - e..];
+                let low = &self.low[3 * s..3 * e];
+                for r in 0..3 {
+                    let mut acc = 0.0;
+                    for j in 0..nb {
+                        acc += low[r * nb + j] * zb[j];
+                    }
+                    zp[r] -= acc;
+                }
+            }
+        }
+        for b in (0..self.blocks()).rev() {
+            let pb = self.parent[b];
+            if pb == ROOT {
+                continue;
+            }
+            let (s, e) = (self.start[b], self.start[b + 1]);
+            let (head, tail) = self.z.split_at_mut(e);
+            let zp = &tail[self.start[pb as usize] - e..];
+            let (xp0, xp1, xp2) = (zp[0], zp[1], zp[2]);
+            let w = &self.w[3 * s..3 * e];
+            for (j, x) in head[s..].iter_mut().enumerate() {
+                *x -= w[3 * j] * xp0 + w[3 * j + 1] * xp1 + w[3 * j + 2] * xp2;
+            }
+        }
+        for (z, &u) in self.z.iter().zip(&self.unknowns) {
+            rhs[u as usize] = *z;
+        }
+    }
+
+    fn name(&self) -> &'static str {
+        "tree elimination"
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assembly::Layout;
+    use crate::laws::VectorLaw;
+    use crate::linear::{for_layout, SparseLu, SparseSolver};
+    use crate::model::System;
+
+    /// Deterministic pseudo-random numbers in [-1, 1) (a 64-bit linear congruential generator).
+    struct Lcg(u64);
+    impl Lcg {
+        fn next(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (self.0 >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        }
+    }
+
+    /// A chain of `n` links from a fixed anchor, with a side branch of 3 particles at the
+    /// middle, a plane under the tip, a fixed coordinate and a spring along the branch: a tree
+    /// with every kind of coupling.
+    fn branched_string(n: usize) -> System {
+        let mut s = System::new([0.0, 0.0, -9.81]);
+        let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
+        let mut middle = prev;
+        for i in 1..=n {
+            let p = s
+                .add_particle(0.1, [0.1 * i as f64, 0.0, 0.0], [0.0; 3], false)
+                .unwrap();
+            s.add_distance(prev, p, None).unwrap();
+            if i == n / 2 {
+                middle = p;
+            }
+            prev = p;
+        }
+        let tip = prev;
+        s.add_plane(
+            tip,
+            VectorLaw::constant([0.0, 0.0, 1.0]),
+            VectorLaw::constant([0.1 * n as f64, 0.0, 0.0]),
+        )
+        .unwrap();
+        let mut prev = middle;
+        for j in 1..=3 {
+            let p = s
+                .add_particle(0.2, [0.05 * n as f64, 0.1 * j as f64, 0.0], [0.0; 3], false)
+                .unwrap();
+            s.add_distance(prev, p, None).unwrap();
+            if j == 2 {
+                s.add_spring_damper(prev, p, 50.0, 0.5, None).unwrap();
+                s.add_fixed_coordinate(p, 2, None).unwrap();
+            }
+            prev = p;
+        }
+        s
+    }
+
+    /// Values for the pattern of `layout`: dominant particle diagonal blocks, random couplings.
+    fn values(layout: &Layout, seed: u64) -> Vec<f64> {
+        let p = &layout.pattern;
+        let mut rng = Lcg(seed);
+        let mut v = vec![0.0; p.nnz()];
+        for col in 0..p.n {
+            for k in p.col_ptr[col]..p.col_ptr[col + 1] {
+                let row = p.row_idx[k];
+                v[k] = rng.next();
+                if row == col && row < 3 * layout.free {
+                    v[k] += 6.0;
+                }
+            }
+        }
+        v
+    }
+
+    fn solve(solver: &mut dyn LinearSolver, values: &[f64], b: &[f64]) -> Vec<f64> {
+        solver.factor(values).unwrap();
+        let mut x = b.to_vec();
+        solver.solve_in_place(&mut x);
+        x
+    }
+
+    /// Tree elimination and faer's general sparse LU give the same solution (to 1e-12 relative)
+    /// on random matrices with the patterns of a chain and of a branched string; the reference
+    /// is the sparse LU, and the residual of both against the matrix is checked too.
+    #[test]
+    fn tree_elimination_matches_sparse_lu() {
+        for (system, seed) in [(branched_string(1), 1), (branched_string(40), 7)] {
+            let layout = Layout::new(&system, 0);
+            let mut tree = TreeElimination::analyse(&layout.pattern, 3 * layout.free)
+                .expect("a branched string is a tree");
+            let mut lu = SparseLu::new(&layout.pattern);
+            let n = layout.unknowns();
+            let mut rng = Lcg(seed + 100);
+            let b: Vec<f64> = (0..n).map(|_| rng.next()).collect();
+            for round in 0..3 {
+                let v = values(&layout, seed + round);
+                let x = solve(&mut tree, &v, &b);
+                let y = solve(&mut lu, &v, &b);
+                let scale = y.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                for i in 0..n {
+                    assert!(
+                        (x[i] - y[i]).abs() <= 1e-12 * scale,
+                        "unknown {i}: tree {} vs sparse LU {}",
+                        x[i],
+                        y[i]
+                    );
+                }
+                let p = &layout.pattern;
+                let mut r = b.clone();
+                for col in 0..n {
+                    for k in p.col_ptr[col]..p.col_ptr[col + 1] {
+                        r[p.row_idx[k]] -= v[k] * x[col];
+                    }
+                }
+                assert!(r.iter().all(|e| e.abs() < 1e-12), "residual {r:?}");
+            }
+        }
+    }
+
+    /// Closing a loop (a spring from the tip back to the first particle, or a triangle of
+    /// distances) makes the solver fall back to the general sparse LU; a chain gets the tree.
+    #[test]
+    fn loops_fall_back_to_sparse_lu() {
+        let name = |s: &System| {
+            let layout = Layout::new(s, 0);
+            for_layout(&layout.pattern, 3 * layout.free, SparseSolver::Auto).name()
+        };
+        let mut s = branched_string(10);
+        assert_eq!(name(&s), "tree elimination");
+        let first = s.particle_id(1).unwrap();
+        let tip = s.particle_id(10).unwrap();
+        s.add_spring_damper(first, tip, 1.0, 0.0, None).unwrap();
+        assert_eq!(name(&s), "sparse LU");
+
+        let mut t = System::new([0.0, 0.0, -9.81]);
+        let p: Vec<_> = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+            .iter()
+            .map(|&x| t.add_particle(1.0, x, [0.0; 3], false).unwrap())
+            .collect();
+        t.add_distance(p[0], p[1], None).unwrap();
+        t.add_distance(p[1], p[2], None).unwrap();
+        assert_eq!(name(&t), "tree elimination");
+        t.add_distance(p[2], p[0], None).unwrap();
+        assert_eq!(name(&t), "sparse LU");
+    }
+
+    /// A rank-deficient tree matrix (a particle held by two identical fixed coordinates) is
+    /// reported as singular, naming an unknown of that particle's block.
+    #[test]
+    fn singular_block_is_reported() {
+        let mut s = System::new([0.0, 0.0, -9.81]);
+        let a = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
+        let b = s
+            .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], false)
+            .unwrap();
+        s.add_distance(a, b, None).unwrap();
+        s.add_fixed_coordinate(b, 1, None).unwrap();
+        s.add_fixed_coordinate(b, 1, None).unwrap();
+        let layout = Layout::new(&s, 0);
+        let mut tree = TreeElimination::analyse(&layout.pattern, 3).unwrap();
+        let mut v = values(&layout, 3);
+        // Make the two fixed-coordinate rows and columns identical.
+        let (k1, k2) = (4, 5);
+        for j in 0..3 {
+            v[layout.pattern.slot(k2, j)] = v[layout.pattern.slot(k1, j)];
+            v[layout.pattern.slot(j, k2)] = v[layout.pattern.slot(j, k1)];
+        }
+        let err = tree.factor(&v).unwrap_err();
+        assert!(err.column.is_some_and(|c| c < 6), "{err:?}");
+    }
+}
