@@ -64,7 +64,10 @@ fn chain_and_branched_string_give_the_same_trajectory_with_either_solver() {
             .iter()
             .zip(&lu.positions)
             .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-        assert!(worst < 1e-12 * extent, "largest position difference {worst:e}");
+        assert!(
+            worst < 1e-12 * extent,
+            "largest position difference {worst:e}"
+        );
         // Multipliers agree to 1e-9 of the largest (they are differences of large numbers).
         let largest = lu.multipliers.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let worst = tree
@@ -72,7 +75,10 @@ fn chain_and_branched_string_give_the_same_trajectory_with_either_solver() {
             .iter()
             .zip(&lu.multipliers)
             .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-        assert!(worst < 1e-9 * largest, "largest multiplier difference {worst:e}");
+        assert!(
+            worst < 1e-9 * largest,
+            "largest multiplier difference {worst:e}"
+        );
         let its = |s: &Solution| s.stats.iter().map(|x| x.newton_iterations).sum::<usize>();
         assert_eq!(its(&tree), its(&lu));
     }

@@ -57,8 +57,25 @@ impl Layout {
         let n = 3 * free + m;
         let lambda = |k: usize| 3 * free + k;
 
-        // Structural entries, column by column.
-        let mut entries: Vec<(usize, usize)> = Vec::new();
+        // Structural entries, column by column (reserved exactly: no doubling overshoot, which
+        // dominates the peak memory of million-particle models).
+        let count = |parts: &[usize]| {
+            let k = parts.iter().filter(|&&p| dof[p] != NONE).count();
+            9 * k * k
+        };
+        let reserve = 9 * free
+            + system
+                .constraints()
+                .iter()
+                .map(|c| count(c.particles()) + 2 * 3 * c.particles().len())
+                .sum::<usize>()
+            + system
+                .forces()
+                .iter()
+                .filter(|f| f.has_jacobian())
+                .map(|f| count(f.particles()))
+                .sum::<usize>();
+        let mut entries: Vec<(usize, usize)> = Vec::with_capacity(reserve);
         let block = |entries: &mut Vec<(usize, usize)>, a: usize, b: usize| {
             if a != NONE && b != NONE {
                 for r in 0..3 {

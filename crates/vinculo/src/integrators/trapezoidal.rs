@@ -37,6 +37,10 @@ pub struct GeneralizedTrapezoidal {
     pub alpha: f64,
 }
 
+/// Patterns with more entries than this (about 100,000 chain links) are released once the
+/// solver has analysed them (see [`crate::assembly::Pattern::release_structure`]).
+pub const RELEASE_PATTERN_ABOVE: usize = 1 << 22;
+
 /// Matrices, solver and buffers reused by every step of a run (no allocation per step).
 pub struct StepWorkspace {
     /// Unknown numbering, pattern and slots.
@@ -76,8 +80,12 @@ impl StepWorkspace {
 
     /// Analyses the system once, with the given choice of sparse solver.
     pub fn with_solver(system: &System, dense_limit: usize, sparse: SparseSolver) -> StepWorkspace {
-        let layout = Layout::new(system, dense_limit);
+        let mut layout = Layout::new(system, dense_limit);
         let solver = for_layout(&layout.pattern, 3 * layout.free, sparse);
+        // Assembly uses the slot tables only: large models free the pattern's index arrays.
+        if layout.pattern.nnz() > RELEASE_PATTERN_ABOVE {
+            layout.pattern.release_structure();
+        }
         let n = system.particles().len();
         let free: Vec<f64> = system
             .particles()

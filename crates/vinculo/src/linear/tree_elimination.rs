@@ -296,8 +296,10 @@ fn gather(out: &mut [f64], slots: &[u32], values: &[f64]) {
 
 /// In-place LU with partial pivoting of the n x n row-major matrix `a`; returns the local
 /// column of a negligible pivot.
-#[inline]
+#[inline(always)]
 fn lu_in_place(a: &mut [f64], n: usize, perm: &mut [u32]) -> Result<(), usize> {
+    // Slices of known length let the unrolled copies drop their bounds checks.
+    let (a, perm) = (&mut a[..n * n], &mut perm[..n]);
     let largest = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let tiny = largest * 1e3 * f64::EPSILON * n as f64;
     for k in 0..n {
@@ -332,8 +334,9 @@ fn lu_in_place(a: &mut [f64], n: usize, perm: &mut [u32]) -> Result<(), usize> {
 }
 
 /// Solves with the factors of `lu_in_place` for the n x m row-major right-hand side `x`.
-#[inline]
+#[inline(always)]
 fn lu_solve(a: &[f64], n: usize, perm: &[u32], x: &mut [f64], m: usize) {
+    let (a, perm, x) = (&a[..n * n], &perm[..n], &mut x[..n * m]);
     for k in 0..n {
         let p = perm[k] as usize;
         if p != k {
@@ -366,6 +369,54 @@ fn lu_solve(a: &[f64], n: usize, perm: &[u32], x: &mut [f64], m: usize) {
     }
 }
 
+/// A block's coupling to its parent during factorisation: W_b (holding A_bP on entry), A_Pb,
+/// the parent's diagonal storage and the parent's block size.
+type Coupling<'a> = Option<(&'a mut [f64], &'a [f64], &'a mut [f64], usize)>;
+
+/// Factorises D_b and, for a block with a parent, forms W_b = D_b^-1 A_bP and applies the
+/// Schur complement to the parent's particle part: D_P[0..3, 0..3] -= A_Pb W_b.
+#[inline(always)]
+fn eliminate(d: &mut [f64], nb: usize, perm: &mut [u32], coupling: Coupling) -> Result<(), usize> {
+    lu_in_place(d, nb, perm)?;
+    if let Some((w, low, dp, np)) = coupling {
+        let (w, low, dp) = (&mut w[..3 * nb], &low[..3 * nb], &mut dp[..2 * np + 3]);
+        lu_solve(d, nb, perm, w, 3);
+        for r in 0..3 {
+            for c in 0..3 {
+                let mut acc = 0.0;
+                for j in 0..nb {
+                    acc += low[r * nb + j] * w[j * 3 + c];
+                }
+                dp[r * np + c] -= acc;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Forward step of the solve for one block: z_b = D_b^-1 z_b, then z_P -= A_Pb z_b.
+#[inline(always)]
+fn forward(
+    d: &[f64],
+    nb: usize,
+    perm: &[u32],
+    zb: &mut [f64],
+    coupling: Option<(&[f64], &mut [f64])>,
+) {
+    let zb = &mut zb[..nb];
+    lu_solve(d, nb, perm, zb, 1);
+    if let Some((low, zp)) = coupling {
+        let (low, zp) = (&low[..3 * nb], &mut zp[..3]);
+        for r in 0..3 {
+            let mut acc = 0.0;
+            for j in 0..nb {
+                acc += low[r * nb + j] * zb[j];
+            }
+            zp[r] -= acc;
+        }
+    }
+}
+
 impl LinearSolver for TreeElimination {
     fn factor(&mut self, values: &[f64]) -> Result<(), Singular> {
         self.factored = false;
@@ -377,7 +428,28 @@ impl LinearSolver for TreeElimination {
             let (da, db) = (self.diag_at[b], self.diag_at[b + 1]);
             let (own, rest) = self.diag.split_at_mut(db);
             let d = &mut own[da..];
-            if let Err(k) = lu_in_place(d, nb, &mut self.perm[s..s + nb]) {
+            let perm = &mut self.perm[s..s + nb];
+            let pb = self.parent[b];
+            let coupling = if pb == ROOT {
+                None
+            } else {
+                let pb = pb as usize;
+                let np = self.start[pb + 1] - self.start[pb];
+                Some((
+                    &mut self.w[3 * s..3 * s + 3 * nb],
+                    &self.low[3 * s..3 * s + 3 * nb],
+                    &mut rest[self.diag_at[pb] - db..],
+                    np,
+                ))
+            };
+            // Blocks of 3 (a free particle) and 4 (a particle and its link) get unrolled copies.
+            let result = match nb {
+                3 => eliminate(d, 3, perm, coupling),
+                4 => eliminate(d, 4, perm, coupling),
+                5 => eliminate(d, 5, perm, coupling),
+                _ => eliminate(d, nb, perm, coupling),
+            };
+            if let Err(k) = result {
                 let column = self.unknowns[s + k] as usize;
                 return Err(Singular {
                     column: Some(column),
@@ -385,26 +457,6 @@ impl LinearSolver for TreeElimination {
                         "negligible pivot in the block of unknown {column} (tree elimination)"
                     ),
                 });
-            }
-            let pb = self.parent[b];
-            if pb == ROOT {
-                continue;
-            }
-            let w = &mut self.w[3 * s..3 * s + 3 * nb];
-            lu_solve(d, nb, &self.perm[s..s + nb], w, 3);
-            // Schur complement on the parent's particle part: D_P[0..3, 0..3] -= A_Pb W_b.
-            let pb = pb as usize;
-            let np = self.start[pb + 1] - self.start[pb];
-            let dp = &mut rest[self.diag_at[pb] - db..];
-            let low = &self.low[3 * s..3 * s + 3 * nb];
-            for r in 0..3 {
-                for c in 0..3 {
-                    let mut acc = 0.0;
-                    for j in 0..nb {
-                        acc += low[r * nb + j] * w[j * 3 + c];
-                    }
-                    dp[r * np + c] -= acc;
-                }
             }
         }
         self.factored = true;
@@ -422,18 +474,21 @@ impl LinearSolver for TreeElimination {
             let d = &self.diag[self.diag_at[b]..self.diag_at[b + 1]];
             let (head, tail) = self.z.split_at_mut(e);
             let zb = &mut head[s..];
-            lu_solve(d, nb, &self.perm[s..e], zb, 1);
+            let perm = &self.perm[s..e];
             let pb = self.parent[b];
-            if pb != ROOT {
-                let zp = &mut tail[self.start[pb as usize] - e..];
-                let low = &self.low[3 * s..3 * e];
-                for r in 0..3 {
-                    let mut acc = 0.0;
-                    for j in 0..nb {
-                        acc += low[r * nb + j] * zb[j];
-                    }
-                    zp[r] -= acc;
-                }
+            let coupling = if pb == ROOT {
+                None
+            } else {
+                Some((
+                    &self.low[3 * s..3 * e],
+                    &mut tail[self.start[pb as usize] - e..],
+                ))
+            };
+            match nb {
+                3 => forward(d, 3, perm, zb, coupling),
+                4 => forward(d, 4, perm, zb, coupling),
+                5 => forward(d, 5, perm, zb, coupling),
+                _ => forward(d, nb, perm, zb, coupling),
             }
         }
         for b in (0..self.blocks()).rev() {

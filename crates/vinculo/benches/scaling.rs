@@ -1,0 +1,127 @@
+//! Scaling of the cost per step with the number of particles: hanging and swinging chains of
+//! 10^3 to 10^6 point masses (0.1 m links, 0.1 kg, dt = 1e-3), seconds per step and peak memory.
+//!
+//! Run with `cargo bench -p vinculo --bench scaling` (all sizes, each in its own process so
+//! that the peak resident memory, VmHWM, is that of one size) or
+//! `cargo bench -p vinculo --bench scaling -- N [swinging]` for one size. The time per step is
+//! measured between the first and the last accepted step (model analysis excluded); a run
+//! stores only its first and last states. Prints the fitted exponent of time per step against N.
+
+use std::process::Command;
+use std::time::Instant;
+use vinculo::model::System;
+use vinculo::{simulate_with_observer, Observer, SimulationOptions};
+
+fn chain(n: usize, hanging: bool) -> System {
+    let mut s = System::new([0.0, 0.0, -9.81]);
+    let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
+    for i in 1..=n {
+        let x = 0.1 * i as f64;
+        let pos = if hanging {
+            [0.0, 0.0, -x]
+        } else {
+            [x, 0.0, 0.0]
+        };
+        let p = s.add_particle(0.1, pos, [0.0; 3], false).unwrap();
+        s.add_distance(prev, p, None).unwrap();
+        prev = p;
+    }
+    s
+}
+
+/// Records the wall-clock time of every accepted step.
+struct Clock(Vec<Instant>);
+impl Observer for Clock {
+    fn step(&mut self, _t: f64, _t_end: f64) -> bool {
+        self.0.push(Instant::now());
+        true
+    }
+}
+
+fn peak_memory_mb() -> f64 {
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    status
+        .lines()
+        .find(|l| l.starts_with("VmHWM:"))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .and_then(|kb| kb.parse::<f64>().ok())
+        .map_or(f64::NAN, |kb| kb / 1024.0)
+}
+
+/// One size, in this process: prints "N seconds_per_step iterations_per_step peak_MB solver".
+fn one(n: usize, hanging: bool) {
+    let steps = (2_000_000 / n).clamp(6, 200);
+    let system = chain(n, hanging);
+    let options = SimulationOptions {
+        t_end: steps as f64 * 1e-3,
+        dt: 1e-3,
+        save_every: usize::MAX,
+        ..Default::default()
+    };
+    let mut clock = Clock(Vec::with_capacity(steps + 1));
+    let sol = simulate_with_observer(&system, &options, &mut clock).unwrap();
+    assert!(sol.status.is_ok(), "{:?}", sol.status);
+    let per_step =
+        (clock.0[clock.0.len() - 1] - clock.0[0]).as_secs_f64() / (clock.0.len() - 1) as f64;
+    let last = sol.stats.last().unwrap().newton_iterations;
+    println!(
+        "{n} {per_step:.6e} {last} {:.1} {}",
+        peak_memory_mb(),
+        sol.linear_solver.replace(' ', "_")
+    );
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| a != "--bench")
+        .collect();
+    if let Some(n) = args.first().and_then(|a| a.parse::<usize>().ok()) {
+        one(n, args.get(1).map(String::as_str) != Some("swinging"));
+        return;
+    }
+    let exe = std::env::current_exe().unwrap();
+    for shape in ["hanging", "swinging"] {
+        println!("{shape} chains, 0.1 m links, dt = 1e-3");
+        println!(
+            "{:>9} {:>14} {:>10} {:>14} {:>12}  solver",
+            "N", "s/step", "us/particle", "Newton it.", "peak MB"
+        );
+        let mut points = Vec::new();
+        for n in [1_000, 10_000, 100_000, 1_000_000] {
+            let out = Command::new(&exe)
+                .arg(n.to_string())
+                .arg(shape)
+                .output()
+                .unwrap();
+            let text = String::from_utf8_lossy(&out.stdout);
+            let f: Vec<&str> = text.split_whitespace().collect();
+            if !out.status.success() || f.len() < 5 {
+                println!("{n:>9} failed: {}", String::from_utf8_lossy(&out.stderr));
+                continue;
+            }
+            let per_step: f64 = f[1].parse().unwrap();
+            println!(
+                "{n:>9} {per_step:>14.4e} {:>10.3} {:>14} {:>12} {}",
+                per_step / n as f64 * 1e6,
+                f[2],
+                f[3],
+                f[4].replace('_', " ")
+            );
+            points.push(((n as f64).ln(), per_step.ln()));
+        }
+        // Least-squares slope of log(time per step) against log(N).
+        let k = points.len() as f64;
+        let (sx, sy) = points
+            .iter()
+            .fold((0.0, 0.0), |(a, b), p| (a + p.0, b + p.1));
+        let (mx, my) = (sx / k, sy / k);
+        let (num, den) = points.iter().fold((0.0, 0.0), |(a, b), p| {
+            (a + (p.0 - mx) * (p.1 - my), b + (p.0 - mx).powi(2))
+        });
+        println!(
+            "fitted exponent (time per step ~ N^p, 10^3..10^6): p = {:.3}\n",
+            num / den
+        );
+    }
+}
