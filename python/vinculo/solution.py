@@ -56,6 +56,9 @@ class Solution:
             :class:`vinculo.ConvergenceError`, the core's description of the failure (keys
             'kind', 'message', 'time', 'step_size', 'residual', 'iterations', 'equation').
         system: the :class:`vinculo.System` that was simulated.
+        linear_solver: the linear solver the run used: 'dense LU' (small systems),
+            'tree elimination' (tree-shaped constraint graphs: chains, ropes, branched strings)
+            or 'sparse LU' (graphs with loops).
     """
 
     times: np.ndarray
@@ -69,6 +72,7 @@ class Solution:
     increment_norms: np.ndarray
     error: dict[str, Any] | None
     system: System
+    linear_solver: str = ""
 
     @classmethod
     def from_core(cls, data: dict[str, Any], system: System) -> Solution:
@@ -86,7 +90,12 @@ class Solution:
             for name in _ARRAY_FIELDS
         }
         error = data.get("error")
-        return cls(**arrays, error=dict(error) if error is not None else None, system=system)
+        return cls(
+            **arrays,
+            error=dict(error) if error is not None else None,
+            system=system,
+            linear_solver=str(data.get("linear_solver", "")),
+        )
 
     @property
     def success(self) -> bool:
@@ -214,6 +223,8 @@ class Solution:
                 f"max {int(np.max(iterations))}"
             )
             lines.append(f"min step size: {np.min(self.step_sizes[1:]):.6g} s")
+        if self.linear_solver:
+            lines.append(f"linear solver: {self.linear_solver}")
         return "\n".join(lines)
 
     def __repr__(self) -> str:

@@ -1,0 +1,126 @@
+"""The benchmark models, built identically in vinculo and (when installed) in Exudyn.
+
+Every model is a set of point masses under gravity ``(0, 0, -9.81)`` linked by distance
+constraints to a fixed anchor at the origin and to each other: a single pendulum (1 kg, 1 m,
+released horizontally) and chains of N point masses (0.1 kg each, 0.1 m links unless stated),
+either hanging straight down at rest (a static equilibrium: the test of pure throughput) or
+released horizontally at rest (swinging: large motions, several Newton iterations per step).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+import vinculo
+
+GRAVITY = 9.81
+
+
+@dataclass(frozen=True)
+class Chain:
+    """N point masses in a row from a fixed anchor at the origin.
+
+    Attributes:
+        name: label for the tables.
+        n: number of moving particles (1 with ``mass=1, link=1`` is the single pendulum).
+        link: link length, in m.
+        mass: mass of each particle, in kg.
+        hanging: True: along -z at rest (equilibrium); False: along +x at rest (swinging).
+        t_end: simulated time, in s.
+        dt: step, in s.
+    """
+
+    name: str
+    n: int
+    link: float = 0.1
+    mass: float = 0.1
+    hanging: bool = True
+    t_end: float = 1.0
+    dt: float = 1e-3
+
+    @property
+    def steps(self) -> int:
+        """Number of steps of the run."""
+        return round(self.t_end / self.dt)
+
+    def positions(self) -> np.ndarray:
+        """Initial positions of the moving particles, shape (n, 3)."""
+        s = self.link * np.arange(1, self.n + 1)
+        out = np.zeros((self.n, 3))
+        if self.hanging:
+            out[:, 2] = -s
+        else:
+            out[:, 0] = s
+        return out
+
+
+def build_vinculo(model: Chain) -> tuple[vinculo.System, vinculo.ParticleId]:
+    """The model as a vinculo System; returns it with the tip particle's handle."""
+    system = vinculo.System(gravity=(0.0, 0.0, -GRAVITY))
+    prev = system.add_particle(mass=1.0, position=(0.0, 0.0, 0.0), fixed=True)
+    for p in model.positions():
+        q = system.add_particle(mass=model.mass, position=tuple(p))
+        system.add_distance(prev, q, length=model.link)
+        prev = q
+    return system, prev
+
+
+def build_exudyn(model: Chain, exu):  # noqa: ANN001, ANN201 (exudyn is optional, untyped)
+    """The model in Exudyn: NodePoint + MassPoint per particle, DistanceConstraint per link,
+    a NodePointGround anchor, gravity as a Force load m g on each particle.
+
+    Returns:
+        (system container, main system, tip node number).
+    """
+    from exudyn.itemInterface import (
+        DistanceConstraint,
+        Force,
+        MarkerNodePosition,
+        MassPoint,
+        NodePoint,
+        NodePointGround,
+    )
+
+    sc = exu.SystemContainer()
+    mbs = sc.AddSystem()
+    ground = mbs.AddNode(NodePointGround(referenceCoordinates=[0.0, 0.0, 0.0]))
+    prev = mbs.AddMarker(MarkerNodePosition(nodeNumber=ground))
+    node = ground
+    for p in model.positions():
+        node = mbs.AddNode(NodePoint(referenceCoordinates=[float(x) for x in p]))
+        mbs.AddObject(MassPoint(physicsMass=model.mass, nodeNumber=node))
+        marker = mbs.AddMarker(MarkerNodePosition(nodeNumber=node))
+        mbs.AddObject(DistanceConstraint(markerNumbers=[prev, marker], distance=model.link))
+        mbs.AddLoad(Force(markerNumber=marker, loadVector=[0.0, 0.0, -model.mass * GRAVITY]))
+        prev = marker
+    mbs.Assemble()
+    return sc, mbs, node
+
+
+def exudyn_settings(model: Chain, exu, dense: bool = False):  # noqa: ANN001, ANN201
+    """Exudyn's defaults for generalised-alpha, index 3, at the fixed step ``model.dt``.
+
+    Spectral radius 0.9 (its default; second order like vinculo's alpha = 1/2, damping only
+    the highest frequencies: with 1.0 Exudyn's index-3 solver fails within the first second
+    on the pendulum and on swinging chains, and 0.99 fails on swinging chains too), its
+    default Newton tolerances (relative 1e-8, absolute 1e-10) and modified Newton, no
+    automatic step size, sparse (or dense) LU, no output written.
+    """
+    ss = exu.SimulationSettings()
+    ti = ss.timeIntegration
+    ti.numberOfSteps = model.steps
+    ti.endTime = model.t_end
+    ti.adaptiveStep = False
+    ti.verboseMode = 0
+    ti.generalizedAlpha.spectralRadius = 0.9
+    ti.generalizedAlpha.useIndex2Constraints = False
+    ti.generalizedAlpha.useNewmark = False
+    ss.linearSolverType = (
+        exu.LinearSolverType.EigenDense if dense else exu.LinearSolverType.EigenSparse
+    )
+    ss.solutionSettings.writeSolutionToFile = False
+    ss.displayStatistics = False
+    ss.displayComputationTime = False
+    return ss

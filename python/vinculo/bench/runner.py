@@ -1,0 +1,107 @@
+"""Timed runs of one model in vinculo and in Exudyn."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import os
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+import vinculo
+from vinculo.bench.models import Chain, build_exudyn, build_vinculo, exudyn_settings
+
+
+@dataclass
+class Run:
+    """Outcome of one timed run.
+
+    Attributes:
+        seconds: wall time of the integration (model building excluded, analysis included).
+        steps: steps taken.
+        tip: position of the last particle at ``t_end`` (None if the run failed).
+        detail: the linear solver, Newton iterations, or why the run failed.
+    """
+
+    seconds: float
+    steps: int
+    tip: np.ndarray | None
+    detail: str
+
+    @property
+    def steps_per_second(self) -> float:
+        """Steps per second of wall time (NaN when the run failed)."""
+        return self.steps / self.seconds if self.tip is not None else float("nan")
+
+
+def run_vinculo(model: Chain, repeat: int = 1) -> Run:
+    """Best of ``repeat`` runs of vinculo (alpha = 1/2, default tolerance 1e-10 of the length
+    scale), storing only the first and the last state."""
+    system, tip = build_vinculo(model)
+    best = None
+    for _ in range(repeat):
+        start = time.perf_counter()
+        try:
+            solution = vinculo.simulate(
+                system, t_end=model.t_end, dt=model.dt, alpha=0.5, save_every=model.steps
+            )
+        except vinculo.ConvergenceError as error:
+            return Run(time.perf_counter() - start, 0, None, f"failed: {error}")
+        seconds = time.perf_counter() - start
+        if best is None or seconds < best.seconds:
+            iterations = solution.newton_iterations[1:]
+            best = Run(
+                seconds,
+                model.steps,
+                solution.particle(tip)[-1],
+                f"{solution.linear_solver}, {np.mean(iterations):.1f} Newton it./step",
+            )
+    assert best is not None
+    return best
+
+
+def run_exudyn(model: Chain, exu, repeat: int = 1) -> Run:  # noqa: ANN001
+    """Best of ``repeat`` runs of Exudyn (see ``exudyn_settings``); for models of at most 100
+    coordinates the faster of its dense and sparse LU is kept."""
+    dense_options = [False, True] if 3 * model.n <= 100 else [False]
+    best = None
+    for dense in dense_options:
+        for _ in range(repeat):
+            _, mbs, tip = build_exudyn(model, exu)
+            settings = exudyn_settings(model, exu, dense=dense)
+            start = time.perf_counter()
+            try:
+                # Exudyn prints its own diagnostics; keep the table readable.
+                with _quiet():
+                    ok = mbs.SolveDynamic(settings)
+            except Exception as error:  # noqa: BLE001 (any solver failure is a result here)
+                ok, why = False, str(error).strip().splitlines()[-1][:60]
+            else:
+                why = "SolveDynamic returned False"
+            seconds = time.perf_counter() - start
+            if not ok:
+                return Run(seconds, 0, None, f"failed: {why}")
+            position = np.array(mbs.GetNodeOutput(tip, exu.OutputVariableType.Position))
+            if best is None or seconds < best.seconds:
+                best = Run(seconds, model.steps, position, "dense LU" if dense else "sparse LU")
+    assert best is not None
+    return best
+
+
+@contextlib.contextmanager
+def _quiet():  # noqa: ANN202
+    """Silences output written to the process's stdout and stderr (also from C++)."""
+    saved = [os.dup(1), os.dup(2)]
+    with open(os.devnull, "w") as null:
+        os.dup2(null.fileno(), 1)
+        os.dup2(null.fileno(), 2)
+        try:
+            with contextlib.redirect_stdout(io.StringIO()):
+                yield
+        finally:
+            os.dup2(saved[0], 1)
+            os.dup2(saved[1], 2)
+            for fd in saved:
+                os.close(fd)

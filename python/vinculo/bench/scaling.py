@@ -1,0 +1,75 @@
+"""vinculo alone: seconds per step and peak memory of hanging chains of 10^3 to 10^6 particles.
+
+Each size runs in its own process (``python -m vinculo.bench.scaling N``) so that the peak
+resident memory (``ru_maxrss``) is that of one model: building it, the run (only the first and
+last states stored) and the returned Solution.
+"""
+
+from __future__ import annotations
+
+import math
+import resource
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+import vinculo
+from vinculo.bench.models import Chain, build_vinculo
+
+SIZES = (1_000, 10_000, 100_000, 1_000_000)
+
+
+def one(n: int, hanging: bool = True) -> dict[str, float | str]:
+    """Runs one size in this process; returns its figures."""
+    steps = min(200, max(6, 2_000_000 // n))
+    model = Chain(f"chain {n}", n, hanging=hanging, t_end=steps * 1e-3)
+    system, _ = build_vinculo(model)
+    start = time.perf_counter()
+    solution = vinculo.simulate(system, t_end=model.t_end, dt=model.dt, save_every=steps)
+    seconds = time.perf_counter() - start
+    peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    return {
+        "n": n,
+        "steps": steps,
+        "seconds_per_step": seconds / steps,
+        "newton": float(np.mean(solution.newton_iterations[1:])),
+        "peak_mb": peak_mb,
+        "solver": solution.linear_solver,
+    }
+
+
+def run(sizes: tuple[int, ...] = SIZES, hanging: bool = True, out=print) -> float:  # noqa: ANN001
+    """Runs every size in a subprocess, prints a table and returns the fitted exponent p of
+    seconds per step ~ N^p."""
+    shape = "hanging" if hanging else "swinging"
+    out(f"vinculo scaling: {shape} chains, 0.1 m links, 0.1 kg, dt = 1e-3 "
+        "(analysis included, amortised over the run)")
+    out(f"{'N':>9} {'steps':>6} {'s/step':>11} {'us/particle':>12} {'Newton it.':>11} "
+        f"{'peak MB':>9}  solver")
+    points = []
+    for n in sizes:
+        args = [sys.executable, "-m", "vinculo.bench.scaling", str(n), shape]
+        done = subprocess.run(args, capture_output=True, text=True, check=False)
+        if done.returncode != 0:
+            out(f"{n:>9} failed: {done.stderr.strip().splitlines()[-1:]}")
+            continue
+        r = eval(done.stdout.strip().splitlines()[-1], {})  # noqa: S307 (our own dict repr)
+        out(f"{n:>9} {r['steps']:>6} {r['seconds_per_step']:>11.4e} "
+            f"{1e6 * r['seconds_per_step'] / n:>12.3f} {r['newton']:>11.2f} "
+            f"{r['peak_mb']:>9.0f}  {r['solver']}")
+        points.append((math.log(n), math.log(r["seconds_per_step"])))
+    if len(points) < 2:
+        return float("nan")
+    x, y = np.array(points).T
+    p = float(np.polyfit(x, y, 1)[0])
+    out(f"fitted exponent: seconds per step ~ N^{p:.3f} (N = {sizes[0]:,} .. {sizes[-1]:,})")
+    return p
+
+
+if __name__ == "__main__":
+    if len(sys.argv) > 1:
+        print(one(int(sys.argv[1]), hanging=(sys.argv[2:3] != ["swinging"])))
+    else:
+        run()
