@@ -35,9 +35,20 @@ fn chain(n: usize, link: f64, hanging: bool) -> System {
 }
 
 fn measure(name: &str, system: &System, t_end: f64, dt: f64) {
+    measure_with(
+        name,
+        system,
+        t_end,
+        dt,
+        SimulationOptions::default().dense_limit,
+    );
+}
+
+fn measure_with(name: &str, system: &System, t_end: f64, dt: f64, dense_limit: usize) {
     let options = SimulationOptions {
         t_end,
         dt,
+        dense_limit,
         ..Default::default()
     };
     simulate(system, &options).unwrap();
@@ -57,6 +68,19 @@ fn measure(name: &str, system: &System, t_end: f64, dt: f64) {
 
 fn main() {
     measure("pendulum, dt = 1e-3, 10 s", &pendulum(), 10.0, 1e-3);
+    // Small systems: the dense LU against the tree elimination (dense_limit 0).
+    measure_with("pendulum, 10 s, no dense LU", &pendulum(), 10.0, 1e-3, 0);
+    for (hanging, shape) in [(true, "hanging"), (false, "swinging")] {
+        let c = chain(10, 0.1, hanging);
+        measure(&format!("{shape} chain N = 10, 1 s"), &c, 1.0, 1e-3);
+        measure_with(
+            &format!("{shape} chain N = 10, no dense LU"),
+            &c,
+            1.0,
+            1e-3,
+            0,
+        );
+    }
     measure(
         "hanging chain N = 1000, 0.1 m links, 1 s",
         &chain(1000, 0.1, true),

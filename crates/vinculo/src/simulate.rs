@@ -31,7 +31,8 @@ pub struct SimulationOptions {
     pub initial_tolerance: f64,
     /// Store every k-th step (the last step is always stored).
     pub save_every: usize,
-    /// Systems with at most this many unknowns use a dense LU.
+    /// Systems with at most this many unknowns whose constraint graph has loops use a dense
+    /// LU (tree-shaped graphs always get the tree elimination with `SparseSolver::Auto`).
     pub dense_limit: usize,
     /// Solver for larger systems: tree elimination when the constraint graph is a forest
     /// (`Auto`), or always the general sparse LU. [`Solution::linear_solver`] names the one used.

@@ -43,7 +43,7 @@ def robustness_models(quick: bool = False) -> list[Chain]:
     ]
 
 
-def buoy_model():  # noqa: ANN201
+def buoy_model():
     """Hook for the buoy case study: returns its model once ``vinculo`` provides one, else None.
 
     The buoy model (rigid bodies, Morison force, added mass) does not exist yet; when it does,
@@ -52,7 +52,7 @@ def buoy_model():  # noqa: ANN201
     return None
 
 
-def _import_exudyn():  # noqa: ANN202
+def _import_exudyn():
     try:
         import exudyn
     except ImportError:
@@ -60,7 +60,7 @@ def _import_exudyn():  # noqa: ANN202
     return exudyn
 
 
-def _row(model: Chain, v: Run, e: Run | None, out) -> bool:  # noqa: ANN001
+def _row(model: Chain, v: Run, e: Run | None, out) -> bool:
     """Prints one table row; returns False if both ran and disagree."""
     agree = True
     if e is None:
@@ -78,18 +78,24 @@ def _row(model: Chain, v: Run, e: Run | None, out) -> bool:  # noqa: ANN001
     return agree
 
 
-def compare(quick: bool = False, repeat: int = 3, out=print) -> bool:  # noqa: ANN001
+def compare(quick: bool = False, repeat: int = 3, out=print) -> bool:
     """The side-by-side table; returns True if every pair that ran agrees."""
     exu = _import_exudyn()
     if exu is None:
         out("Exudyn is not installed (pip install exudyn): its columns are skipped.")
     else:
-        out(f"Exudyn {exu.__version__}: generalised-alpha, index 3, spectral radius 0.9, "
-            "modified Newton (its defaults), sparse LU (dense if faster for <= 100 unknowns)")
-    out("vinculo: trapezoidal rule (alpha = 1/2), Newton tolerance 1e-10 of the length scale; "
-        f"dt = 1e-3 for both; tip check: |tip_vinculo - tip_exudyn| <= {TIP_TOLERANCE:g} m at t_end")
-    out(f"{'model':<30} {'vinculo st/s':>12} {'Exudyn st/s':>12} {'ratio':>8}  "
-        f"{'tip gap (m)':<14} vinculo solver")
+        out(
+            f"Exudyn {exu.__version__}: generalised-alpha, index 3, spectral radius 0.9, "
+            "modified Newton (its defaults), sparse LU (dense if faster for <= 100 unknowns)"
+        )
+    out(
+        "vinculo: trapezoidal rule (alpha = 1/2), Newton tolerance 1e-10 of the length scale; "
+        f"dt = 1e-3 for both; tip check: |tip_vinculo - tip_exudyn| <= {TIP_TOLERANCE:g} m"
+    )
+    out(
+        f"{'model':<30} {'vinculo st/s':>12} {'Exudyn st/s':>12} {'ratio':>8}  "
+        f"{'tip gap (m)':<14} vinculo solver"
+    )
     agree = True
     for model in comparison_models(quick) + robustness_models(quick):
         big = model.n >= 1_000

@@ -67,7 +67,7 @@ def build_vinculo(model: Chain) -> tuple[vinculo.System, vinculo.ParticleId]:
     return system, prev
 
 
-def build_exudyn(model: Chain, exu):  # noqa: ANN001, ANN201 (exudyn is optional, untyped)
+def build_exudyn(model: Chain, exu):
     """The model in Exudyn: NodePoint + MassPoint per particle, DistanceConstraint per link,
     a NodePointGround anchor, gravity as a Force load m g on each particle.
 
@@ -99,7 +99,7 @@ def build_exudyn(model: Chain, exu):  # noqa: ANN001, ANN201 (exudyn is optional
     return sc, mbs, node
 
 
-def exudyn_settings(model: Chain, exu, dense: bool = False):  # noqa: ANN001, ANN201
+def exudyn_settings(model: Chain, exu, dense: bool = False):
     """Exudyn's defaults for generalised-alpha, index 3, at the fixed step ``model.dt``.
 
     Spectral radius 0.9 (its default; second order like vinculo's alpha = 1/2, damping only

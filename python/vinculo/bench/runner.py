@@ -62,7 +62,7 @@ def run_vinculo(model: Chain, repeat: int = 1) -> Run:
     return best
 
 
-def run_exudyn(model: Chain, exu, repeat: int = 1) -> Run:  # noqa: ANN001
+def run_exudyn(model: Chain, exu, repeat: int = 1) -> Run:
     """Best of ``repeat`` runs of Exudyn (see ``exudyn_settings``); for models of at most 100
     coordinates the faster of its dense and sparse LU is kept."""
     dense_options = [False, True] if 3 * model.n <= 100 else [False]
@@ -76,7 +76,7 @@ def run_exudyn(model: Chain, exu, repeat: int = 1) -> Run:  # noqa: ANN001
                 # Exudyn prints its own diagnostics; keep the table readable.
                 with _quiet():
                     ok = mbs.SolveDynamic(settings)
-            except Exception as error:  # noqa: BLE001 (any solver failure is a result here)
+            except Exception as error:
                 ok, why = False, str(error).strip().splitlines()[-1][:60]
             else:
                 why = "SolveDynamic returned False"
@@ -91,7 +91,7 @@ def run_exudyn(model: Chain, exu, repeat: int = 1) -> Run:  # noqa: ANN001
 
 
 @contextlib.contextmanager
-def _quiet():  # noqa: ANN202
+def _quiet():
     """Silences output written to the process's stdout and stderr (also from C++)."""
     saved = [os.dup(1), os.dup(2)]
     with open(os.devnull, "w") as null:

@@ -7,6 +7,7 @@ last states stored) and the returned Solution.
 
 from __future__ import annotations
 
+import json
 import math
 import resource
 import subprocess
@@ -40,14 +41,18 @@ def one(n: int, hanging: bool = True) -> dict[str, float | str]:
     }
 
 
-def run(sizes: tuple[int, ...] = SIZES, hanging: bool = True, out=print) -> float:  # noqa: ANN001
+def run(sizes: tuple[int, ...] = SIZES, hanging: bool = True, out=print) -> float:
     """Runs every size in a subprocess, prints a table and returns the fitted exponent p of
     seconds per step ~ N^p."""
     shape = "hanging" if hanging else "swinging"
-    out(f"vinculo scaling: {shape} chains, 0.1 m links, 0.1 kg, dt = 1e-3 "
-        "(analysis included, amortised over the run)")
-    out(f"{'N':>9} {'steps':>6} {'s/step':>11} {'us/particle':>12} {'Newton it.':>11} "
-        f"{'peak MB':>9}  solver")
+    out(
+        f"vinculo scaling: {shape} chains, 0.1 m links, 0.1 kg, dt = 1e-3 "
+        "(analysis included, amortised over the run)"
+    )
+    out(
+        f"{'N':>9} {'steps':>6} {'s/step':>11} {'us/particle':>12} {'Newton it.':>11} "
+        f"{'peak MB':>9}  solver"
+    )
     points = []
     for n in sizes:
         args = [sys.executable, "-m", "vinculo.bench.scaling", str(n), shape]
@@ -55,10 +60,12 @@ def run(sizes: tuple[int, ...] = SIZES, hanging: bool = True, out=print) -> floa
         if done.returncode != 0:
             out(f"{n:>9} failed: {done.stderr.strip().splitlines()[-1:]}")
             continue
-        r = eval(done.stdout.strip().splitlines()[-1], {})  # noqa: S307 (our own dict repr)
-        out(f"{n:>9} {r['steps']:>6} {r['seconds_per_step']:>11.4e} "
+        r = json.loads(done.stdout.strip().splitlines()[-1])
+        out(
+            f"{n:>9} {r['steps']:>6} {r['seconds_per_step']:>11.4e} "
             f"{1e6 * r['seconds_per_step'] / n:>12.3f} {r['newton']:>11.2f} "
-            f"{r['peak_mb']:>9.0f}  {r['solver']}")
+            f"{r['peak_mb']:>9.0f}  {r['solver']}"
+        )
         points.append((math.log(n), math.log(r["seconds_per_step"])))
     if len(points) < 2:
         return float("nan")
@@ -70,6 +77,6 @@ def run(sizes: tuple[int, ...] = SIZES, hanging: bool = True, out=print) -> floa
 
 if __name__ == "__main__":
     if len(sys.argv) > 1:
-        print(one(int(sys.argv[1]), hanging=(sys.argv[2:3] != ["swinging"])))
+        print(json.dumps(one(int(sys.argv[1]), hanging=(sys.argv[2:3] != ["swinging"]))))
     else:
         run()
