@@ -18,11 +18,13 @@ mod distance;
 mod fixed_coordinate;
 mod plane;
 mod point_distance;
+mod redundancy;
 
 pub use distance::Distance;
 pub use fixed_coordinate::FixedCoordinate;
 pub use plane::Plane;
 pub use point_distance::PointDistance;
+pub use redundancy::{find_redundant, MAX_ENTRIES, RANK_TOLERANCE};
 
 use crate::math::{Mat3, Vec3};
 
