@@ -423,9 +423,13 @@ impl PySystem {
     #[getter]
     fn constraint_lengths<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         let v: Vec<f64> = (0..self.inner.constraints().len())
-            .map(|c| match self.inner.constraints()[c].length() {
-                l if l > 0.0 => l,
-                _ => f64::NAN,
+            .map(|c| {
+                let con = &self.inner.constraints()[c];
+                if con.is_distance() {
+                    con.length()
+                } else {
+                    f64::NAN
+                }
             })
             .collect();
         Array1::from(v).into_pyarray(py)

@@ -17,7 +17,6 @@ Coordinates: x along the shaking, z up, the anchor at the origin when the tank i
 from __future__ import annotations
 
 import itertools
-import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -25,7 +24,7 @@ import numpy as np
 
 import vinculo
 from vinculo.buoy.case import BuoyCase
-from vinculo.errors import InvalidInputError
+from vinculo.buoy.reference import tank_motion
 
 __all__ = ["BuoyModel", "ParticleRun", "build_model", "run_particle_model"]
 
@@ -68,13 +67,8 @@ def tank_law(case: BuoyCase, frequency: float) -> vinculo.Law:
     Raises:
         InvalidInputError: the frequency is not finite and positive.
     """
-    if not (math.isfinite(frequency) and frequency > 0.0):
-        raise InvalidInputError(
-            f"frequency must be finite and > 0 Hz, got {frequency!r}",
-            name="frequency",
-            value=frequency,
-        )
-    return vinculo.sine(case.amplitude, frequency, ramp_time=case.ramp_periods / frequency)
+    motion = tank_motion(case, frequency)  # validates the frequency
+    return vinculo.sine(motion.amplitude, motion.frequency, ramp_time=motion.ramp_time)
 
 
 def build_model(

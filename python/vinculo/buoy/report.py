@@ -76,9 +76,12 @@ def _write_parameters(study: StudyResult, path: Path) -> None:
         w = csv.writer(f)
         w.writerow(["parameter", "value", "unit", "source"])
         for name, value in case.to_dict().items():
-            source = f"ASSUMPTION: {ASSUMPTIONS[name]}" if name in ASSUMPTIONS else "paper"
-            if name in ("string_beads", "string_mass", "tank_size", "gravity"):
-                source = "paper" if name in ("tank_size", "gravity") else "option"
+            if name in ASSUMPTIONS:
+                source = f"ASSUMPTION: {ASSUMPTIONS[name]}"
+            elif name in ("string_beads", "string_mass"):
+                source = "option"
+            else:
+                source = "paper"
             w.writerow([name, value, _UNITS.get(name, ""), source])
         for name, (value, unit) in derived.items():
             w.writerow([name, value, unit, "derived"])

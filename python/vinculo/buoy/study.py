@@ -65,6 +65,14 @@ class ModelResult:
     elapsed: float = 0.0
 
 
+def _check_model(model: str, name: str) -> None:
+    """Raise InvalidInputError unless ``model`` is one of :data:`MODELS`."""
+    if model not in MODELS:
+        raise InvalidInputError(
+            f"unknown model {model!r}: choose from {', '.join(MODELS)}", name=name, value=model
+        )
+
+
 def run_task(
     case: BuoyCase,
     settings: SweepSettings,
@@ -87,10 +95,7 @@ def run_task(
     Raises:
         InvalidInputError: an unknown model name.
     """
-    if model not in MODELS:
-        raise InvalidInputError(
-            f"unknown model {model!r}: choose from {', '.join(MODELS)}", name="model", value=model
-        )
+    _check_model(model, "model")
     started = time.perf_counter()
     t_end = settings.t_end(frequency)
     error: str | None = None
@@ -234,10 +239,7 @@ def run_study(
         InvalidInputError: an unknown model or a bad worker count.
     """
     for m in models:
-        if m not in MODELS:
-            raise InvalidInputError(
-                f"unknown model {m!r}: choose from {', '.join(MODELS)}", name="models", value=m
-            )
+        _check_model(m, "models")
     workers = (os.cpu_count() or 1) if workers is None else workers
     if not (isinstance(workers, int) and workers >= 1):
         raise InvalidInputError(

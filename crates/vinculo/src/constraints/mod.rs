@@ -100,13 +100,19 @@ impl Constraint {
         dispatch!(self, c => c.scale())
     }
 
-    /// A characteristic length of the constraint (for the model's length scale).
+    /// A characteristic length of the constraint (for the model's length scale): the length of
+    /// a distance, 0 for the other kinds.
     pub fn length(&self) -> f64 {
         match self {
             Constraint::Distance(c) => c.length,
             Constraint::PointDistance(c) => c.length,
             _ => 0.0,
         }
+    }
+
+    /// True for the kinds that hold a distance (whose multiplier is a tension 2 lambda L).
+    pub fn is_distance(&self) -> bool {
+        matches!(self, Constraint::Distance(_) | Constraint::PointDistance(_))
     }
 
     /// The time interval on which the constraint's laws are defined.

@@ -84,10 +84,9 @@ impl Morison {
     pub(crate) fn force(&self, _q: &[Vec3], v: &[Vec3], t: f64) -> Local {
         let (_, u, a) = self.fluid.eval(t);
         let mf = self.displaced_mass();
-        let r = sub(u, v[self.particles[0]]);
-        let c = self.drag_factor() * norm(r);
+        let drag = self.drag_at(u, v[self.particles[0]]);
         let f = std::array::from_fn(|k| {
-            mf * (a[k] - self.gravity[k]) + self.added_mass() * a[k] + c * r[k]
+            mf * (a[k] - self.gravity[k]) + self.added_mass() * a[k] + drag[k]
         });
         [f, [0.0; 3]]
     }
@@ -109,9 +108,13 @@ impl Morison {
         }
     }
 
-    /// The drag force alone, for output.
+    /// The drag force alone on a body moving at `v` at time `t`, for output.
     pub fn drag(&self, v: Vec3, t: f64) -> Vec3 {
-        let (_, u, _) = self.fluid.eval(t);
+        self.drag_at(self.fluid.eval(t).1, v)
+    }
+
+    /// 1/2 rho Cd A |u - v| (u - v) for fluid velocity `u`.
+    fn drag_at(&self, u: Vec3, v: Vec3) -> Vec3 {
         let r = sub(u, v);
         scale(self.drag_factor() * norm(r), r)
     }

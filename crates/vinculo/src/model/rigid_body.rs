@@ -29,7 +29,7 @@ use super::particle::{ConstraintId, ParticleId};
 use super::system::System;
 use crate::constraints::find_redundant;
 use crate::error::{finite_vector, positive, Error, Result};
-use crate::math::{add, norm, outer, scale, sub, Mat3, Vec3};
+use crate::math::{add, add_mat, norm, outer, scale, sub, Mat3, Vec3};
 
 /// What a rigid body is made of and how it starts moving.
 #[derive(Debug, Clone, PartialEq)]
@@ -231,16 +231,6 @@ impl System {
         } else {
             let mu = fraction * m;
             let rest = m - mu * extras.len() as f64;
-            let first: Vec3 = extras
-                .iter()
-                .fold([0.0; 3], |a, p| add(a, scale(mu, sub(*p, c))));
-            let shift = scale(-1.0 / rest, first);
-            let mut jr = j;
-            for p in &extras {
-                let d = sub(*p, c);
-                jr = sub_mat(jr, outer(mu, d, d));
-            }
-            jr = sub_mat(jr, outer(rest, shift, shift));
             if rest <= 0.0 {
                 return Err(Error::InvalidParameter {
                     name: "point_mass_fraction of the rigid body".into(),
@@ -251,6 +241,16 @@ impl System {
                     ),
                 });
             }
+            let first: Vec3 = extras
+                .iter()
+                .fold([0.0; 3], |a, p| add(a, scale(mu, sub(*p, c))));
+            let shift = scale(-1.0 / rest, first);
+            let mut jr = j;
+            for p in &extras {
+                let d = sub(*p, c);
+                jr = add_mat(jr, outer(-mu, d, d));
+            }
+            jr = add_mat(jr, outer(-rest, shift, shift));
             octahedron(rest, add(c, shift), &jr)?
         };
 
@@ -298,10 +298,6 @@ impl System {
             axes: shape.axes,
         })
     }
-}
-
-fn sub_mat(a: Mat3, b: Mat3) -> Mat3 {
-    std::array::from_fn(|r| std::array::from_fn(|k| a[r][k] - b[r][k]))
 }
 
 /// The three of the seven octahedron particles whose directions from `p` are the most

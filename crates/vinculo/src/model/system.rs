@@ -292,7 +292,7 @@ impl System {
     /// returning the motion of a rod. Only distance constraints can be tension-only.
     pub fn set_tension_only(&mut self, c: ConstraintId) -> Result<()> {
         match self.constraints.get(c.0) {
-            Some(Constraint::Distance(_)) | Some(Constraint::PointDistance(_)) => {
+            Some(con) if con.is_distance() => {
                 if !self.tension_only.contains(&c.0) {
                     self.tension_only.push(c.0);
                 }
@@ -323,11 +323,8 @@ impl System {
     /// with Phi = L^2 - |d|^2 the force on the first particle is -2 lambda d, so the tension is
     /// 2 lambda L. `None` for constraints that are not distances.
     pub fn tension(&self, c: usize, lambda: f64) -> Option<f64> {
-        match &self.constraints[c] {
-            Constraint::Distance(d) => Some(2.0 * lambda * d.length),
-            Constraint::PointDistance(d) => Some(2.0 * lambda * d.length),
-            _ => None,
-        }
+        let con = &self.constraints[c];
+        con.is_distance().then(|| 2.0 * lambda * con.length())
     }
 
     /// Inertia of each particle's translation: its mass plus the added mass of fluid elements.
