@@ -8,9 +8,9 @@ VENV_STAMP := $(VENV)/.installed
 
 .PHONY: run test build .venv
 
-## run: build, then run the main job (the demo models; plots go to output/)
+## run: build, then run the main job (the buoy study; tables, figures and summary go to output/)
 run: build
-	$(VENV)/bin/vinculo demo --output output
+	$(VENV)/bin/vinculo buoy --output output
 
 ## test: formatting, lints, Rust tests, build, Python lint and tests, in that order
 test: $(VENV_STAMP)

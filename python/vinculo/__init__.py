@@ -20,6 +20,8 @@ from vinculo.errors import (
     InconsistentInitialStateError,
     InternalError,
     InvalidInputError,
+    NegativeTensionError,
+    RedundantConstraintsError,
     UnknownHandleError,
     VinculoError,
 )
@@ -40,7 +42,9 @@ __all__ = [
     "InternalError",
     "InvalidInputError",
     "Law",
+    "NegativeTensionError",
     "ParticleId",
+    "RedundantConstraintsError",
     "Solution",
     "System",
     "UnknownHandleError",

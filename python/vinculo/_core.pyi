@@ -2,7 +2,7 @@
 
 Users import from ``vinculo``; this module is the thin layer the Python package is built on.
 """
-from typing import Callable, Sequence, Union
+from typing import Any, Callable, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -64,6 +64,48 @@ class System:
         """f = -c v."""
     def add_quadratic_drag(self, particle: ParticleId, coefficient: float) -> ForceId:
         """f = -c |v| v."""
+    def add_rigid_body(
+        self,
+        mass: float,
+        centre: Vector,
+        inertia: Sequence[Sequence[float]],
+        velocity: Vector | None = None,
+        angular_velocity: Vector | None = None,
+        points: Sequence[Vector] | None = None,
+        point_mass_fraction: float = 0.01,
+    ) -> dict[str, Any]:
+        """A rigid body of 7 particles (octahedron + centre; more for points off the octahedron)
+        with the given mass, centre of mass and inertia tensor (kg m^2, about the centre, world
+        axes), held rigid by 15 independent distances (3 more per added point).
+
+        Returns {"centre": ParticleId, "vertices": [6 ParticleId: +e1, -e1, +e2, -e2, +e3, -e3],
+        "points": [ParticleId per point], "particles": [...], "constraints": [ConstraintId...],
+        "axes": 3x3 principal axes as columns}.
+        Raises InvalidInputError (bad mass, non-symmetric or flat inertia),
+        RedundantConstraintsError (degenerate geometry)."""
+    def add_morison(
+        self,
+        particle: ParticleId,
+        *,
+        volume: float,
+        area: float,
+        drag_coefficient: float,
+        added_mass_coefficient: float,
+        density: float = 1000.0,
+        fluid_motion: Vector | None = None,
+    ) -> ForceId:
+        """Fluid forces on a body's centre particle, the fluid moving as a rigid body by
+        X_f(t) = fluid_motion (None: still): rho V (a_f - g) + Ca rho V a_f
+        + 1/2 rho Cd A |u_f - v| (u_f - v); the added mass Ca rho V joins the particle's inertia."""
+    def set_tension_only(self, constraint: ConstraintId) -> None:
+        """Declare a distance constraint a string: runs stop with NegativeTensionError when it
+        would have to push."""
+    @property
+    def constraint_lengths(self) -> npt.NDArray[np.float64]:
+        """Length of each constraint (m); NaN for constraints that are not distances."""
+    @property
+    def inertia(self) -> npt.NDArray[np.float64]:
+        """Translational inertia of each particle: mass plus added mass (kg)."""
     @property
     def num_particles(self) -> int: ...
     @property

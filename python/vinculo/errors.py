@@ -19,6 +19,8 @@ __all__ = [
     "InconsistentInitialStateError",
     "InternalError",
     "InvalidInputError",
+    "NegativeTensionError",
+    "RedundantConstraintsError",
     "UnknownHandleError",
     "VinculoError",
 ]
@@ -91,6 +93,47 @@ class InconsistentInitialStateError(InvalidInputError):
     the constraint. Call ``System.project_initial_state()`` to move the initial state onto the
     constraints with the least mass-weighted change, or fix the model.
     """
+
+
+class RedundantConstraintsError(InvalidInputError):
+    """Some constraint equations are combinations of others.
+
+    Redundant constraints leave the multipliers undetermined and make every linear solve singular.
+    Raised when a rigid body is built, or when a run starts on a system whose constraint gradients
+    are linearly dependent. The message names the dependent constraint and those it is a
+    combination of; remove one of them.
+
+    Attributes:
+        constraint: name of the dependent constraint; ``index`` its index.
+        depends_on: names of the constraints it is a combination of; ``depends_on_indices`` theirs.
+    """
+
+    constraint: str | None = None
+    index: int | None = None
+    depends_on: list[str] | None = None
+    depends_on_indices: list[int] | None = None
+
+
+class NegativeTensionError(VinculoError, RuntimeError):
+    """A string (a tension-only distance) would have to push.
+
+    Raised by :func:`vinculo.simulate` at the first step where a constraint declared with
+    ``System.set_tension_only`` carries a negative tension: from then on the model (an
+    inextensible rod) no longer describes a string, so the run stops instead of returning
+    unphysical motion. ``solution`` holds every step up to and including that one.
+
+    Attributes:
+        time: when the tension first became negative (s).
+        constraint: the string's name; ``index`` its index.
+        tension: the (negative) tension it would need, in N.
+        solution: the partial :class:`vinculo.Solution`.
+    """
+
+    time: float | None = None
+    constraint: str | None = None
+    index: int | None = None
+    tension: float | None = None
+    solution: Any = None
 
 
 class ConvergenceError(VinculoError, RuntimeError):

@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from vinculo._core import ConstraintId, ParticleId, System
-from vinculo.errors import UnknownHandleError
+from vinculo.errors import InvalidInputError, UnknownHandleError
 
 __all__ = ["Solution"]
 
@@ -153,7 +153,9 @@ class Solution:
         index = self._index(constraint, ConstraintId, self.multipliers.shape[1], "constraint")
         return self.multipliers[:, index]
 
-    def distance_tension(self, constraint: ConstraintId, length: float) -> np.ndarray:
+    def distance_tension(
+        self, constraint: ConstraintId, length: float | None = None
+    ) -> np.ndarray:
         """Tension in a distance constraint (a massless rigid link).
 
         With ``Phi = L^2 - |q_a - q_b|^2`` the constraint force on ``a`` is
@@ -162,15 +164,25 @@ class Solution:
 
         Arguments:
             constraint: the handle returned by ``add_distance`` or ``add_distance_to_point``.
-            length: the constraint's length L, in m.
+            length: the constraint's length L, in m (None: the length the system holds).
 
         Returns:
             (s,) tension in N.
 
         Raises:
             UnknownHandleError: if ``constraint`` is not a ConstraintId of this system.
+            InvalidInputError: ``length`` is None and the constraint is not a distance.
         """
-        return 2.0 * self.multiplier(constraint) * float(length)
+        multiplier = self.multiplier(constraint)
+        if length is None:
+            length = float(self.system.constraint_lengths[constraint.index])
+            if not np.isfinite(length):
+                raise InvalidInputError(
+                    f"constraint {constraint.index} is not a distance: it has no tension",
+                    name="constraint",
+                    value=constraint.index,
+                )
+        return 2.0 * multiplier * float(length)
 
     def kinetic_energy(self) -> np.ndarray:
         """Kinetic energy ``sum 1/2 m |v|^2`` at each stored time.

@@ -74,6 +74,28 @@ pub fn details<'py>(py: Python<'py>, e: &Error) -> PyResult<Bound<'py, PyDict>> 
             d.set_item("equation", equation)?;
         }
         Error::Interrupted { t } => d.set_item("time", t)?,
+        Error::RedundantConstraints {
+            constraint,
+            index,
+            depends_on,
+            depends_on_indices,
+        } => {
+            d.set_item("constraint", constraint)?;
+            d.set_item("index", index)?;
+            d.set_item("depends_on", depends_on.clone())?;
+            d.set_item("depends_on_indices", depends_on_indices.clone())?;
+        }
+        Error::NegativeTension {
+            t,
+            constraint,
+            index,
+            tension,
+        } => {
+            d.set_item("time", t)?;
+            d.set_item("constraint", constraint)?;
+            d.set_item("index", index)?;
+            d.set_item("tension", tension)?;
+        }
     }
     Ok(d)
 }

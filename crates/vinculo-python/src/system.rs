@@ -6,7 +6,8 @@ use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use vinculo::model::{ParticleId, System};
+use vinculo::forces::MorisonSpec;
+use vinculo::model::{ParticleId, RigidBodySpec, System};
 
 /// Handle to a particle of one System.
 #[pyclass(name = "ParticleId", module = "vinculo._core", frozen, eq, hash)]
@@ -300,6 +301,144 @@ impl PySystem {
             .add_quadratic_drag(p, coefficient)
             .map_err(to_py)?;
         Ok(PyForceId { index: id.0 })
+    }
+
+    /// A rigid body made of particles: same mass, centre and inertia tensor, exactly rigid.
+    ///
+    /// Returns a dict with "centre", "vertices", "points", "particles" (ParticleIds),
+    /// "constraints" (ConstraintIds) and "axes" (principal axes as columns).
+    #[pyo3(signature = (mass, centre, inertia, velocity=None, angular_velocity=None, points=None, point_mass_fraction=0.01))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_rigid_body<'py>(
+        &mut self,
+        py: Python<'py>,
+        mass: f64,
+        centre: &Bound<'_, PyAny>,
+        inertia: &Bound<'_, PyAny>,
+        velocity: Option<&Bound<'_, PyAny>>,
+        angular_velocity: Option<&Bound<'_, PyAny>>,
+        points: Option<Vec<Bound<'_, PyAny>>>,
+        point_mass_fraction: f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let rows: Vec<Vec<f64>> = inertia.extract().map_err(|_| {
+            invalid(
+                "inertia",
+                inertia.repr().map(|r| r.to_string()).unwrap_or_default(),
+                "expected a 3 x 3 tensor (kg m^2)",
+            )
+        })?;
+        if rows.len() != 3 || rows.iter().any(|r| r.len() != 3) {
+            return Err(invalid(
+                "inertia",
+                format!("{rows:?}"),
+                "expected a 3 x 3 tensor",
+            ));
+        }
+        let spec = RigidBodySpec {
+            mass,
+            centre: vec3(centre, "centre")?,
+            inertia: std::array::from_fn(|r| [rows[r][0], rows[r][1], rows[r][2]]),
+            velocity: velocity
+                .map(|v| vec3(v, "velocity"))
+                .transpose()?
+                .unwrap_or([0.0; 3]),
+            angular_velocity: angular_velocity
+                .map(|v| vec3(v, "angular_velocity"))
+                .transpose()?
+                .unwrap_or([0.0; 3]),
+            points: points
+                .unwrap_or_default()
+                .iter()
+                .map(|p| vec3(p, "points"))
+                .collect::<PyResult<_>>()?,
+            point_mass_fraction,
+        };
+        let body = self.inner.add_rigid_body(&spec).map_err(to_py)?;
+        let ids = |v: &[ParticleId]| -> Vec<PyParticleId> {
+            v.iter().map(|&inner| PyParticleId { inner }).collect()
+        };
+        let d = PyDict::new(py);
+        d.set_item("centre", PyParticleId { inner: body.centre })?;
+        d.set_item("vertices", ids(&body.vertices))?;
+        d.set_item("points", ids(&body.points))?;
+        d.set_item("particles", ids(&body.particles))?;
+        let constraints: Vec<PyConstraintId> = body
+            .constraints
+            .iter()
+            .map(|c| PyConstraintId { index: c.0 })
+            .collect();
+        d.set_item("constraints", constraints)?;
+        d.set_item("axes", body.axes.map(|r| r.to_vec()).to_vec())?;
+        Ok(d)
+    }
+
+    /// Fluid forces on a body's centre: buoyancy and Froude-Krylov, added mass, Morison drag,
+    /// for a fluid moving as a rigid body with displacement `fluid_motion` (3 numbers or Laws).
+    #[pyo3(signature = (particle, *, volume, area, drag_coefficient, added_mass_coefficient, density=1000.0, fluid_motion=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_morison(
+        &mut self,
+        particle: &Bound<'_, PyAny>,
+        volume: f64,
+        area: f64,
+        drag_coefficient: f64,
+        added_mass_coefficient: f64,
+        density: f64,
+        fluid_motion: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<PyForceId> {
+        let p = self.particle(particle)?;
+        let fluid = match fluid_motion {
+            Some(f) => vector(f, "fluid_motion")?,
+            None => vinculo::laws::VectorLaw::constant([0.0; 3]),
+        };
+        let spec = MorisonSpec {
+            density,
+            volume,
+            area,
+            drag_coefficient,
+            added_mass_coefficient,
+            fluid,
+        };
+        let id = self.inner.add_morison(p, spec).map_err(to_py)?;
+        Ok(PyForceId { index: id.0 })
+    }
+
+    /// Declares a distance constraint a string: a run stops with NegativeTensionError when it
+    /// would have to push.
+    fn set_tension_only(&mut self, constraint: &Bound<'_, PyAny>) -> PyResult<()> {
+        let c = constraint.cast::<PyConstraintId>().map_err(|_| {
+            invalid(
+                "constraint",
+                constraint.repr().map(|r| r.to_string()).unwrap_or_default(),
+                "expected a ConstraintId returned by System.add_distance or add_distance_to_point",
+            )
+        })?;
+        let index = c.get().index;
+        self.inner
+            .set_tension_only(vinculo::model::ConstraintId(index))
+            .map_err(to_py)
+    }
+
+    /// Lengths of the constraints (m; NaN for constraints that are not distances).
+    #[getter]
+    fn constraint_lengths<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let v: Vec<f64> = (0..self.inner.constraints().len())
+            .map(|c| {
+                let con = &self.inner.constraints()[c];
+                if con.is_distance() {
+                    con.length()
+                } else {
+                    f64::NAN
+                }
+            })
+            .collect();
+        Array1::from(v).into_pyarray(py)
+    }
+
+    /// Inertia of each particle's translation (kg): mass plus added mass of fluid elements.
+    #[getter]
+    fn inertia<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        Array1::from(self.inner.inertia()).into_pyarray(py)
     }
 
     /// Number of particles.

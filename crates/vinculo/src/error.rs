@@ -114,6 +114,31 @@ pub enum Error {
         /// What the linear solver reported.
         detail: String,
     },
+    /// Some constraint equations are combinations of others: the constraint gradients are
+    /// linearly dependent, so the multipliers are not unique and the KKT matrix is singular.
+    #[error("redundant constraints: {constraint} is a linear combination of {}; remove it (or one of those) so that every constraint adds a condition of its own", depends_on.join(", "))]
+    RedundantConstraints {
+        /// The constraint found to be dependent on earlier ones.
+        constraint: String,
+        /// Index of that constraint.
+        index: usize,
+        /// The constraints it is a combination of.
+        depends_on: Vec<String>,
+        /// Their indices.
+        depends_on_indices: Vec<usize>,
+    },
+    /// A tension-only constraint (a string) would have to push to keep its length.
+    #[error("{constraint} would have to push at t = {t:.6} s (tension {tension:.4e} N < 0): a string cannot; the model is not valid from this time on (a buoy denser than the fluid, or an excitation violent enough to slacken the string)")]
+    NegativeTension {
+        /// Time of the first step where the tension is negative.
+        t: f64,
+        /// The constraint's name.
+        constraint: String,
+        /// Index of the constraint.
+        index: usize,
+        /// The tension it would need (N, negative).
+        tension: f64,
+    },
     /// The run was stopped by its observer (for instance a keyboard interrupt).
     #[error("run interrupted at t = {t:.6} s")]
     Interrupted {
@@ -133,6 +158,8 @@ impl Error {
             | Error::LawOutOfDomain { .. } => "InvalidInputError",
             Error::UnknownParticle { .. } => "UnknownHandleError",
             Error::InconsistentInitialState { .. } => "InconsistentInitialStateError",
+            Error::RedundantConstraints { .. } => "RedundantConstraintsError",
+            Error::NegativeTension { .. } => "NegativeTensionError",
             Error::ProjectionFailed { .. }
             | Error::NewtonFailed { .. }
             | Error::SingularMatrix { .. }

@@ -24,11 +24,11 @@ fn fill_saddle(system: &System, ws: &mut StepWorkspace, q: &[Vec3], t: f64) {
     let layout = &ws.layout;
     let values = &mut ws.values;
     values.fill(0.0);
-    for (i, p) in system.particles().iter().enumerate() {
+    for (i, m) in ws.inertia.iter().enumerate() {
         let blk = &layout.particle_block[i];
         if blk[0] != NONE {
             for k in 0..3 {
-                values[blk[4 * k]] += p.mass / ws.mass_ref;
+                values[blk[4 * k]] += m / ws.mass_ref;
             }
         }
     }

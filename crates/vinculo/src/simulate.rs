@@ -1,6 +1,7 @@
 //! The entry point: validate, start consistently, march in time with step retries, keep
 //! everything computed even when a step fails.
 
+use crate::constraints::find_redundant;
 use crate::error::{Error, Result};
 use crate::initial::{
     consistent_accelerations, scaled_velocity_violation, scaled_violation, singular_error,
@@ -145,6 +146,19 @@ fn check_options(system: &System, o: &SimulationOptions) -> Result<()> {
     Ok(())
 }
 
+/// The first tension-only constraint whose tension is below `floor` (N), as an error.
+fn negative_tension(system: &System, lambda: &[f64], t: f64, floor: f64) -> Option<Error> {
+    system.tension_only().iter().find_map(|&c| {
+        let tension = system.tension(c, lambda[c])?;
+        (tension < floor).then(|| Error::NegativeTension {
+            t,
+            constraint: system.constraints()[c].name(c),
+            index: c,
+            tension,
+        })
+    })
+}
+
 /// Integrates `system` from `options.t_start` to `options.t_end`.
 ///
 /// Errors in the input are returned as `Err`. A run that stops part-way (Newton failure after
@@ -207,7 +221,12 @@ pub fn simulate_with_observer(
         ..options.newton
     };
     let mut sol = Solution::new(q.len(), system.constraints().len(), ws.solver.name());
-    let (mut acc, mut lambda) = match consistent_accelerations(system, &mut ws, &q, &v, t0) {
+    let start = consistent_accelerations(system, &mut ws, &q, &v, t0).map_err(|e| match e {
+        // Name the culprits when the matrix is singular because constraints are redundant.
+        Error::SingularMatrix { .. } => find_redundant(system, &q, t0, None).unwrap_or(e),
+        e => e,
+    });
+    let (mut acc, mut lambda) = match start {
         Ok(x) => x,
         Err(e) => {
             sol.push(
@@ -223,6 +242,16 @@ pub fn simulate_with_observer(
         }
     };
     sol.push(t0, &q, &v, &lambda, worst, StepStats::default());
+    let weight = system
+        .particles()
+        .iter()
+        .map(|p| p.mass * crate::math::norm(g))
+        .sum::<f64>();
+    let tension_floor = -1e-9 * if weight > 0.0 { weight } else { 1.0 };
+    if let Some(e) = negative_tension(system, &lambda, t0, tension_floor) {
+        sol.status = Err(e);
+        return Ok(sol);
+    }
 
     // Times are kept on an exact grid: every step is dt / 2^j, an integer number of the smallest
     // allowed step, so t = t_start + units * unit never accumulates round-off. The last step is
@@ -265,7 +294,8 @@ pub fn simulate_with_observer(
                     t0 + units as f64 * unit
                 };
                 step += 1;
-                if step % options.save_every == 0 || last {
+                let slack = negative_tension(system, &lambda, t, tension_floor);
+                if step % options.save_every == 0 || last || slack.is_some() {
                     let stats = StepStats {
                         newton_iterations: report.iterations,
                         step_size: h_try,
@@ -273,6 +303,10 @@ pub fn simulate_with_observer(
                         increment_norm: report.increment,
                     };
                     sol.push(t, &q, &v, &lambda, scaled_violation(system, &q, t).0, stats);
+                }
+                if let Some(e) = slack {
+                    sol.status = Err(e);
+                    break;
                 }
                 // Grow back towards the nominal step after a reduction.
                 level = (level + 1).min(top);

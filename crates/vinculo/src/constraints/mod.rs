@@ -18,11 +18,13 @@ mod distance;
 mod fixed_coordinate;
 mod plane;
 mod point_distance;
+mod redundancy;
 
 pub use distance::Distance;
 pub use fixed_coordinate::FixedCoordinate;
 pub use plane::Plane;
 pub use point_distance::PointDistance;
+pub use redundancy::{find_redundant, MAX_ENTRIES, RANK_TOLERANCE};
 
 use crate::math::{Mat3, Vec3};
 
@@ -98,13 +100,19 @@ impl Constraint {
         dispatch!(self, c => c.scale())
     }
 
-    /// A characteristic length of the constraint (for the model's length scale).
+    /// A characteristic length of the constraint (for the model's length scale): the length of
+    /// a distance, 0 for the other kinds.
     pub fn length(&self) -> f64 {
         match self {
             Constraint::Distance(c) => c.length,
             Constraint::PointDistance(c) => c.length,
             _ => 0.0,
         }
+    }
+
+    /// True for the kinds that hold a distance (whose multiplier is a tension 2 lambda L).
+    pub fn is_distance(&self) -> bool {
+        matches!(self, Constraint::Distance(_) | Constraint::PointDistance(_))
     }
 
     /// The time interval on which the constraint's laws are defined.

@@ -7,15 +7,19 @@
 //!   particles;
 //! - `potential(q)`: the potential energy for conservative elements (0 for dissipative ones).
 //!
+//! - `added_mass()`: mass added to a particle's inertia (fluid elements only).
+//!
 //! Uniform gravity acts on every particle and lives in the [`System`](crate::model::System) itself.
 //! The residual of the dynamics uses F = -f (formulation.md), so the assembler subtracts these.
 
 mod applied;
 mod drag;
+mod morison;
 mod spring_damper;
 
 pub use applied::AppliedForce;
 pub use drag::{LinearDrag, QuadraticDrag};
+pub use morison::{Morison, MorisonSpec};
 pub use spring_damper::SpringDamper;
 
 use crate::math::{Mat3, Vec3};
@@ -36,6 +40,8 @@ pub enum Force {
     LinearDrag(LinearDrag),
     /// f = -c |v| v.
     QuadraticDrag(QuadraticDrag),
+    /// Buoyancy, Froude-Krylov, added mass and drag of a fluid in rigid motion.
+    Morison(Box<Morison>),
 }
 
 macro_rules! dispatch {
@@ -45,6 +51,7 @@ macro_rules! dispatch {
             Force::Applied($f) => $e,
             Force::LinearDrag($f) => $e,
             Force::QuadraticDrag($f) => $e,
+            Force::Morison($f) => $e,
         }
     };
 }
@@ -88,10 +95,20 @@ impl Force {
         !matches!(self, Force::Applied(_))
     }
 
+    /// Mass the element adds to the inertia of a particle's translation: (particle, mass).
+    /// The mass matrix is constant, so this is read once per run.
+    pub fn added_mass(&self) -> Option<(usize, f64)> {
+        match self {
+            Force::Morison(f) => Some((f.particles[0], f.added_mass())),
+            _ => None,
+        }
+    }
+
     /// The time interval on which the force's laws are defined.
     pub fn domain(&self) -> (f64, f64) {
         match self {
             Force::Applied(f) => f.force.domain(),
+            Force::Morison(f) => f.fluid.domain(),
             _ => (f64::NEG_INFINITY, f64::INFINITY),
         }
     }
@@ -106,6 +123,7 @@ impl Force {
             Force::Applied(_) => format!("applied force #{index} (particle {})", p[0]),
             Force::LinearDrag(_) => format!("linear drag #{index} (particle {})", p[0]),
             Force::QuadraticDrag(_) => format!("quadratic drag #{index} (particle {})", p[0]),
+            Force::Morison(_) => format!("fluid forces #{index} (particle {})", p[0]),
         }
     }
 }

@@ -55,6 +55,9 @@ pub struct StepWorkspace {
     pub state: StepBuffers,
     /// Reference mass used in the scaling (mean mass of the free particles).
     pub mass_ref: f64,
+    /// Inertia of each particle's translation: its mass plus any added mass of fluid elements
+    /// (the diagonal of M, constant over the run). Gravity acts on the mass alone.
+    pub inertia: Vec<f64>,
     /// s_k of each constraint.
     pub scales: Vec<f64>,
 }
@@ -125,6 +128,7 @@ impl StepWorkspace {
             },
             scales: system.constraints().iter().map(|c| c.scale()).collect(),
             mass_ref,
+            inertia: system.inertia(),
             layout,
         }
     }
@@ -136,6 +140,7 @@ pub struct StepProblem<'a> {
     layout: &'a Layout,
     buffers: &'a mut StepBuffers,
     scales: &'a [f64],
+    inertia: &'a [f64],
     q_n: &'a [Vec3],
     v_n: &'a [Vec3],
     t_n: f64,
@@ -175,7 +180,8 @@ impl NewtonProblem for StepProblem<'_> {
             let d = layout.dof[i];
             if d != NONE {
                 for k in 0..3 {
-                    r[d + k] = sigma * p.mass * ((b.v[i][k] - self.v_n[i][k]) / h - g[k]);
+                    r[d + k] = sigma
+                        * (self.inertia[i] * (b.v[i][k] - self.v_n[i][k]) / h - p.mass * g[k]);
                 }
             }
         }
@@ -212,10 +218,10 @@ impl NewtonProblem for StepProblem<'_> {
         let ta = self.t_alpha();
         let t1 = self.t_n + h;
         let b = &*self.buffers;
-        for (i, p) in system.particles().iter().enumerate() {
+        for i in 0..system.particles().len() {
             let blk = &layout.particle_block[i];
             if blk[0] != NONE {
-                let m = sigma * p.mass / (a * h * h);
+                let m = sigma * self.inertia[i] / (a * h * h);
                 for k in 0..3 {
                     values[blk[4 * k]] += m;
                 }
@@ -311,6 +317,7 @@ impl GeneralizedTrapezoidal {
             layout: &ws.layout,
             buffers: &mut ws.state,
             scales: &ws.scales,
+            inertia: &ws.inertia,
             q_n,
             v_n,
             t_n,
@@ -370,6 +377,23 @@ mod tests {
         s.add_spring_damper(c, d, 40.0, 1.5, Some(0.5)).unwrap();
         s.add_quadratic_drag(b, 0.8).unwrap();
         s.add_linear_drag(c, 0.3).unwrap();
+        // Fluid forces with added mass (which enters the mass matrix) on a constrained particle.
+        s.add_morison(
+            b,
+            crate::forces::MorisonSpec {
+                density: 1000.0,
+                volume: 2e-4,
+                area: 0.01,
+                drag_coefficient: 0.4,
+                added_mass_coefficient: 0.5,
+                fluid: VectorLaw([
+                    Law::sine(0.05, 0.9, 0.0, 0.0, 0.5, 0.0).unwrap(),
+                    Law::Constant(0.0),
+                    Law::Constant(0.0),
+                ]),
+            },
+        )
+        .unwrap();
         s.add_force(
             d,
             VectorLaw([
@@ -406,6 +430,7 @@ mod tests {
                 layout: &ws.layout,
                 buffers: &mut ws.state,
                 scales: &ws.scales,
+                inertia: &ws.inertia,
                 q_n: &q_n,
                 v_n: &v_n,
                 t_n: 0.3,

@@ -1,7 +1,10 @@
-//! The model: particles and the system that owns them with their constraints and forces.
+//! The model: particles and the system that owns them with their constraints and forces, and
+//! rigid bodies built from particles.
 
 mod particle;
+mod rigid_body;
 mod system;
 
 pub use particle::{ConstraintId, ForceId, Particle, ParticleId};
+pub use rigid_body::{RigidBody, RigidBodySpec};
 pub use system::System;

@@ -3,7 +3,9 @@
 use super::particle::{ConstraintId, ForceId, Particle, ParticleId};
 use crate::constraints::{Constraint, Distance, FixedCoordinate, Plane, PointDistance};
 use crate::error::{finite_vector, non_negative, positive, Error, Result};
-use crate::forces::{AppliedForce, Force, LinearDrag, QuadraticDrag, SpringDamper};
+use crate::forces::{
+    AppliedForce, Force, LinearDrag, Morison, MorisonSpec, QuadraticDrag, SpringDamper,
+};
 use crate::laws::{Law, VectorLaw};
 use crate::math::{dot, norm, sub, Vec3};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -18,6 +20,7 @@ pub struct System {
     particles: Vec<Particle>,
     constraints: Vec<Constraint>,
     forces: Vec<Force>,
+    tension_only: Vec<usize>,
 }
 
 impl System {
@@ -38,6 +41,7 @@ impl System {
             particles: Vec::new(),
             constraints: Vec::new(),
             forces: Vec::new(),
+            tension_only: Vec::new(),
         })
     }
 
@@ -258,6 +262,80 @@ impl System {
             coefficient,
         }));
         Ok(ForceId(index))
+    }
+
+    /// Buoyancy, Froude-Krylov, added mass and drag of a fluid moving as a rigid body by
+    /// `spec.fluid`, acting on `p` (a body's centre). See [`Morison`] for the equations.
+    pub fn add_morison(&mut self, p: ParticleId, spec: MorisonSpec) -> Result<ForceId> {
+        let i = self.check(p)?;
+        let index = self.forces.len();
+        let what = |field: &str| format!("{field} of fluid forces #{index} (particle {i})");
+        let element = Morison {
+            particles: [i],
+            density: positive(what("fluid density"), spec.density)?,
+            volume: positive(what("volume"), spec.volume)?,
+            area: non_negative(what("frontal area"), spec.area)?,
+            drag_coefficient: non_negative(what("drag coefficient"), spec.drag_coefficient)?,
+            added_mass_coefficient: non_negative(
+                what("added-mass coefficient"),
+                spec.added_mass_coefficient,
+            )?,
+            fluid: spec.fluid,
+            gravity: self.gravity,
+        };
+        self.forces.push(Force::Morison(Box::new(element)));
+        Ok(ForceId(index))
+    }
+
+    /// Declares constraint `c` a string or cable: it may pull but never push. A run stops with
+    /// [`Error::NegativeTension`] at the first time the constraint would have to push, instead of
+    /// returning the motion of a rod. Only distance constraints can be tension-only.
+    pub fn set_tension_only(&mut self, c: ConstraintId) -> Result<()> {
+        match self.constraints.get(c.0) {
+            Some(con) if con.is_distance() => {
+                if !self.tension_only.contains(&c.0) {
+                    self.tension_only.push(c.0);
+                }
+                Ok(())
+            }
+            Some(other) => Err(Error::InvalidParameter {
+                name: format!("tension-only constraint ({})", other.name(c.0)),
+                value: c.0 as f64,
+                expected: "must be a distance constraint (a string can only be a distance)".into(),
+            }),
+            None => Err(Error::InvalidParameter {
+                name: "constraint handle".into(),
+                value: c.0 as f64,
+                expected: format!(
+                    "must be one of the system's {} constraints",
+                    self.constraints.len()
+                ),
+            }),
+        }
+    }
+
+    /// The constraints declared tension-only.
+    pub fn tension_only(&self) -> &[usize] {
+        &self.tension_only
+    }
+
+    /// Tension (N, > 0 pulling) of distance constraint `c` carrying multiplier `lambda`:
+    /// with Phi = L^2 - |d|^2 the force on the first particle is -2 lambda d, so the tension is
+    /// 2 lambda L. `None` for constraints that are not distances.
+    pub fn tension(&self, c: usize, lambda: f64) -> Option<f64> {
+        let con = &self.constraints[c];
+        con.is_distance().then(|| 2.0 * lambda * con.length())
+    }
+
+    /// Inertia of each particle's translation: its mass plus the added mass of fluid elements.
+    pub fn inertia(&self) -> Vec<f64> {
+        let mut m: Vec<f64> = self.particles.iter().map(|p| p.mass).collect();
+        for f in &self.forces {
+            if let Some((i, a)) = f.added_mass() {
+                m[i] += a;
+            }
+        }
+        m
     }
 
     /// Identifier of this system (handles remember it).

@@ -1,0 +1,67 @@
+"""The buoy case study: a buoyant sphere tethered to the floor of a shaken water tank.
+
+- :mod:`vinculo.buoy.case`: the study's parameters (:class:`BuoyCase`), the frequency sweep
+  (:class:`SweepSettings`) and reading both from a TOML file;
+- :mod:`vinculo.buoy.reference`: the reference models integrated with scipy (the rigid pendulum of
+  the study's eq. 31, corrected, and the string + sphere 2-DOF model) and the tank's motion;
+- :mod:`vinculo.buoy.harmonic`: steady-state amplitude and phase by least squares over
+  whole periods;
+- :mod:`vinculo.buoy.data`: reading measured amplitude and phase curves from CSV.
+"""
+
+from vinculo.buoy.case import (
+    ASSUMPTIONS,
+    ATTACHMENTS,
+    BuoyCase,
+    SweepSettings,
+    load_case,
+    load_study,
+    load_sweep,
+)
+from vinculo.buoy.data import COLUMNS, MOTIONS, Measurements, read_measurements
+from vinculo.buoy.harmonic import (
+    PHASE_CONVENTION,
+    HarmonicFit,
+    SteadyResponse,
+    fit_harmonic,
+    steady_response,
+    steady_window,
+    wrap_phase,
+)
+from vinculo.buoy.reference import (
+    OneDofModel,
+    ReferenceRun,
+    TankMotion,
+    TwoDofModel,
+    antiresonance_frequency,
+    high_frequency_ratio,
+    tank_motion,
+)
+
+__all__ = [
+    "ASSUMPTIONS",
+    "ATTACHMENTS",
+    "COLUMNS",
+    "MOTIONS",
+    "PHASE_CONVENTION",
+    "BuoyCase",
+    "HarmonicFit",
+    "Measurements",
+    "OneDofModel",
+    "ReferenceRun",
+    "SteadyResponse",
+    "SweepSettings",
+    "TankMotion",
+    "TwoDofModel",
+    "antiresonance_frequency",
+    "fit_harmonic",
+    "high_frequency_ratio",
+    "load_case",
+    "load_study",
+    "load_sweep",
+    "read_measurements",
+    "steady_response",
+    "steady_window",
+    "tank_motion",
+    "wrap_phase",
+]

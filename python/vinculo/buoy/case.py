@@ -1,0 +1,557 @@
+"""The buoy case study: its parameters, the frequency sweep, and reading both from TOML.
+
+:class:`BuoyCase` holds the physical parameters of the tethered sphere in the shaken tank, with the
+values of the study as defaults (SI units); :class:`SweepSettings` holds the frequency sweep and the
+time settings of each run. Both are frozen dataclasses, validated when built, so a case that exists
+can be simulated.
+
+A case file is TOML with two optional tables, ``[case]`` (the fields of :class:`BuoyCase`) and
+``[sweep]`` (the fields of :class:`SweepSettings`); a key left out keeps its default. Keys outside
+these two tables are rejected, so that a forgotten ``[case]`` header or a misspelt key is reported
+instead of silently ignored::
+
+    [case]
+    amplitude = 0.004       # m, X0 of the shake table
+    attachment = "centre"
+
+    [sweep]
+    f_min = 0.6
+    f_max = 1.4
+    count = 17
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import sys
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from vinculo.errors import InvalidInputError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10 reads TOML with the tomli backport
+    import tomli as tomllib
+
+__all__ = [
+    "ASSUMPTIONS",
+    "ATTACHMENTS",
+    "BuoyCase",
+    "SweepSettings",
+    "load_case",
+    "load_study",
+    "load_sweep",
+]
+
+#: The two readings of where the string is tied to the sphere.
+ATTACHMENTS = ("bottom", "centre")
+
+#: Fields of :class:`BuoyCase` whose defaults are assumptions, not values from the study, each with
+#: the reason for the default.
+ASSUMPTIONS: dict[str, str] = {
+    "amplitude": "the table's displacement amplitude X0 is not reported; at 5 mm the string "
+    "swings at most about 13 deg (at resonance), where the linear picture still holds",
+    "attachment": "the study gives the string length but not where it is tied; 'bottom' (the "
+    "sphere's lowest point) puts the centre 0.21 m above the anchor",
+    "ramp_periods": "the study starts the table abruptly; a smooth C2 ramp over 10 periods avoids "
+    "the strong start-up transient it reports (set 0 for the abrupt start)",
+}
+
+
+def _is_number(value: Any) -> bool:
+    """Whether ``value`` is a real number (an int or float, not a bool)."""
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+        value, (bool, np.bool_)
+    )
+
+
+def _is_integer(value: Any) -> bool:
+    """Whether ``value`` is an integer (not a bool)."""
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+
+def _positive(owner: str, name: str, value: float, unit: str) -> None:
+    """Raise unless ``value`` is finite and positive."""
+    if not (math.isfinite(value) and value > 0.0):
+        raise InvalidInputError(
+            f"{owner}.{name} must be a finite positive number ({unit}), got {value!r}; "
+            f"give a value greater than 0",
+            name=name,
+            value=value,
+        )
+
+
+def _non_negative(owner: str, name: str, value: float, unit: str) -> None:
+    """Raise unless ``value`` is finite and not negative."""
+    if not (math.isfinite(value) and value >= 0.0):
+        raise InvalidInputError(
+            f"{owner}.{name} must be a finite number >= 0 ({unit}), got {value!r}; "
+            f"give 0 or a positive value",
+            name=name,
+            value=value,
+        )
+
+
+@dataclass(frozen=True)
+class BuoyCase:
+    """Parameters of the buoy study: a sphere tethered to the floor of a shaken water tank.
+
+    The defaults are the study's values, except the fields listed in :data:`ASSUMPTIONS`
+    (``amplitude``, ``attachment``, ``ramp_periods``), which the study does not give.
+
+    Arguments:
+        diameter: sphere diameter D, in m.
+        sphere_density: density of the sphere, in kg/m^3.
+        fluid_density: density of the water, in kg/m^3.
+        string_length: length of the string, in m.
+        attachment: ``"bottom"``: the string is tied to the sphere's lowest point, so at rest the
+            centre is ``string_length + R`` above the anchor and the sphere can turn about the
+            attachment; ``"centre"``: the string reaches the centre (``string_length`` to it).
+        drag_coefficient: Cd of the sphere (drag ``1/2 rho Cd A |u| u``).
+        added_mass_coefficient: Ca (added mass ``Ca rho V``, on the translation of the centre).
+        gravity: g, in m/s^2.
+        amplitude: displacement amplitude X0 of the shake table, in m (an assumption).
+        ramp_periods: the table's motion rises smoothly from rest over this many periods
+            (0: the abrupt start of the study).
+        string_beads: number of small masses along the string (0: a massless string).
+        string_mass: total mass of those beads, in kg (must be positive when there are beads, and
+            0 when there are none).
+        tank_size: inner length, width and height of the tank, in m (informational: the fluid is
+            modelled as moving rigidly with the tank, whatever its size).
+
+    Raises:
+        InvalidInputError: if a field is out of its domain (the message names the field and value).
+    """
+
+    diameter: float = 0.1
+    sphere_density: float = 366.69
+    fluid_density: float = 1000.0
+    string_length: float = 0.16
+    attachment: str = "bottom"
+    drag_coefficient: float = 0.22
+    added_mass_coefficient: float = 0.52
+    gravity: float = 9.81
+    amplitude: float = 0.005
+    ramp_periods: float = 10.0
+    string_beads: int = 0
+    string_mass: float = 0.0
+    tank_size: tuple[float, float, float] = (0.38, 0.38, 0.40)
+
+    #: Fields whose defaults are assumptions (see the module's :data:`ASSUMPTIONS`).
+    ASSUMPTIONS: ClassVar[dict[str, str]] = ASSUMPTIONS
+
+    def __post_init__(self) -> None:
+        owner = "BuoyCase"
+        for name, unit in (
+            ("diameter", "m"),
+            ("sphere_density", "kg/m^3"),
+            ("fluid_density", "kg/m^3"),
+            ("string_length", "m"),
+            ("gravity", "m/s^2"),
+            ("amplitude", "m"),
+        ):
+            _positive(owner, name, getattr(self, name), unit)
+        for name, unit in (
+            ("drag_coefficient", "dimensionless"),
+            ("added_mass_coefficient", "dimensionless"),
+            ("ramp_periods", "periods"),
+            ("string_mass", "kg"),
+        ):
+            _non_negative(owner, name, getattr(self, name), unit)
+        if self.attachment not in ATTACHMENTS:
+            raise InvalidInputError(
+                f"BuoyCase.attachment must be one of {', '.join(map(repr, ATTACHMENTS))}, "
+                f"got {self.attachment!r}",
+                name="attachment",
+                value=self.attachment,
+            )
+        if not _is_integer(self.string_beads) or self.string_beads < 0:
+            raise InvalidInputError(
+                f"BuoyCase.string_beads must be a whole number >= 0, got {self.string_beads!r}",
+                name="string_beads",
+                value=self.string_beads,
+            )
+        if self.string_beads > 0 and self.string_mass == 0.0:
+            raise InvalidInputError(
+                f"BuoyCase.string_mass is 0 but string_beads is {self.string_beads}: beads must "
+                f"have mass; give string_mass > 0, or string_beads = 0 for a massless string",
+                name="string_mass",
+                value=self.string_mass,
+            )
+        if self.string_beads == 0 and self.string_mass > 0.0:
+            raise InvalidInputError(
+                f"BuoyCase.string_mass is {self.string_mass!r} kg but string_beads is 0, so the "
+                f"mass would be ignored; give string_beads >= 1 to carry it, or string_mass = 0",
+                name="string_mass",
+                value=self.string_mass,
+            )
+        size = tuple(self.tank_size)
+        if len(size) != 3 or not all(_is_number(v) and math.isfinite(v) and v > 0.0 for v in size):
+            raise InvalidInputError(
+                f"BuoyCase.tank_size must be three finite positive lengths (m), got "
+                f"{self.tank_size!r}",
+                name="tank_size",
+                value=self.tank_size,
+            )
+        object.__setattr__(self, "tank_size", tuple(float(v) for v in size))
+
+    # ---- derived quantities ------------------------------------------------------------------
+
+    @property
+    def radius(self) -> float:
+        """Sphere radius R = D / 2, in m."""
+        return 0.5 * self.diameter
+
+    @property
+    def volume(self) -> float:
+        """Sphere volume V = pi D^3 / 6, in m^3."""
+        return math.pi * self.diameter**3 / 6.0
+
+    @property
+    def frontal_area(self) -> float:
+        """Frontal area A = pi R^2 seen by the drag, in m^2."""
+        return math.pi * self.radius**2
+
+    @property
+    def sphere_mass(self) -> float:
+        """Sphere mass m_s = rho_s V, in kg."""
+        return self.sphere_density * self.volume
+
+    @property
+    def displaced_mass(self) -> float:
+        """Mass of the displaced fluid m_f = rho_f V, in kg."""
+        return self.fluid_density * self.volume
+
+    @property
+    def added_mass(self) -> float:
+        """Added mass m_a = Ca m_f, in kg (translation of the centre only)."""
+        return self.added_mass_coefficient * self.displaced_mass
+
+    @property
+    def centre_inertia(self) -> float:
+        """Moment of inertia of the sphere about its centre, I_c = 2/5 m_s R^2, in kg m^2."""
+        return 0.4 * self.sphere_mass * self.radius**2
+
+    @property
+    def pendulum_length(self) -> float:
+        """Anchor-to-centre distance at rest, in m: ``string_length + R`` ("bottom") or
+        ``string_length`` ("centre")."""
+        if self.attachment == "bottom":
+            return self.string_length + self.radius
+        return self.string_length
+
+    # ---- conversion --------------------------------------------------------------------------
+
+    def to_dict(self) -> dict[str, Any]:
+        """The fields as a plain dict (``tank_size`` as a list), ready for TOML or JSON.
+
+        Returns:
+            ``{field: value}`` for every field; :meth:`from_mapping` rebuilds an equal case.
+        """
+        data = dataclasses.asdict(self)
+        data["tank_size"] = list(self.tank_size)
+        return data
+
+    @classmethod
+    def from_mapping(cls, mapping: Mapping[str, Any], source: str | None = None) -> BuoyCase:
+        """Build a case from a mapping of field names to values (missing fields keep defaults).
+
+        Arguments:
+            mapping: for example the ``[case]`` table of a parsed TOML file.
+            source: where the mapping came from (a file name), quoted in error messages.
+
+        Returns:
+            The validated case.
+
+        Raises:
+            InvalidInputError: for an unknown key (the message lists the valid ones), a value of
+                the wrong type, or a value out of its domain.
+        """
+        return _build(cls, mapping, source, "case")
+
+
+@dataclass(frozen=True)
+class SweepSettings:
+    """A frequency sweep and the time settings of each run in it.
+
+    Each run simulates ``settle_periods`` periods for the transient to die out, then
+    ``fit_periods`` periods over which amplitude and phase are fitted, so it ends at
+    ``(settle_periods + fit_periods) / f``. The default of 30 settling periods is set by the slow
+    decay of the transient: the only damping is quadratic drag, weak at millimetre amplitudes, so
+    the free oscillation at the natural frequency that the start leaves behind dies out slowly.
+    With a 3-period ramp the relative amplitude fitted over periods 30-40 differs from the one
+    over periods 20-30 by up to about 2 % across 0.5-1.5 Hz (largest off resonance); the default
+    10-period ramp excites less of it and brings this under 0.6 %.
+    :attr:`vinculo.buoy.harmonic.SteadyResponse.settling` reports it for each run.
+
+    Arguments:
+        f_min: lowest excitation frequency, in Hz.
+        f_max: highest excitation frequency, in Hz (>= f_min).
+        count: number of frequencies, evenly spaced from f_min to f_max (1 when they are equal).
+        dt: time step of the particle model, in s (at least 20 steps per period of f_max). The
+            default 2 ms is 333 steps per period at 1.5 Hz; halving it changes the fitted
+            amplitudes by less than 1e-4 relative (second-order rule).
+        settle_periods: periods simulated before the fit window (the ramp-up counts among them).
+        fit_periods: whole periods in the fit window (>= 1).
+
+    Raises:
+        InvalidInputError: if a field is out of its domain, or the range has no points.
+    """
+
+    f_min: float = 0.5
+    f_max: float = 1.5
+    count: int = 21
+    dt: float = 2e-3
+    settle_periods: float = 30.0
+    fit_periods: int = 10
+
+    def __post_init__(self) -> None:
+        owner = "SweepSettings"
+        _positive(owner, "f_min", self.f_min, "Hz")
+        _positive(owner, "f_max", self.f_max, "Hz")
+        _positive(owner, "dt", self.dt, "s")
+        _non_negative(owner, "settle_periods", self.settle_periods, "periods")
+        if not _is_integer(self.count) or self.count < 1:
+            raise InvalidInputError(
+                f"SweepSettings.count is {self.count!r}: a frequency range with no points; give "
+                f"a whole number >= 1",
+                name="count",
+                value=self.count,
+            )
+        if self.f_max < self.f_min:
+            raise InvalidInputError(
+                f"SweepSettings.f_max = {self.f_max!r} Hz is below f_min = {self.f_min!r} Hz; "
+                f"give f_max >= f_min",
+                name="f_max",
+                value=self.f_max,
+            )
+        if self.count == 1 and self.f_max != self.f_min:
+            raise InvalidInputError(
+                f"SweepSettings.count is 1 but f_min = {self.f_min!r} and f_max = {self.f_max!r} "
+                f"differ; give count >= 2 to cover the range, or f_max = f_min for one frequency",
+                name="count",
+                value=self.count,
+            )
+        if self.count > 1 and self.f_max == self.f_min:
+            raise InvalidInputError(
+                f"SweepSettings.count is {self.count} but f_min = f_max = {self.f_min!r} Hz, "
+                f"which repeats one frequency; give count = 1 or a wider range",
+                name="count",
+                value=self.count,
+            )
+        if not _is_integer(self.fit_periods) or self.fit_periods < 1:
+            raise InvalidInputError(
+                f"SweepSettings.fit_periods must be a whole number >= 1, got {self.fit_periods!r}",
+                name="fit_periods",
+                value=self.fit_periods,
+            )
+        steps_per_period = 1.0 / (self.f_max * self.dt)
+        if steps_per_period < 20.0:
+            raise InvalidInputError(
+                f"SweepSettings.dt = {self.dt!r} s gives only {steps_per_period:.3g} steps per "
+                f"period at f_max = {self.f_max!r} Hz; give dt <= "
+                f"{1.0 / (20.0 * self.f_max):.3g} s",
+                name="dt",
+                value=self.dt,
+            )
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """The excitation frequencies, in Hz: ``np.linspace(f_min, f_max, count)``."""
+        return np.linspace(self.f_min, self.f_max, self.count)
+
+    def t_end(self, frequency: float) -> float:
+        """Duration of the run at ``frequency``: ``(settle_periods + fit_periods) / frequency``.
+
+        Arguments:
+            frequency: excitation frequency, in Hz (> 0).
+
+        Returns:
+            The end time, in s.
+
+        Raises:
+            InvalidInputError: if ``frequency`` is not finite and positive.
+        """
+        _positive("SweepSettings.t_end", "frequency", frequency, "Hz")
+        return (self.settle_periods + self.fit_periods) / frequency
+
+    def to_dict(self) -> dict[str, Any]:
+        """The fields as a plain dict.
+
+        Returns:
+            ``{field: value}``; :meth:`from_mapping` rebuilds equal settings.
+        """
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_mapping(cls, mapping: Mapping[str, Any], source: str | None = None) -> SweepSettings:
+        """Build settings from a mapping of field names to values (missing fields keep defaults).
+
+        Arguments:
+            mapping: for example the ``[sweep]`` table of a parsed TOML file.
+            source: where the mapping came from (a file name), quoted in error messages.
+
+        Returns:
+            The validated settings.
+
+        Raises:
+            InvalidInputError: for an unknown key, a value of the wrong type, or a value out of
+                its domain.
+        """
+        return _build(cls, mapping, source, "sweep")
+
+
+def _checked_fields(
+    cls: type, mapping: Mapping[str, Any], source: str | None, table: str
+) -> dict[str, Any]:
+    """Check the keys and value types of ``mapping`` against the fields of dataclass ``cls``."""
+    where = f" in {source}" if source else ""
+    if not isinstance(mapping, Mapping):
+        raise InvalidInputError(
+            f"the [{table}] settings{where} must be a table of key = value pairs, got "
+            f"{type(mapping).__name__}",
+            name=table,
+            value=mapping,
+            source=source,
+        )
+    defaults = {field.name: field.default for field in dataclasses.fields(cls)}
+    values: dict[str, Any] = {}
+    for key, value in mapping.items():
+        if key not in defaults:
+            raise InvalidInputError(
+                f"unknown key {key!r} in [{table}]{where}; valid keys are: {', '.join(defaults)}",
+                name=key,
+                value=value,
+                source=source,
+            )
+        default = defaults[key]
+        if isinstance(default, str):
+            ok, expected = isinstance(value, str), "a string"
+        elif isinstance(default, bool):  # pragma: no cover - no boolean fields yet
+            ok, expected = isinstance(value, bool), "true or false"
+        elif isinstance(default, int):
+            ok, expected = _is_integer(value), "a whole number"
+        elif isinstance(default, float):
+            ok, expected = _is_number(value), "a number"
+        else:  # a tuple of numbers
+            ok = isinstance(value, (list, tuple)) and all(_is_number(v) for v in value)
+            expected = f"a list of {len(default)} numbers"
+        if not ok:
+            raise InvalidInputError(
+                f"[{table}] {key}{where} must be {expected}, got {value!r} "
+                f"({type(value).__name__})",
+                name=key,
+                value=value,
+                source=source,
+            )
+        values[key] = float(value) if isinstance(default, float) else value
+    return values
+
+
+def _build(cls: type, mapping: Mapping[str, Any], source: str | None, table: str) -> Any:
+    """Build ``cls`` from ``mapping``; an out-of-domain value's message also names ``source``."""
+    values = _checked_fields(cls, mapping, source, table)
+    try:
+        return cls(**values)
+    except InvalidInputError as error:
+        if source is None:
+            raise
+        details = {**error.details, "source": source}
+        raise InvalidInputError(f"{error.message} (in {source})", **details) from None
+
+
+def _read_toml(path: str | Path) -> dict[str, Any]:
+    """Parse a case file and check that it holds only the ``[case]`` and ``[sweep]`` tables."""
+    path = Path(path)
+    try:
+        with path.open("rb") as stream:
+            data = tomllib.load(stream)
+    except FileNotFoundError:
+        raise InvalidInputError(
+            f"case file {str(path)!r} does not exist; check the path",
+            name="path",
+            value=str(path),
+        ) from None
+    except OSError as error:
+        raise InvalidInputError(
+            f"cannot read case file {str(path)!r}: {error.strerror or error}",
+            name="path",
+            value=str(path),
+        ) from None
+    except tomllib.TOMLDecodeError as error:
+        raise InvalidInputError(
+            f"case file {str(path)!r} is not valid TOML: {error}",
+            name="path",
+            value=str(path),
+        ) from None
+    for key, value in data.items():
+        if key not in ("case", "sweep"):
+            hint = (
+                "; put case parameters under a [case] header"
+                if key in {f.name for f in dataclasses.fields(BuoyCase)}
+                else ""
+            )
+            raise InvalidInputError(
+                f"unexpected top-level key {key!r} in case file {str(path)!r}: only the tables "
+                f"[case] and [sweep] are read{hint}",
+                name=key,
+                value=value,
+                source=str(path),
+            )
+    return data
+
+
+def load_study(path: str | Path) -> tuple[BuoyCase, SweepSettings]:
+    """Read a case and its sweep from a TOML file with optional ``[case]`` and ``[sweep]`` tables.
+
+    Arguments:
+        path: the TOML file.
+
+    Returns:
+        ``(case, sweep)``; a missing table or key keeps the defaults.
+
+    Raises:
+        InvalidInputError: if the file is missing, unreadable or not TOML, has a key outside the
+            two tables, or a table has an unknown key or a bad value (the message names the file).
+    """
+    data = _read_toml(path)
+    source = str(path)
+    case = BuoyCase.from_mapping(data.get("case", {}), source=source)
+    sweep = SweepSettings.from_mapping(data.get("sweep", {}), source=source)
+    return case, sweep
+
+
+def load_case(path: str | Path) -> BuoyCase:
+    """Read the ``[case]`` table of a TOML file (see :func:`load_study`).
+
+    Arguments:
+        path: the TOML file.
+
+    Returns:
+        The case; keys left out keep their defaults.
+
+    Raises:
+        InvalidInputError: as :func:`load_study`.
+    """
+    return load_study(path)[0]
+
+
+def load_sweep(path: str | Path) -> SweepSettings:
+    """Read the ``[sweep]`` table of a TOML file (see :func:`load_study`).
+
+    Arguments:
+        path: the TOML file.
+
+    Returns:
+        The sweep settings; keys left out keep their defaults.
+
+    Raises:
+        InvalidInputError: as :func:`load_study`.
+    """
+    return load_study(path)[1]

@@ -1,0 +1,214 @@
+"""The particle model of the buoy (paper 3.3): a rigid sphere of 7 particles tied by a string.
+
+The sphere is :meth:`vinculo.System.add_rigid_body` with the sphere's mass, centre and inertia
+``2/5 m_s R^2``: an octahedron of six particles of ``m_s / 10`` at distance R around a centre
+particle of ``0.4 m_s``, held rigid by 15 distance constraints. Its lowest vertex is the string's
+attachment (``attachment="bottom"``), or the string is tied to the centre particle
+(``attachment="centre"``). The fluid forces act on the centre particle
+(:meth:`vinculo.System.add_morison`): buoyancy and Froude-Krylov, added mass on the translation
+only, Morison drag, the fluid moving rigidly with the tank. The string is a tension-only distance
+from the anchor, which moves with the tank floor, to the attachment; with ``string_beads = n`` it
+is a chain of n point masses (``string_mass / n`` each) and n + 1 equal links. A run stops with
+:class:`vinculo.NegativeTensionError` at the first time a link would have to push.
+
+Coordinates: x along the shaking, z up, the anchor at the origin when the tank is at rest.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+import vinculo
+from vinculo.buoy.case import BuoyCase
+from vinculo.buoy.reference import tank_motion
+
+__all__ = ["BuoyModel", "ParticleRun", "build_model", "run_particle_model"]
+
+
+@dataclass
+class BuoyModel:
+    """A built particle model and the handles needed to read its results.
+
+    Attributes:
+        system: the :class:`vinculo.System`.
+        centre: the sphere's centre particle.
+        attachment: the particle the string is tied to.
+        body: the dict returned by ``System.add_rigid_body``.
+        links: the string's constraints, from the anchor to the attachment.
+        beads: the string's point masses (empty for a massless string).
+        link_length: length of each link (m).
+        tank: the tank's displacement as a :class:`vinculo.Law` of time.
+    """
+
+    system: vinculo.System
+    centre: vinculo.ParticleId
+    attachment: vinculo.ParticleId
+    body: dict[str, Any]
+    links: list[vinculo.ConstraintId]
+    beads: list[vinculo.ParticleId]
+    link_length: float
+    tank: vinculo.Law
+
+
+def tank_law(case: BuoyCase, frequency: float) -> vinculo.Law:
+    """The tank displacement ``X0 s(t) sin(2 pi f t)`` with the case's ramp, as a core law.
+
+    Arguments:
+        case: the parameters (amplitude X0 and ramp_periods are used).
+        frequency: excitation frequency f, in Hz (> 0).
+
+    Returns:
+        The law (its derivatives are the tank's velocity and acceleration).
+
+    Raises:
+        InvalidInputError: the frequency is not finite and positive.
+    """
+    motion = tank_motion(case, frequency)  # validates the frequency
+    return vinculo.sine(motion.amplitude, motion.frequency, ramp_time=motion.ramp_time)
+
+
+def build_model(
+    case: BuoyCase,
+    tank: vinculo.Law | float = 0.0,
+    initial_rates: tuple[float, float] = (0.0, 0.0),
+) -> BuoyModel:
+    """Build the particle model of ``case`` with the tank moving by ``tank`` (x displacement).
+
+    Arguments:
+        case: the study's parameters.
+        tank: the tank's displacement X_t(t) along x (for example :func:`tank_law`, or a
+            ``vinculo.tabulated`` law of measured displacements); a number for a tank at rest.
+        initial_rates: initial angular rates (rad/s) of the string and of the sphere about the
+            attachment, positive towards +x (free-vibration studies; only with a massless string).
+
+    Returns:
+        The :class:`BuoyModel`, upright (string vertical) at t = 0, at rest unless
+        ``initial_rates`` are given.
+    """
+    if not isinstance(tank, vinculo.Law):
+        tank = vinculo.constant(float(tank))
+    system = vinculo.System(gravity=(0.0, 0.0, -case.gravity))
+    radius = case.radius
+    centre_height = case.pendulum_length
+    attach_height = centre_height - radius if case.attachment == "bottom" else centre_height
+    inertia = case.centre_inertia
+    # Rates: the attachment moves at l th1' along x; the sphere turns at th2' about +y.
+    string_rate, sphere_rate = initial_rates
+    body = system.add_rigid_body(
+        case.sphere_mass,
+        (0.0, 0.0, centre_height),
+        [[inertia, 0.0, 0.0], [0.0, inertia, 0.0], [0.0, 0.0, inertia]],
+        velocity=(attach_height * string_rate + (centre_height - attach_height) * sphere_rate,
+                  0.0, 0.0),
+        angular_velocity=(0.0, sphere_rate, 0.0),
+        points=[(0.0, 0.0, attach_height)],
+    )
+    centre = body["centre"]
+    attachment = body["points"][0]
+    system.add_morison(
+        centre,
+        volume=case.volume,
+        area=case.frontal_area,
+        drag_coefficient=case.drag_coefficient,
+        added_mass_coefficient=case.added_mass_coefficient,
+        density=case.fluid_density,
+        fluid_motion=(tank, 0.0, 0.0),
+    )
+    n = case.string_beads
+    link = case.string_length / (n + 1)
+    beads = [
+        system.add_particle(case.string_mass / n, (0.0, 0.0, link * (k + 1))) for k in range(n)
+    ]
+    ends = [*beads, attachment]
+    links = [system.add_distance_to_point(ends[0], (tank, 0.0, 0.0), length=link)]
+    links += [system.add_distance(a, b, length=link) for a, b in itertools.pairwise(ends)]
+    for c in links:
+        system.set_tension_only(c)
+    return BuoyModel(system, centre, attachment, body, links, beads, link, tank)
+
+
+@dataclass
+class ParticleRun:
+    """Time histories of one run of the particle model.
+
+    Attributes:
+        frequency: excitation frequency (Hz).
+        time: sample times (s).
+        tank: tank displacement X_t (m).
+        buoy: horizontal displacement of the sphere's centre (m, absolute).
+        relative: ``buoy - tank`` (m): the centre relative to the tank.
+        height: height of the centre above the tank floor (m).
+        tension: string tension at the anchor (N), from the link's multiplier.
+        solution: the full :class:`vinculo.Solution`.
+        error: None, or the exception that stopped the run early (the histories then end there).
+    """
+
+    frequency: float
+    time: np.ndarray
+    tank: np.ndarray
+    buoy: np.ndarray
+    relative: np.ndarray
+    height: np.ndarray
+    tension: np.ndarray
+    solution: vinculo.Solution
+    error: vinculo.VinculoError | None = None
+
+
+def run_particle_model(
+    case: BuoyCase,
+    frequency: float,
+    t_end: float,
+    *,
+    dt: float = 1e-3,
+    save_every: int = 5,
+    tank: vinculo.Law | None = None,
+    progress: Any = None,
+) -> ParticleRun:
+    """Simulate the particle model at one frequency from rest.
+
+    Arguments:
+        case: the study's parameters.
+        frequency: excitation frequency (Hz); used for the tank law unless ``tank`` is given.
+        t_end: duration (s).
+        dt: time step (s).
+        save_every: keep every k-th step.
+        tank: a tank displacement law to use instead of the harmonic one (measured motion).
+        progress: passed to :func:`vinculo.simulate`.
+
+    Returns:
+        The :class:`ParticleRun`. A run stopped early by a negative string tension or a failed step
+        keeps what it computed and carries the exception in ``error``.
+    """
+    law = tank if tank is not None else tank_law(case, frequency)
+    model = build_model(case, law)
+    error: vinculo.VinculoError | None = None
+    try:
+        solution = vinculo.simulate(
+            model.system, t_end=t_end, dt=dt, save_every=save_every, progress=progress
+        )
+    except (vinculo.ConvergenceError, vinculo.NegativeTensionError) as e:
+        error, solution = e, e.solution
+    time = solution.times
+    tank_x = _evaluate(law, time)
+    centre = solution.particle(model.centre)
+    tension = solution.distance_tension(model.links[0])
+    return ParticleRun(
+        frequency=frequency,
+        time=time,
+        tank=tank_x,
+        buoy=centre[:, 0],
+        relative=centre[:, 0] - tank_x,
+        height=centre[:, 2],
+        tension=tension,
+        solution=solution,
+        error=error,
+    )
+
+
+def _evaluate(law: vinculo.Law, times: np.ndarray) -> np.ndarray:
+    """Values of a core law at many times."""
+    return np.fromiter((law(t) for t in times), dtype=np.float64, count=len(times))

@@ -1,0 +1,236 @@
+"""Files and plots of the buoy study: CSV tables of every plotted number, the parameters with
+their sources, the figures of the study (time histories, amplitude and phase against frequency)
+and a printed summary."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+from vinculo.buoy.case import ASSUMPTIONS
+from vinculo.buoy.data import Measurements
+from vinculo.buoy.harmonic import PHASE_CONVENTION
+from vinculo.buoy.reference import OneDofModel, TwoDofModel
+from vinculo.buoy.study import LABELS, MODELS, StudyResult
+
+__all__ = ["summary", "write_report"]
+
+_STYLE = {
+    "particle": {"color": "C0", "marker": "o", "linestyle": "-"},
+    "two-dof": {"color": "C1", "marker": "", "linestyle": "--"},
+    "one-dof": {"color": "C2", "marker": "", "linestyle": ":"},
+}
+_FIELDS = [
+    "tank_amplitude",
+    "absolute_amplitude",
+    "absolute_ratio",
+    "absolute_phase_deg",
+    "relative_amplitude",
+    "relative_ratio",
+    "relative_phase_deg",
+    "settling",
+    "residual_rms",
+]
+
+
+def summary(study: StudyResult) -> str:
+    """A printable summary: linear natural frequencies and, per model, the resonance frequency
+    and peak amplitude of the relative motion, plus the failures."""
+    case = study.case
+    lines = [
+        f"buoy study: D = {case.diameter} m, rho_s = {case.sphere_density} kg/m^3, string "
+        f"{case.string_length} m ({case.attachment}), Cd = {case.drag_coefficient}, "
+        f"Ca = {case.added_mass_coefficient}, X0 = {case.amplitude * 1e3:g} mm (assumed)",
+        f"linear natural frequency: 1-DOF {OneDofModel(case).natural_frequency():.4f} Hz; "
+        f"2-DOF {', '.join(f'{f:.4f}' for f in TwoDofModel(case).natural_frequencies())} Hz",
+    ]
+    for model in MODELS:
+        runs = study.of(model)
+        if not runs:
+            continue
+        f, peak = study.resonance(model)
+        ok = sum(r.response is not None for r in runs)
+        lines.append(
+            f"{LABELS[model]:48s} resonance {f:.4f} Hz, peak relative amplitude "
+            f"{peak * 1e3:.3f} mm ({peak / case.amplitude:.3f} X0); {ok}/{len(runs)} runs ok"
+        )
+    for r in study.failures():
+        lines.append(f"FAILED {r.model} at {r.frequency:g} Hz: {r.error}")
+    lines.append(f"{len(study.results)} runs in {study.elapsed:.1f} s on {study.workers} workers")
+    return "\n".join(lines)
+
+
+def _write_parameters(study: StudyResult, path: Path) -> None:
+    case, settings = study.case, study.settings
+    derived = {
+        "radius": (case.radius, "m"),
+        "volume": (case.volume, "m^3"),
+        "frontal_area": (case.frontal_area, "m^2"),
+        "sphere_mass": (case.sphere_mass, "kg"),
+        "displaced_mass": (case.displaced_mass, "kg"),
+        "added_mass": (case.added_mass, "kg"),
+        "centre_inertia": (case.centre_inertia, "kg m^2"),
+        "pendulum_length": (case.pendulum_length, "m"),
+    }
+    with path.open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["parameter", "value", "unit", "source"])
+        for name, value in case.to_dict().items():
+            if name in ASSUMPTIONS:
+                source = f"ASSUMPTION: {ASSUMPTIONS[name]}"
+            elif name in ("string_beads", "string_mass"):
+                source = "option"
+            else:
+                source = "paper"
+            w.writerow([name, value, _UNITS.get(name, ""), source])
+        for name, (value, unit) in derived.items():
+            w.writerow([name, value, unit, "derived"])
+        for name, value in settings.to_dict().items():
+            w.writerow([f"sweep.{name}", value, _UNITS.get(name, ""), "sweep setting"])
+
+
+_UNITS = {
+    "diameter": "m",
+    "sphere_density": "kg/m^3",
+    "fluid_density": "kg/m^3",
+    "string_length": "m",
+    "gravity": "m/s^2",
+    "amplitude": "m",
+    "ramp_periods": "periods",
+    "string_mass": "kg",
+    "tank_size": "m",
+    "f_min": "Hz",
+    "f_max": "Hz",
+    "dt": "s",
+    "settle_periods": "periods",
+    "fit_periods": "periods",
+}
+
+
+def _write_sweep(study: StudyResult, data: Measurements | None, path: Path) -> None:
+    with path.open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(
+            ["model", "frequency_hz", *_FIELDS, "window_start_s", "window_end_s", "error"]
+        )
+        for r in study.results:
+            if r.response is None:
+                w.writerow([r.model, r.frequency, *([""] * (len(_FIELDS) + 2)), r.error])
+                continue
+            values = [getattr(r.response, k) for k in _FIELDS]
+            w.writerow([r.model, r.frequency, *values, *r.response.window, ""])
+        if data is not None:
+            for fr, amp, ph in zip(data.frequency, data.amplitude, data.phase_deg, strict=True):
+                row = dict.fromkeys(_FIELDS, "")
+                row[f"{data.motion}_amplitude"] = amp
+                row[f"{data.motion}_phase_deg"] = ph
+                w.writerow(["measured", fr, *row.values(), "", "", ""])
+
+
+def _write_histories(study: StudyResult, path: Path) -> None:
+    with path.open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["model", "frequency_hz", "time_s", "tank_m", "buoy_m", "relative_m",
+                    "tension_n"])
+        for r in study.results:
+            if r.history is None:
+                continue
+            h = r.history
+            columns = (h["time"], h["tank"], h["buoy"], h["relative"], h["tension"])
+            for row in zip(*columns, strict=True):
+                w.writerow([r.model, r.frequency, *(f"{x:.9g}" for x in row)])
+
+
+def write_report(
+    study: StudyResult, output: Path, data: Measurements | None = None
+) -> list[Path]:
+    """Write the study's tables and figures into ``output``.
+
+    Files: ``parameters.csv`` (every parameter with its unit and source; assumptions marked),
+    ``sweep.csv`` (amplitude and phase of every model at every frequency, fit windows, errors, and
+    the measurements if given), ``histories.csv`` (the kept time histories),
+    ``history_<f>Hz.png`` (figs. 11-13), ``amplitude.png`` (fig. 14), ``phase.png`` (fig. 15),
+    ``summary.txt``.
+
+    Arguments:
+        study: the result of :func:`vinculo.buoy.study.run_study`.
+        output: the folder (created if missing).
+        data: the user's measurements, plotted beside the models.
+
+    Returns:
+        The paths written.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    output.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, writer in (
+        ("parameters.csv", lambda p: _write_parameters(study, p)),
+        ("sweep.csv", lambda p: _write_sweep(study, data, p)),
+        ("histories.csv", lambda p: _write_histories(study, p)),
+    ):
+        writer(output / name)
+        written.append(output / name)
+    x0_mm = study.case.amplitude * 1e3
+
+    # Figs. 11-13: time histories.
+    by_frequency: dict[float, list] = {}
+    for r in study.results:
+        if r.history is not None:
+            by_frequency.setdefault(round(r.frequency, 9), []).append(r)
+    for f, runs in sorted(by_frequency.items()):
+        fig, ax = plt.subplots(figsize=(9, 4))
+        first = runs[0].history
+        ax.plot(first["time"], first["tank"] * 1e3, color="0.5", lw=1.0, label="tank")
+        for r in runs:
+            ax.plot(r.history["time"], r.history["buoy"] * 1e3, lw=1.0,
+                    color=_STYLE[r.model]["color"], linestyle=_STYLE[r.model]["linestyle"],
+                    label=f"buoy: {LABELS[r.model]}" + (" (FAILED)" if r.error else ""))
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel("horizontal displacement (mm)")
+        ax.set_title(f"buoy and tank displacement at {f:g} Hz (X0 = {x0_mm:g} mm, assumed)")
+        ax.legend(fontsize=8, loc="upper right")
+        ax.grid(alpha=0.3)
+        path = output / f"history_{f:.2f}Hz.png"
+        fig.tight_layout()
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+        written.append(path)
+
+    # Figs. 14-15: amplitude and phase against frequency, absolute and relative to the tank.
+    for kind, unit in (("amplitude", "mm"), ("phase", "deg")):
+        fig, axes = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
+        for ax, motion in zip(axes, ("absolute", "relative"), strict=True):
+            quantity = f"{motion}_amplitude" if kind == "amplitude" else f"{motion}_phase_deg"
+            scale = 1e3 if kind == "amplitude" else 1.0
+            for model in MODELS:
+                f, y = study.curve(model, quantity)
+                if len(f):
+                    ax.plot(f, y * scale, label=LABELS[model], **_STYLE[model], ms=4)
+            if data is not None and data.motion == motion:
+                y = data.amplitude * 1e3 if kind == "amplitude" else data.phase_deg
+                ax.plot(data.frequency, y, "ks", ms=5, label=LABELS["measured"])
+            what = "buoy displacement" if motion == "absolute" else "buoy relative to tank"
+            ax.set_ylabel(f"{kind} ({unit})")
+            ax.set_title(f"{what}", fontsize=10)
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=8)
+        axes[-1].set_xlabel("excitation frequency (Hz)")
+        title = (
+            f"amplitude of the buoy's horizontal displacement (X0 = {x0_mm:g} mm, assumed)"
+            if kind == "amplitude"
+            else f"phase: {PHASE_CONVENTION}"
+        )
+        fig.suptitle(title, fontsize=10)
+        fig.tight_layout()
+        path = output / f"{kind}.png"
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+        written.append(path)
+    text = summary(study)
+    (output / "summary.txt").write_text(text + "\n")
+    written.append(output / "summary.txt")
+    return written
