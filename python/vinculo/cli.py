@@ -3,7 +3,8 @@
 Usage::
 
     vinculo demo [--output DIR]
-    vinculo buoy [--output DIR] [--case FILE.toml] [--data FILE.csv] [--PARAMETER VALUE ...]
+    vinculo buoy [--output DIR] [--case FILE.toml] [--data FILE.csv] [--tank-motion FILE.csv]
+                 [--PARAMETER VALUE ...]
 
 ``demo`` runs the four demo models (pendulum, double pendulum, hanging chain, inclined plane),
 prints one line per model comparing the simulation with its reference value, and writes one PNG
@@ -85,6 +86,15 @@ def _add_buoy_parser(commands: Any) -> None:
     buoy.add_argument("--data-motion", choices=("absolute", "relative"), default="absolute",
                       help="whether the measured amplitude is of the absolute or the relative "
                       "motion (default: absolute)")
+    buoy.add_argument("--tank-motion", metavar="FILE.csv", type=Path, action="append",
+                      default=[],
+                      help="a measured tank displacement record (time (s), displacement (m)) to "
+                      "drive the models instead of the harmonic sweep; repeat for several "
+                      "records. Each is smoothed by a spline and fitted at its dominant "
+                      "frequency over its last fit-periods periods")
+    buoy.add_argument("--tank-smoothing", metavar="LAM", type=float, default=None,
+                      help="penalty lam (s^3) of the records' smoothing spline (0 interpolates; "
+                      "default: fit within the noise estimated from the record)")
     buoy.add_argument("--models", default="particle,two-dof,one-dof",
                       help="comma-separated models to run (default: all three)")
     buoy.add_argument("--workers", type=int, default=None,
@@ -132,7 +142,13 @@ def _demo(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
 
 def _buoy(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     """Run the buoy study and write its report into args.output."""
-    from vinculo.buoy import BuoyCase, SweepSettings, load_study, read_measurements
+    from vinculo.buoy import (
+        BuoyCase,
+        SweepSettings,
+        load_study,
+        read_measurements,
+        read_tank_motion,
+    )
     from vinculo.buoy.report import summary, write_report
     from vinculo.buoy.study import run_study
 
@@ -149,12 +165,13 @@ def _buoy(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     case = BuoyCase.from_mapping(case_values, source="the command line")
     settings = SweepSettings.from_mapping(sweep_values, source="the command line")
     data = read_measurements(args.data, motion=args.data_motion) if args.data else None
+    motions = [read_tank_motion(p, smoothing=args.tank_smoothing) for p in args.tank_motion]
     models = tuple(m.strip() for m in args.models.split(",") if m.strip())
     output: Path = args.output
     if output.exists() and not output.is_dir():
         parser.error(f"--output {str(output)!r} exists and is not a folder")
     study = run_study(case, settings, models=models, workers=args.workers,
-                      progress=not args.no_progress)
+                      progress=not args.no_progress, motions=motions)
     paths = write_report(study, output, data)
     print(summary(study), flush=True)
     print(f"results: {len(paths)} files in {output}", flush=True)

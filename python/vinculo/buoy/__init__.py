@@ -3,7 +3,9 @@
 - :mod:`vinculo.buoy.case`: the study's parameters (:class:`BuoyCase`), the frequency sweep
   (:class:`SweepSettings`) and reading both from a TOML file;
 - :mod:`vinculo.buoy.reference`: the reference models integrated with scipy (the rigid pendulum of
-  the study's eq. 31, corrected, and the string + sphere 2-DOF model) and the tank's motion;
+  the study's eq. 31, corrected, and the string + sphere 2-DOF model);
+- :mod:`vinculo.buoy.tank`: the tank's motion, harmonic or a measured displacement record read
+  from CSV and smoothed by a spline;
 - :mod:`vinculo.buoy.harmonic`: steady-state amplitude and phase by least squares over
   whole periods;
 - :mod:`vinculo.buoy.data`: reading measured amplitude and phase curves from CSV.
@@ -31,10 +33,15 @@ from vinculo.buoy.harmonic import (
 from vinculo.buoy.reference import (
     OneDofModel,
     ReferenceRun,
-    TankMotion,
     TwoDofModel,
     antiresonance_frequency,
     high_frequency_ratio,
+)
+from vinculo.buoy.tank import (
+    MOTION_COLUMNS,
+    MeasuredTankMotion,
+    TankMotion,
+    read_tank_motion,
     tank_motion,
 )
 
@@ -43,9 +50,11 @@ __all__ = [
     "ATTACHMENTS",
     "COLUMNS",
     "MOTIONS",
+    "MOTION_COLUMNS",
     "PHASE_CONVENTION",
     "BuoyCase",
     "HarmonicFit",
+    "MeasuredTankMotion",
     "Measurements",
     "OneDofModel",
     "ReferenceRun",
@@ -60,6 +69,7 @@ __all__ = [
     "load_study",
     "load_sweep",
     "read_measurements",
+    "read_tank_motion",
     "steady_response",
     "steady_window",
     "tank_motion",

@@ -24,7 +24,7 @@ import numpy as np
 
 import vinculo
 from vinculo.buoy.case import BuoyCase
-from vinculo.buoy.reference import tank_motion
+from vinculo.buoy.tank import MeasuredTankMotion, TankMotion, tank_motion
 
 __all__ = ["BuoyModel", "ParticleRun", "build_model", "run_particle_model"]
 
@@ -67,8 +67,7 @@ def tank_law(case: BuoyCase, frequency: float) -> vinculo.Law:
     Raises:
         InvalidInputError: the frequency is not finite and positive.
     """
-    motion = tank_motion(case, frequency)  # validates the frequency
-    return vinculo.sine(motion.amplitude, motion.frequency, ramp_time=motion.ramp_time)
+    return tank_motion(case, frequency).law()  # validates the frequency
 
 
 def build_model(
@@ -165,7 +164,7 @@ def run_particle_model(
     *,
     dt: float = 1e-3,
     save_every: int = 5,
-    tank: vinculo.Law | None = None,
+    tank: vinculo.Law | TankMotion | MeasuredTankMotion | None = None,
     progress: Any = None,
 ) -> ParticleRun:
     """Simulate the particle model at one frequency from rest.
@@ -176,14 +175,21 @@ def run_particle_model(
         t_end: duration (s).
         dt: time step (s).
         save_every: keep every k-th step.
-        tank: a tank displacement law to use instead of the harmonic one (measured motion).
+        tank: the tank's motion, instead of the harmonic one at ``frequency``: a core law of the
+            displacement, or a motion object such as a measured record
+            (:func:`vinculo.buoy.tank.read_tank_motion`), whose fit becomes the law.
         progress: passed to :func:`vinculo.simulate`.
 
     Returns:
         The :class:`ParticleRun`. A run stopped early by a negative string tension or a failed step
         keeps what it computed and carries the exception in ``error``.
     """
-    law = tank if tank is not None else tank_law(case, frequency)
+    if tank is None:
+        law = tank_law(case, frequency)
+    elif isinstance(tank, vinculo.Law):
+        law = tank
+    else:
+        law = tank.law()
     model = build_model(case, law)
     error: vinculo.VinculoError | None = None
     try:

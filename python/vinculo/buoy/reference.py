@@ -42,16 +42,15 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from vinculo.buoy.case import BuoyCase
+from vinculo.buoy.tank import MeasuredTankMotion, TankMotion, tank_motion
 from vinculo.errors import ConvergenceError, InvalidInputError
 
 __all__ = [
     "OneDofModel",
     "ReferenceRun",
-    "TankMotion",
     "TwoDofModel",
     "antiresonance_frequency",
     "high_frequency_ratio",
-    "tank_motion",
 ]
 
 #: Relative and absolute tolerances of the integration (angles in rad, rates in rad/s).
@@ -59,105 +58,6 @@ RTOL = 1e-9
 ATOL = 1e-11
 #: Largest integration step, as a fraction of the shortest period in the problem.
 STEP_FRACTION = 0.5
-
-
-@dataclass(frozen=True)
-class TankMotion:
-    """The displacement of the tank, ``X_t(t) = X0 s(t) sin(2 pi f t)``, with its derivatives.
-
-    ``s`` is the C2 quintic ramp ``10 u^3 - 15 u^4 + 6 u^5``, ``u = t / ramp_time`` clamped to
-    [0, 1]; ``ramp_time = 0`` gives ``s = 1`` (the abrupt start). Before ``t = 0`` the tank is at
-    rest when there is a ramp.
-
-    Arguments:
-        amplitude: X0, in m.
-        frequency: f, in Hz.
-        ramp_time: duration of the ramp, in s (0: none).
-    """
-
-    amplitude: float
-    frequency: float
-    ramp_time: float
-
-    def __call__(self, t: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Evaluate the motion at one time or an array of times.
-
-        Arguments:
-            t: time(s), in s.
-
-        Returns:
-            ``(X, X', X'')``, arrays of the shape of ``t``, in m, m/s and m/s^2 (exact derivatives
-            of the product ``X0 s(t) sin(2 pi f t)``).
-        """
-        t = np.asarray(t, dtype=np.float64)
-        omega = 2.0 * math.pi * self.frequency
-        sine, cosine = np.sin(omega * t), np.cos(omega * t)
-        if self.ramp_time > 0.0:
-            u = np.clip(t / self.ramp_time, 0.0, 1.0)
-            s = u**3 * (10.0 + u * (-15.0 + 6.0 * u))
-            s1 = 30.0 * u**2 * (1.0 - u) ** 2 / self.ramp_time
-            s2 = 60.0 * u * (1.0 - u) * (1.0 - 2.0 * u) / self.ramp_time**2
-        else:
-            s, s1, s2 = np.ones_like(t), np.zeros_like(t), np.zeros_like(t)
-        x0 = self.amplitude
-        position = x0 * s * sine
-        velocity = x0 * (s1 * sine + s * omega * cosine)
-        acceleration = x0 * (s2 * sine + 2.0 * s1 * omega * cosine - s * omega**2 * sine)
-        return position, velocity, acceleration
-
-    def at(self, t: float) -> tuple[float, float, float]:
-        """Scalar evaluation of ``(X, X', X'')`` at one time (fast path for the integrators).
-
-        Arguments:
-            t: time, in s.
-
-        Returns:
-            ``(X, X', X'')`` as floats, equal to ``self(t)``.
-        """
-        omega = 2.0 * math.pi * self.frequency
-        sine, cosine = math.sin(omega * t), math.cos(omega * t)
-        if self.ramp_time > 0.0:
-            u = min(max(t / self.ramp_time, 0.0), 1.0)
-            s = u**3 * (10.0 + u * (-15.0 + 6.0 * u))
-            s1 = 30.0 * u**2 * (1.0 - u) ** 2 / self.ramp_time
-            s2 = 60.0 * u * (1.0 - u) * (1.0 - 2.0 * u) / self.ramp_time**2
-        else:
-            s, s1, s2 = 1.0, 0.0, 0.0
-        x0 = self.amplitude
-        return (
-            x0 * s * sine,
-            x0 * (s1 * sine + s * omega * cosine),
-            x0 * (s2 * sine + 2.0 * s1 * omega * cosine - s * omega**2 * sine),
-        )
-
-
-def _check_frequency(frequency: float) -> float:
-    """Return ``frequency`` as a float, or raise if it is not finite and positive."""
-    value = float(frequency)
-    if not (math.isfinite(value) and value > 0.0):
-        raise InvalidInputError(
-            f"frequency must be a finite positive number of Hz, got {frequency!r}",
-            name="frequency",
-            value=frequency,
-        )
-    return value
-
-
-def tank_motion(case: BuoyCase, frequency: float) -> TankMotion:
-    """The tank's motion at ``frequency`` for ``case``: amplitude X0, ramp over ramp_periods.
-
-    Arguments:
-        case: the buoy case (``amplitude`` and ``ramp_periods`` are used).
-        frequency: excitation frequency, in Hz.
-
-    Returns:
-        A callable ``t -> (X, X', X'')``, vectorised over ``t``.
-
-    Raises:
-        InvalidInputError: if ``frequency`` is not finite and positive.
-    """
-    frequency = _check_frequency(frequency)
-    return TankMotion(case.amplitude, frequency, case.ramp_periods / frequency)
 
 
 _TANK_AT_REST = TankMotion(0.0, 1.0, 0.0)
@@ -272,6 +172,7 @@ class _PendulumModel:
         *,
         initial: Any = None,
         sample_dt: float = 1e-3,
+        tank: TankMotion | MeasuredTankMotion | None = None,
     ) -> ReferenceRun:
         """Integrate the model with the tank shaken at ``frequency`` from ``t = 0`` to ``t_end``.
 
@@ -286,18 +187,32 @@ class _PendulumModel:
                 abrupt start, the relative rates that cancel the tank's initial velocity).
             sample_dt: spacing of the stored samples, in s (samples at ``k * sample_dt``, plus
                 ``t_end``).
+            tank: a tank motion to use instead of the harmonic one at ``frequency``, such as a
+                measured record (:func:`vinculo.buoy.tank.read_tank_motion`); ``frequency`` is
+                then ignored and the run is labelled with the motion's frequency.
 
         Returns:
             The time history.
 
         Raises:
-            InvalidInputError: for a bad frequency, ``t_end``, ``sample_dt`` or ``initial``.
+            InvalidInputError: for a bad frequency, ``t_end``, ``sample_dt`` or ``initial``, or a
+                ``t_end`` beyond the end of a measured ``tank`` record.
             ConvergenceError: if the integrator fails.
         """
-        tank = _TANK_AT_REST if frequency is None else tank_motion(self.case, frequency)
+        if tank is None:
+            tank = _TANK_AT_REST if frequency is None else tank_motion(self.case, frequency)
+            frequency = None if frequency is None else tank.frequency
+        else:
+            frequency = tank.frequency
         if not (math.isfinite(t_end) and t_end > 0.0):
             raise InvalidInputError(
                 f"t_end must be a finite positive time in s, got {t_end!r}",
+                name="t_end",
+                value=t_end,
+            )
+        if t_end > tank.duration * (1.0 + 1e-12):
+            raise InvalidInputError(
+                f"t_end = {t_end!r} s goes beyond the tank motion record ({tank.duration:g} s)",
                 name="t_end",
                 value=t_end,
             )
@@ -325,7 +240,13 @@ class _PendulumModel:
         times[-1] = min(times[-1], t_end)
         period = self._shortest_period()
         if frequency is not None:
-            period = min(period, 1.0 / tank.frequency)
+            period = min(period, 1.0 / frequency)
+        max_step = STEP_FRACTION * period
+        knots = getattr(tank, "times", None)
+        if knots is not None:
+            # A measured motion's acceleration has a kink at every sample: steps that span one
+            # sample at most are not rejected at the kinks (about 9 times fewer evaluations).
+            max_step = min(max_step, float(np.max(np.diff(knots))))
         dof = self.dof
 
         def rhs(t: float, y: np.ndarray) -> list[float]:
@@ -341,7 +262,7 @@ class _PendulumModel:
             t_eval=times,
             rtol=RTOL,
             atol=ATOL,
-            max_step=STEP_FRACTION * period,
+            max_step=max_step,
         )
         if result.status != 0:
             raise ConvergenceError(
@@ -354,7 +275,7 @@ class _PendulumModel:
         _, x_rel, z_rel, tension = self._dynamics(angles.T, rates.T, a_tank, np)
         return ReferenceRun(
             model=self.name,
-            frequency=None if frequency is None else tank.frequency,
+            frequency=frequency,
             times=times,
             x_tank=x_tank,
             x_rel=x_rel,

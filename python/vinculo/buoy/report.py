@@ -20,6 +20,7 @@ _STYLE = {
     "two-dof": {"color": "C1", "marker": "", "linestyle": "--"},
     "one-dof": {"color": "C2", "marker": "", "linestyle": ":"},
 }
+_RECORD_MARKERS = {"particle": "o", "two-dof": "s", "one-dof": "^"}
 _FIELDS = [
     "tank_amplitude",
     "absolute_amplitude",
@@ -44,7 +45,22 @@ def summary(study: StudyResult) -> str:
         f"linear natural frequency: 1-DOF {OneDofModel(case).natural_frequency():.4f} Hz; "
         f"2-DOF {', '.join(f'{f:.4f}' for f in TwoDofModel(case).natural_frequencies())} Hz",
     ]
-    for model in MODELS:
+    records = sorted({(r.frequency, r.record) for r in study.results if r.record is not None})
+    if records:
+        lines[0] = lines[0].split(", X0 =")[0]
+        lines.append(
+            f"tank driven by {len(records)} measured record(s): "
+            + ", ".join(f"{name} ({f:.4f} Hz)" for f, name in records)
+        )
+        for r in study.results:
+            if r.response is not None:
+                lines.append(
+                    f"{LABELS[r.model]:48s} {r.record} at {r.frequency:.4f} Hz: tank "
+                    f"{r.response.tank_amplitude * 1e3:.3f} mm, relative amplitude "
+                    f"{r.response.relative_amplitude * 1e3:.3f} mm, phase "
+                    f"{r.response.relative_phase_deg:.1f} deg"
+                )
+    for model in MODELS if not records else ():
         runs = study.of(model)
         if not runs:
             continue
@@ -55,7 +71,8 @@ def summary(study: StudyResult) -> str:
             f"{peak * 1e3:.3f} mm ({peak / case.amplitude:.3f} X0); {ok}/{len(runs)} runs ok"
         )
     for r in study.failures():
-        lines.append(f"FAILED {r.model} at {r.frequency:g} Hz: {r.error}")
+        source = f" ({r.record})" if r.record else ""
+        lines.append(f"FAILED {r.model} at {r.frequency:g} Hz{source}: {r.error}")
     lines.append(f"{len(study.results)} runs in {study.elapsed:.1f} s on {study.workers} workers")
     return "\n".join(lines)
 
@@ -111,34 +128,36 @@ def _write_sweep(study: StudyResult, data: Measurements | None, path: Path) -> N
     with path.open("w", newline="") as f:
         w = csv.writer(f)
         w.writerow(
-            ["model", "frequency_hz", *_FIELDS, "window_start_s", "window_end_s", "error"]
+            ["model", "frequency_hz", *_FIELDS, "window_start_s", "window_end_s", "error",
+             "tank_record"]
         )
         for r in study.results:
+            record = r.record or ""
             if r.response is None:
-                w.writerow([r.model, r.frequency, *([""] * (len(_FIELDS) + 2)), r.error])
+                w.writerow([r.model, r.frequency, *([""] * (len(_FIELDS) + 2)), r.error, record])
                 continue
             values = [getattr(r.response, k) for k in _FIELDS]
-            w.writerow([r.model, r.frequency, *values, *r.response.window, ""])
+            w.writerow([r.model, r.frequency, *values, *r.response.window, "", record])
         if data is not None:
             for fr, amp, ph in zip(data.frequency, data.amplitude, data.phase_deg, strict=True):
                 row = dict.fromkeys(_FIELDS, "")
                 row[f"{data.motion}_amplitude"] = amp
                 row[f"{data.motion}_phase_deg"] = ph
-                w.writerow(["measured", fr, *row.values(), "", "", ""])
+                w.writerow(["measured", fr, *row.values(), "", "", "", ""])
 
 
 def _write_histories(study: StudyResult, path: Path) -> None:
     with path.open("w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["model", "frequency_hz", "time_s", "tank_m", "buoy_m", "relative_m",
-                    "tension_n"])
+                    "tension_n", "tank_record"])
         for r in study.results:
             if r.history is None:
                 continue
             h = r.history
             columns = (h["time"], h["tank"], h["buoy"], h["relative"], h["tension"])
             for row in zip(*columns, strict=True):
-                w.writerow([r.model, r.frequency, *(f"{x:.9g}" for x in row)])
+                w.writerow([r.model, r.frequency, *(f"{x:.9g}" for x in row), r.record or ""])
 
 
 def write_report(
@@ -149,8 +168,8 @@ def write_report(
     Files: ``parameters.csv`` (every parameter with its unit and source; assumptions marked),
     ``sweep.csv`` (amplitude and phase of every model at every frequency, fit windows, errors, and
     the measurements if given), ``histories.csv`` (the kept time histories),
-    ``history_<f>Hz.png`` (figs. 11-13), ``amplitude.png`` (fig. 14), ``phase.png`` (fig. 15),
-    ``summary.txt``.
+    ``history_<f>Hz.png`` (figs. 11-13; ``history_<record>.png`` for a measured tank record),
+    ``amplitude.png`` (fig. 14), ``phase.png`` (fig. 15), ``summary.txt``.
 
     Arguments:
         study: the result of :func:`vinculo.buoy.study.run_study`.
@@ -175,13 +194,14 @@ def write_report(
         writer(output / name)
         written.append(output / name)
     x0_mm = study.case.amplitude * 1e3
+    measured_tank = any(r.record is not None for r in study.results)
 
-    # Figs. 11-13: time histories.
-    by_frequency: dict[float, list] = {}
+    # Figs. 11-13: time histories, one figure per frequency (or per measured record).
+    by_excitation: dict[tuple[float, str], list] = {}
     for r in study.results:
         if r.history is not None:
-            by_frequency.setdefault(round(r.frequency, 9), []).append(r)
-    for f, runs in sorted(by_frequency.items()):
+            by_excitation.setdefault((round(r.frequency, 9), r.record or ""), []).append(r)
+    for (f, record), runs in sorted(by_excitation.items()):
         fig, ax = plt.subplots(figsize=(9, 4))
         first = runs[0].history
         ax.plot(first["time"], first["tank"] * 1e3, color="0.5", lw=1.0, label="tank")
@@ -191,10 +211,14 @@ def write_report(
                     label=f"buoy: {LABELS[r.model]}" + (" (FAILED)" if r.error else ""))
         ax.set_xlabel("time (s)")
         ax.set_ylabel("horizontal displacement (mm)")
-        ax.set_title(f"buoy and tank displacement at {f:g} Hz (X0 = {x0_mm:g} mm, assumed)")
+        if record:
+            ax.set_title(f"buoy and tank displacement, tank record {record} ({f:.4g} Hz)")
+            path = output / f"history_{Path(record).stem}.png"
+        else:
+            ax.set_title(f"buoy and tank displacement at {f:g} Hz (X0 = {x0_mm:g} mm, assumed)")
+            path = output / f"history_{f:.2f}Hz.png"
         ax.legend(fontsize=8, loc="upper right")
         ax.grid(alpha=0.3)
-        path = output / f"history_{f:.2f}Hz.png"
         fig.tight_layout()
         fig.savefig(path, dpi=120)
         plt.close(fig)
@@ -209,7 +233,10 @@ def write_report(
             for model in MODELS:
                 f, y = study.curve(model, quantity)
                 if len(f):
-                    ax.plot(f, y * scale, label=LABELS[model], **_STYLE[model], ms=4)
+                    style = dict(_STYLE[model])
+                    if measured_tank:  # a few scattered records: mark every point
+                        style["marker"] = style["marker"] or _RECORD_MARKERS[model]
+                    ax.plot(f, y * scale, label=LABELS[model], **style, ms=4)
             if data is not None and data.motion == motion:
                 y = data.amplitude * 1e3 if kind == "amplitude" else data.phase_deg
                 ax.plot(data.frequency, y, "ks", ms=5, label=LABELS["measured"])
@@ -219,8 +246,9 @@ def write_report(
             ax.grid(alpha=0.3)
             ax.legend(fontsize=8)
         axes[-1].set_xlabel("excitation frequency (Hz)")
+        tank = "measured tank records" if measured_tank else f"X0 = {x0_mm:g} mm, assumed"
         title = (
-            f"amplitude of the buoy's horizontal displacement (X0 = {x0_mm:g} mm, assumed)"
+            f"amplitude of the buoy's horizontal displacement ({tank})"
             if kind == "amplitude"
             else f"phase: {PHASE_CONVENTION}"
         )

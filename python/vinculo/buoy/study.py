@@ -5,6 +5,10 @@ fit the steady-state amplitude and phase over the last ``fit_periods`` whole per
 (:func:`vinculo.buoy.harmonic.steady_response`). Tasks run in worker processes (the particle model
 releases the GIL, the scipy reference models do not, so processes serve both); a task that fails
 is recorded with its error and the others go on.
+
+Driven by measured tank records instead (``run_study(..., motions=[...])``, ``vinculo buoy
+--tank-motion FILE.csv``), each record is one excitation: every model runs over the whole record
+and is fitted over its last ``fit_periods`` periods at the record's frequency.
 """
 
 from __future__ import annotations
@@ -26,6 +30,7 @@ from vinculo.buoy.case import BuoyCase, SweepSettings
 from vinculo.buoy.harmonic import SteadyResponse, steady_response
 from vinculo.buoy.model import run_particle_model
 from vinculo.buoy.reference import OneDofModel, TwoDofModel
+from vinculo.buoy.tank import MeasuredTankMotion
 from vinculo.errors import InvalidInputError, VinculoError
 
 __all__ = ["MODELS", "ModelResult", "StudyResult", "run_study", "run_task"]
@@ -55,6 +60,8 @@ class ModelResult:
         history: time histories (``time``, ``tank``, ``buoy``, ``relative``, ``tension``) when
             kept, else None. A failed run keeps what it computed.
         elapsed: wall time of the task (s).
+        record: the measured tank record that drove the run (its file name), or None for the
+            harmonic excitation.
     """
 
     model: str
@@ -63,6 +70,7 @@ class ModelResult:
     error: str | None = None
     history: dict[str, np.ndarray] | None = None
     elapsed: float = 0.0
+    record: str | None = None
 
 
 def _check_model(model: str, name: str) -> None:
@@ -79,6 +87,7 @@ def run_task(
     model: str,
     frequency: float,
     keep_history: bool = False,
+    motion: MeasuredTankMotion | None = None,
 ) -> ModelResult:
     """Simulate ``model`` at ``frequency`` and fit its steady state.
 
@@ -86,8 +95,10 @@ def run_task(
         case: the study's parameters.
         settings: the sweep settings (step, periods).
         model: one of :data:`MODELS`.
-        frequency: in Hz.
+        frequency: in Hz (ignored when ``motion`` is given).
         keep_history: keep the time histories in the result.
+        motion: a measured tank record to drive the run instead of the harmonic shake; the run
+            covers the whole record and is fitted at the record's frequency.
 
     Returns:
         The :class:`ModelResult`; a vinculo error during the run is caught and recorded.
@@ -97,11 +108,17 @@ def run_task(
     """
     _check_model(model, "model")
     started = time.perf_counter()
-    t_end = settings.t_end(frequency)
+    record = None if motion is None else motion.source
+    if motion is None:
+        t_end = settings.t_end(frequency)
+    else:
+        frequency, t_end = motion.frequency, motion.duration
     error: str | None = None
     try:
         if model == "particle":
-            run = run_particle_model(case, frequency, t_end, dt=settings.dt, save_every=2)
+            run = run_particle_model(
+                case, frequency, t_end, dt=settings.dt, save_every=2, tank=motion
+            )
             history = {
                 "time": run.time,
                 "tank": run.tank,
@@ -113,7 +130,7 @@ def run_task(
                 error = f"{type(run.error).__name__}: {run.error}"
         else:
             reference = TwoDofModel(case) if model == "two-dof" else OneDofModel(case)
-            ref = reference.simulate(frequency, t_end, sample_dt=2.0 * settings.dt)
+            ref = reference.simulate(frequency, t_end, sample_dt=2.0 * settings.dt, tank=motion)
             history = {
                 "time": ref.times,
                 "tank": ref.x_tank,
@@ -124,7 +141,7 @@ def run_task(
     except VinculoError as e:
         return ModelResult(
             model, frequency, None, f"{type(e).__name__}: {e}", None,
-            time.perf_counter() - started,
+            time.perf_counter() - started, record,
         )
     response = None
     if error is None:
@@ -138,6 +155,7 @@ def run_task(
         error,
         history if (keep_history or error is not None) else None,
         time.perf_counter() - started,
+        record,
     )
 
 
@@ -218,8 +236,13 @@ def run_study(
     workers: int | None = None,
     progress: bool | Callable[[int, int, ModelResult], None] = True,
     stream: IO[str] | None = None,
+    motions: Sequence[MeasuredTankMotion] = (),
 ) -> StudyResult:
     """Run every model at every frequency of the sweep (and at the history frequencies).
+
+    With measured tank records (``motions``), every model runs once per record instead, over the
+    whole record, and every record's time histories are kept; the sweep's frequencies are not
+    used.
 
     Arguments:
         case: the study's parameters.
@@ -231,12 +254,15 @@ def run_study(
         progress: True draws a progress bar on ``stream`` (standard error); a callable is called
             as ``progress(done, total, result)`` after each task.
         stream: where the bar is drawn.
+        motions: measured tank records (:func:`vinculo.buoy.tank.read_tank_motion`) to drive
+            the models instead of the harmonic sweep.
 
     Returns:
         The :class:`StudyResult`; failed runs are in it with their errors.
 
     Raises:
-        InvalidInputError: an unknown model or a bad worker count.
+        InvalidInputError: an unknown model, a bad worker count, or a record shorter than the
+            fit window (``fit_periods`` periods of its frequency).
     """
     for m in models:
         _check_model(m, "models")
@@ -245,12 +271,19 @@ def run_study(
         raise InvalidInputError(
             f"workers must be an integer >= 1, got {workers!r}", name="workers", value=workers
         )
-    sweep = [float(f) for f in settings.frequencies]
-    extra = [f for f in history_frequencies if not any(abs(f - g) < 1e-9 for g in sweep)]
-    frequencies = sorted(sweep + [float(f) for f in extra])
-    keep = {f for f in frequencies if any(abs(f - h) < 1e-9 for h in history_frequencies)}
-    tasks = [(m, f, f in keep) for m in models for f in frequencies]
-    tasks.sort(key=lambda x: -_cost(x[0], x[1]))
+    tasks: list[tuple[str, float, bool, MeasuredTankMotion | None]]
+    if motions:
+        for motion in motions:
+            _check_record(motion, settings)
+        tasks = [(m, motion.frequency, True, motion) for m in models for motion in motions]
+        tasks.sort(key=lambda x: -(x[3].duration if x[3] else 0.0))
+    else:
+        sweep = [float(f) for f in settings.frequencies]
+        extra = [f for f in history_frequencies if not any(abs(f - g) < 1e-9 for g in sweep)]
+        frequencies = sorted(sweep + [float(f) for f in extra])
+        keep = {f for f in frequencies if any(abs(f - h) < 1e-9 for h in history_frequencies)}
+        tasks = [(m, f, f in keep, None) for m in models for f in frequencies]
+        tasks.sort(key=lambda x: -_cost(x[0], x[1]))
     stream = stream if stream is not None else sys.stderr
     started = time.perf_counter()
     results: list[ModelResult] = []
@@ -264,8 +297,8 @@ def run_study(
 
     try:
         if workers == 1:
-            for m, f, k in tasks:
-                report(run_task(case, settings, m, f, k))
+            for m, f, k, motion in tasks:
+                report(run_task(case, settings, m, f, k, motion))
         else:
             # fork starts workers at once and needs no __main__ guard in the user's script; other
             # platforms spawn (scripts then need `if __name__ == "__main__":`).
@@ -273,21 +306,37 @@ def run_study(
             context = multiprocessing.get_context(method)
             with ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
                 futures = {
-                    pool.submit(run_task, case, settings, m, f, k): (m, f) for m, f, k in tasks
+                    pool.submit(run_task, case, settings, m, f, k, motion): (m, f, motion)
+                    for m, f, k, motion in tasks
                 }
                 for future in as_completed(futures):
-                    m, f = futures[future]
+                    m, f, motion = futures[future]
                     try:
                         report(future.result())
                     except (BrokenProcessPool, OSError) as e:  # a worker died: record, go on
-                        report(ModelResult(m, f, None, f"{type(e).__name__}: {e}"))
+                        record = None if motion is None else motion.source
+                        report(ModelResult(m, f, None, f"{type(e).__name__}: {e}", record=record))
     finally:
         if progress is True and results:
             stream.write("\n")
             stream.flush()
     order = {m: i for i, m in enumerate(MODELS)}
-    results.sort(key=lambda r: (order[r.model], r.frequency))
+    results.sort(key=lambda r: (order[r.model], r.frequency, r.record or ""))
     return StudyResult(case, settings, results, time.perf_counter() - started, workers)
+
+
+def _check_record(motion: MeasuredTankMotion, settings: SweepSettings) -> None:
+    """Raise unless ``motion`` is long enough for the fit window at its frequency."""
+    needed = settings.fit_periods / motion.frequency
+    if motion.duration < needed:
+        raise InvalidInputError(
+            f"{motion.source}: the record lasts {motion.duration:g} s, shorter than the fit "
+            f"window of {settings.fit_periods} periods at {motion.frequency:.4g} Hz "
+            f"({needed:g} s); give a longer record (the transient must also die out before the "
+            f"window) or fewer fit periods",
+            name="tank_motion",
+            value=motion.source,
+        )
 
 
 def _draw(stream: IO[str], done: int, total: int, result: ModelResult, elapsed: float) -> None:

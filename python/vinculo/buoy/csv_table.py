@@ -1,0 +1,165 @@
+"""Reading a small numeric CSV table with named columns, for the user's measurement files.
+
+The format shared by the files of :mod:`vinculo.buoy.data` and :mod:`vinculo.buoy.tank`: one row
+of comma-separated numbers per sample; an optional header row naming the columns (any order, any
+letter case, a unit in parentheses or brackets allowed, as in ``time (s)``; other columns are
+ignored); without a header the required columns come in their stated order. Anything after ``#``
+on a line is a comment, and blank lines are skipped. Every error names the file and, where there
+is one, the line (1-based), and quotes it.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from vinculo.errors import InvalidInputError
+
+__all__ = ["Table", "read_table", "table_error"]
+
+_UNIT = re.compile(r"\s*[\(\[].*[\)\]]\s*$")
+
+
+@dataclass(frozen=True)
+class Table:
+    """The numbers of a CSV table.
+
+    Attributes:
+        values: one row per data line, one column per required column, shape (n, k).
+        lines: the 1-based line number of each row, shape (n,).
+        texts: the text of each data line (stripped), for messages that quote it.
+        path: the file read.
+        name: the ``name`` given to errors about it.
+    """
+
+    values: np.ndarray
+    lines: np.ndarray
+    texts: list[str]
+    path: Path
+    name: str = "data"
+
+    def error(self, row: int, message: str) -> InvalidInputError:
+        """An error about data row ``row`` (0-based), naming its line and quoting it."""
+        return table_error(
+            f"{message}: {self.texts[row]!r}", self.path, int(self.lines[row]), self.name
+        )
+
+
+def table_error(
+    message: str, path: Path, line: int | None, name: str = "data"
+) -> InvalidInputError:
+    """An error about a data file, naming it (and the line, when there is one)."""
+    where = f"{path}, line {line}" if line is not None else str(path)
+    return InvalidInputError(f"{where}: {message}", name=name, path=str(path), line=line)
+
+
+def _column_name(field: str) -> str:
+    """A header field without its unit and case: ``"Frequency (Hz)"`` -> ``"frequency"``."""
+    return _UNIT.sub("", field).strip().lower()
+
+
+def _is_number(field: str) -> bool:
+    """Whether a field parses as a float (NaN and infinity included: they are numbers here)."""
+    try:
+        float(field)
+    except ValueError:
+        return False
+    return True
+
+
+def read_table(
+    path: str | Path, columns: tuple[str, ...], *, what: str, name: str = "data"
+) -> Table:
+    """Read the required ``columns`` of a CSV file (format in the module docstring).
+
+    Arguments:
+        path: the CSV file.
+        columns: the required column names, in their order for a file without a header.
+        what: what the file is, for messages (``"measurement file"``).
+        name: the ``name`` of the errors raised (the option or argument that gave the file).
+
+    Returns:
+        The :class:`Table` (finite numbers only).
+
+    Raises:
+        InvalidInputError: (with ``path`` and ``line``) if the file is missing or unreadable, a
+            header lacks a required column, a row has the wrong number of fields or a value that
+            is not a finite number, or there is no data row.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except FileNotFoundError:
+        raise table_error(f"no such {what}; check the path", path, None, name) from None
+    except (OSError, UnicodeDecodeError) as error:
+        reason = getattr(error, "strerror", None) or str(error)
+        raise table_error(f"cannot read the {what}: {reason}", path, None, name) from None
+
+    indices: dict[str, int] | None = None
+    width = len(columns)
+    rows: list[list[float]] = []
+    lines: list[int] = []
+    texts: list[str] = []
+    for number, raw in enumerate(text.splitlines(), start=1):
+        content = raw.split("#", 1)[0]
+        if not content.strip():
+            continue
+        fields = [field.strip() for field in next(csv.reader([content]))]
+        if indices is None and not rows and not all(_is_number(field) for field in fields):
+            names = [_column_name(field) for field in fields]
+            missing = [c for c in columns if c not in names]
+            if missing and any(_is_number(field) for field in fields):
+                bad = next(field for field in fields if not _is_number(field))
+                raise table_error(
+                    f"{bad!r} is not a number, and the line is no header (it lacks the "
+                    f"column(s) {', '.join(missing)}): {raw.strip()!r}",
+                    path, number, name,
+                )
+            if missing:
+                raise table_error(
+                    f"the header {raw.strip()!r} lacks the column(s) {', '.join(missing)}; name "
+                    f"the columns {', '.join(columns)} (any order), or drop the header and give "
+                    f"the {len(columns)} columns in that order",
+                    path, number, name,
+                )
+            indices = {c: names.index(c) for c in columns}
+            width = len(fields)
+            continue
+        if len(fields) != width:
+            raise table_error(
+                f"expected {width} comma-separated fields, found {len(fields)}: {raw.strip()!r}",
+                path, number, name,
+            )
+        order = indices or {c: k for k, c in enumerate(columns)}
+        values = []
+        for column in columns:
+            field = fields[order[column]]
+            try:
+                value = float(field)
+            except ValueError:
+                raise table_error(
+                    f"{column} {field!r} is not a number: {raw.strip()!r}", path, number, name
+                ) from None
+            if not math.isfinite(value):
+                raise table_error(
+                    f"{column} {field!r} is not a finite number: {raw.strip()!r}",
+                    path, number, name,
+                )
+            values.append(value)
+        rows.append(values)
+        lines.append(number)
+        texts.append(raw.strip())
+    if not rows:
+        raise table_error(
+            f"no data rows (only blank lines, comments or a header); add rows of "
+            f"{', '.join(columns)}",
+            path, None, name,
+        )
+    return Table(
+        np.array(rows, dtype=np.float64), np.array(lines, dtype=np.int64), texts, path, name
+    )
