@@ -1,22 +1,61 @@
 """Smoke run of the benchmark command (the full comparison is not part of the test suite)."""
 
 import numpy as np
+import pytest
 
 from vinculo.bench import __main__ as bench
 from vinculo.bench import scaling
+from vinculo.bench.buoy import (
+    CENTRE_TOLERANCE,
+    BuoyBench,
+    model_topology,
+    run_exudyn_buoy,
+    run_vinculo_buoy,
+)
 from vinculo.bench.models import Chain
 from vinculo.bench.runner import run_vinculo
+from vinculo.buoy.model import run_particle_model
+
+# A short buoy run: 2 s of the ramped start at 0.9 Hz (the centre has moved by about 0.1 mm).
+SHORT_BUOY = BuoyBench(name="buoy, 2 s", t_end=2.0)
 
 
 def test_comparison_without_exudyn_says_so_and_runs_vinculo(monkeypatch):
     monkeypatch.setattr(bench, "_import_exudyn", lambda: None)
     monkeypatch.setattr(bench, "comparison_models", lambda quick: [Chain("hanging N = 10", 10)])
+    monkeypatch.setattr(bench, "buoy_bench", lambda quick: SHORT_BUOY)
     lines = []
     assert bench.compare(quick=True, repeat=1, out=lines.append)
     text = "\n".join(lines)
     assert "Exudyn is not installed" in text
-    assert "buoy model: not available yet" in text
     assert "1 m chain N = 300" in text and "tree elimination" in text
+    row = next(line for line in lines if line.startswith("buoy, 2 s"))
+    assert "(no Exudyn)" in row and "dense LU" in row
+
+
+def test_buoy_row_is_the_case_study_model():
+    # The benchmark's buoy is the particle model of the study: same centre at t_end as the
+    # study's own runner for the same case, frequency and step.
+    run = run_vinculo_buoy(SHORT_BUOY)
+    study = run_particle_model(SHORT_BUOY.case, SHORT_BUOY.frequency, SHORT_BUOY.t_end, dt=1e-3)
+    assert study.error is None
+    np.testing.assert_allclose(run.tip[[0, 2]], [study.buoy[-1], study.height[-1]], atol=1e-14)
+    assert abs(run.tip[0]) > 1e-5  # the tank has moved the buoy
+
+
+def test_buoy_topology_is_read_back_from_the_system():
+    links, attachment, string = model_topology(SHORT_BUOY.build().system)
+    assert len(links) == 15 and attachment == 6
+    assert string == pytest.approx(0.16)
+
+
+def test_buoy_in_exudyn_agrees_with_vinculo():
+    exu = pytest.importorskip("exudyn")
+    mine = run_vinculo_buoy(SHORT_BUOY)
+    peer = run_exudyn_buoy(SHORT_BUOY, exu)
+    assert peer.tip is not None, peer.detail
+    assert abs(mine.tip[0] - peer.tip[0]) <= CENTRE_TOLERANCE
+    assert abs(mine.tip[0]) > 10 * CENTRE_TOLERANCE  # the check is not trivially met at rest
 
 
 def test_hanging_chain_stays_at_rest_and_scaling_reports_memory():

@@ -90,7 +90,7 @@ def build_exudyn(model: Chain, exu):
     node = ground
     for p in model.positions():
         node = mbs.AddNode(NodePoint(referenceCoordinates=[float(x) for x in p]))
-        mbs.AddObject(MassPoint(physicsMass=model.mass, nodeNumber=node))
+        mbs.AddObject(MassPoint(mass=model.mass, nodeNumber=node))
         marker = mbs.AddMarker(MarkerNodePosition(nodeNumber=node))
         mbs.AddObject(DistanceConstraint(markerNumbers=[prev, marker], distance=model.link))
         mbs.AddLoad(Force(markerNumber=marker, loadVector=[0.0, 0.0, -model.mass * GRAVITY]))
@@ -107,6 +107,12 @@ def exudyn_settings(model: Chain, exu, dense: bool = False):
     on the pendulum and on swinging chains, and 0.99 fails on swinging chains too), its
     default Newton tolerances (relative 1e-8, absolute 1e-10) and modified Newton, no
     automatic step size, sparse (or dense) LU, no output written.
+
+    Arguments:
+        model: the run, anything with ``steps``, ``t_end`` and ``dt`` (a :class:`Chain` or a
+            :class:`vinculo.bench.buoy.BuoyBench`).
+        exu: the ``exudyn`` module.
+        dense: Exudyn's dense LU instead of its sparse one.
     """
     ss = exu.SimulationSettings()
     ti = ss.timeIntegration
@@ -117,10 +123,10 @@ def exudyn_settings(model: Chain, exu, dense: bool = False):
     ti.generalizedAlpha.spectralRadius = 0.9
     ti.generalizedAlpha.useIndex2Constraints = False
     ti.generalizedAlpha.useNewmark = False
-    ss.linearSolverType = (
+    ss.linearSolver.solverType = (
         exu.LinearSolverType.EigenDense if dense else exu.LinearSolverType.EigenSparse
     )
-    ss.solutionSettings.writeSolutionToFile = False
-    ss.displayStatistics = False
-    ss.displayComputationTime = False
+    ss.solution.file.write = False
+    ss.show.statistics = False
+    ss.show.computationTime = False
     return ss
