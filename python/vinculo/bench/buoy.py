@@ -74,11 +74,6 @@ class BuoyBench:
         """Number of steps of the run."""
         return round(self.t_end / self.dt)
 
-    @property
-    def n(self) -> int:
-        """Number of particles (for the size-dependent choices of the runners)."""
-        return 7
-
     def build(self) -> BuoyModel:
         """The vinculo particle model, the tank driven harmonically with the case's ramp."""
         return build_model(self.case, tank_law(self.case, self.frequency))
