@@ -64,6 +64,7 @@ def simulate(
     initial_tolerance: float = 1e-8,
     save_every: int = 1,
     progress: bool | ProgressCallback = False,
+    jacobian_reuse: bool = False,
 ) -> Solution:
     """Integrate a constrained system from ``t_start`` to ``t_end``.
 
@@ -91,6 +92,12 @@ def simulate(
             models need it to keep the output in memory.
         progress: True draws a progress bar on standard error; a callable is called as
             ``progress(t, t_end)`` about twice a second of wall time.
+        jacobian_reuse: modified Newton: keep the factorised iteration matrix across iterations
+            and steps, refreshing it when the Newton increments shrink by less than half per
+            iteration, after 8 iterations with one matrix, and whenever the step size changes (a
+            step that fails with an old matrix is retried once with a fresh one). The converged
+            states are the same to the Newton tolerance; ``Solution.factorisations`` counts the
+            factorisations. False: full Newton (a new matrix every iteration).
 
     Returns:
         The :class:`Solution`.
@@ -131,6 +138,7 @@ def simulate(
             initial_tolerance=initial_tolerance,
             save_every=save_every,
             progress=callback,
+            jacobian_reuse=bool(jacobian_reuse),
         )
     finally:
         if bar is not None:

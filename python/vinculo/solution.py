@@ -59,6 +59,8 @@ class Solution:
         linear_solver: the linear solver the run used: 'dense LU' (small systems),
             'tree elimination' (tree-shaped constraint graphs: chains, ropes, branched strings)
             or 'sparse LU' (graphs with loops).
+        factorisations: number of Newton iteration matrices factorised over the run (one per
+            Newton iteration in full Newton, fewer with ``jacobian_reuse=True``).
     """
 
     times: np.ndarray
@@ -73,6 +75,7 @@ class Solution:
     error: dict[str, Any] | None
     system: System
     linear_solver: str = ""
+    factorisations: int = 0
 
     @classmethod
     def from_core(cls, data: dict[str, Any], system: System) -> Solution:
@@ -95,6 +98,7 @@ class Solution:
             error=dict(error) if error is not None else None,
             system=system,
             linear_solver=str(data.get("linear_solver", "")),
+            factorisations=int(data.get("factorisations", 0)),
         )
 
     @property

@@ -42,7 +42,8 @@ impl Observer for Progress {
 /// Integrates the system; see the type stubs (`_core.pyi`) for the returned dictionary.
 #[pyfunction]
 #[pyo3(signature = (system, t_end, dt, alpha=0.5, t_start=0.0, tolerance=1e-10, max_iterations=25,
-                    max_halvings=4, initial_tolerance=1e-8, save_every=1, progress=None))]
+                    max_halvings=4, initial_tolerance=1e-8, save_every=1, progress=None,
+                    jacobian_reuse=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
@@ -57,6 +58,7 @@ pub fn simulate<'py>(
     initial_tolerance: f64,
     save_every: i64,
     progress: Option<Py<PyAny>>,
+    jacobian_reuse: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let count = |name: &str, v: i64, min: i64| -> PyResult<usize> {
         if v < min {
@@ -73,6 +75,7 @@ pub fn simulate<'py>(
         newton: NewtonOptions {
             tolerance,
             max_iterations: count("max_iterations", max_iterations, 1)?,
+            jacobian_reuse,
         },
         max_halvings: count("max_halvings", max_halvings, 0)?,
         initial_tolerance,
@@ -136,6 +139,7 @@ pub fn simulate<'py>(
     )?;
     out.set_item("steps_taken", sol.steps_taken)?;
     out.set_item("steps_rejected", sol.steps_rejected)?;
+    out.set_item("factorisations", sol.factorisations)?;
     out.set_item("linear_solver", sol.linear_solver)?;
     match &sol.status {
         Ok(()) => out.set_item("error", py.None())?,

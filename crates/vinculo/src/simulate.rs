@@ -263,6 +263,7 @@ pub fn simulate_with_observer(
     let mut t = t0;
     let mut step = 0usize;
     let mut q_new: Vec<Vec3> = q.clone();
+    let mut fresh_retry = false;
     while t < options.t_end {
         let h_nominal = unit * (1u64 << level) as f64;
         let remaining = options.t_end - t;
@@ -275,8 +276,16 @@ pub fn simulate_with_observer(
             }
         }
         ws.state.lambda.copy_from_slice(&lambda);
-        sol.steps_taken += 1;
-        match scheme.step(system, &mut ws, t, &q, &v, h_try, &newton) {
+        if !fresh_retry {
+            sol.steps_taken += 1;
+        }
+        // Modified Newton starting from a matrix of an earlier step gets one more attempt with a
+        // fresh matrix before the step counts as failed.
+        let stale = newton.jacobian_reuse && ws.matrix.holds(scheme.matrix_key(h_try));
+        let attempt = scheme.step(system, &mut ws, t, &q, &v, h_try, &newton);
+        sol.factorisations = ws.matrix.factorisations;
+        fresh_retry = false;
+        match attempt {
             Ok(report) => {
                 for i in 0..q.len() {
                     for k in 0..3 {
@@ -314,6 +323,10 @@ pub fn simulate_with_observer(
                     sol.status = Err(Error::Interrupted { t });
                     break;
                 }
+            }
+            Err(_) if stale => {
+                ws.matrix.invalidate();
+                fresh_retry = true;
             }
             Err(failure) => {
                 sol.steps_rejected += 1;

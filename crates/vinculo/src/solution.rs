@@ -39,6 +39,9 @@ pub struct Solution {
     pub steps_taken: usize,
     /// Steps rejected because Newton failed (then retried with half the step).
     pub steps_rejected: usize,
+    /// Factorisations of Newton iteration matrices (one per iteration in full Newton; fewer with
+    /// [`NewtonOptions::jacobian_reuse`](crate::integrators::NewtonOptions::jacobian_reuse)).
+    pub factorisations: usize,
     /// Name of the linear solver used.
     pub linear_solver: &'static str,
     /// `Ok` when the run reached its end; otherwise the error that stopped it (the arrays hold
@@ -60,6 +63,7 @@ impl Solution {
             stats: Vec::new(),
             steps_taken: 0,
             steps_rejected: 0,
+            factorisations: 0,
             linear_solver,
             status: Ok(()),
         }

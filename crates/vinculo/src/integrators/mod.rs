@@ -4,5 +4,7 @@
 pub mod newton;
 mod trapezoidal;
 
-pub use newton::{NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport};
+pub use newton::{
+    IterationMatrix, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport,
+};
 pub use trapezoidal::{GeneralizedTrapezoidal, StepProblem, StepWorkspace};

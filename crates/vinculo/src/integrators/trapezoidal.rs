@@ -23,7 +23,9 @@
 //! solved for in the unit lambda_k sigma / s_k. The scaled matrix is
 //! `[M/m_ref + O(h^2), -s G^T; s G, 0]`, and every scaled residual and increment is a length.
 
-use super::newton::{self, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport};
+use super::newton::{
+    self, IterationMatrix, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport,
+};
 use crate::assembly::{add, add_block, Layout, NONE};
 use crate::forces::Jacobian;
 use crate::linear::{for_layout, LinearSolver, SparseSolver, TreeElimination};
@@ -47,6 +49,8 @@ pub struct StepWorkspace {
     pub layout: Layout,
     /// The factorisation of the iteration matrix.
     pub solver: Box<dyn LinearSolver>,
+    /// What that factorisation is (for modified Newton) and how many were made.
+    pub matrix: IterationMatrix,
     /// Matrix values in pattern order.
     pub values: Vec<f64>,
     /// Residual / increment.
@@ -119,6 +123,7 @@ impl StepWorkspace {
             values: vec![0.0; layout.pattern.nnz()],
             r: vec![0.0; layout.unknowns()],
             solver,
+            matrix: IterationMatrix::default(),
             state: StepBuffers {
                 q: vec![[0.0; 3]; n],
                 v: vec![[0.0; 3]; n],
@@ -297,6 +302,11 @@ impl GeneralizedTrapezoidal {
         }
     }
 
+    /// What identifies the iteration matrix of a step of size `h` (for its reuse).
+    pub fn matrix_key(&self, h: f64) -> [f64; 2] {
+        [h, self.alpha]
+    }
+
     /// Takes one step of size `h` from (t_n, q_n, v_n). The caller sets the predictor in
     /// `ws.state.q` and `ws.state.lambda`; on success they hold q_{n+1}, lambda and `ws.state.v`
     /// holds v_{n+1}.
@@ -325,13 +335,13 @@ impl GeneralizedTrapezoidal {
             alpha: self.alpha,
             sigma,
         };
-        let report = newton::solve(
-            &mut problem,
-            ws.solver.as_mut(),
-            &mut ws.values,
-            &mut ws.r,
-            options,
-        )?;
+        let work = LinearWork {
+            solver: ws.solver.as_mut(),
+            values: &mut ws.values,
+            r: &mut ws.r,
+            matrix: &mut ws.matrix,
+        };
+        let report = newton::solve(&mut problem, work, self.matrix_key(h), options)?;
         problem.kinematics();
         Ok(report)
     }
