@@ -61,6 +61,7 @@ class Solution:
             or 'sparse LU' (graphs with loops).
         factorisations: number of Newton iteration matrices factorised over the run (one per
             Newton iteration in full Newton, fewer with ``jacobian_reuse=True``).
+        scheme: the time discretisation: 'trapezoidal', 'backward-euler' or 'generalized-alpha'.
     """
 
     times: np.ndarray
@@ -76,6 +77,7 @@ class Solution:
     system: System
     linear_solver: str = ""
     factorisations: int = 0
+    scheme: str = ""
 
     @classmethod
     def from_core(cls, data: dict[str, Any], system: System) -> Solution:
@@ -99,6 +101,7 @@ class Solution:
             system=system,
             linear_solver=str(data.get("linear_solver", "")),
             factorisations=int(data.get("factorisations", 0)),
+            scheme=str(data.get("scheme", "")),
         )
 
     @property

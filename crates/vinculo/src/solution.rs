@@ -1,6 +1,7 @@
 //! What a run returns: stored states, multipliers, constraint health and per-step statistics.
 
 use crate::error::Error;
+use crate::integrators::Scheme;
 
 /// Statistics of one stored step.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -42,6 +43,8 @@ pub struct Solution {
     /// Factorisations of Newton iteration matrices (one per iteration in full Newton; fewer with
     /// [`NewtonOptions::jacobian_reuse`](crate::integrators::NewtonOptions::jacobian_reuse)).
     pub factorisations: usize,
+    /// The time discretisation used ([`Scheme::name`] names it).
+    pub scheme: Scheme,
     /// Name of the linear solver used.
     pub linear_solver: &'static str,
     /// `Ok` when the run reached its end; otherwise the error that stopped it (the arrays hold
@@ -64,6 +67,7 @@ impl Solution {
             steps_taken: 0,
             steps_rejected: 0,
             factorisations: 0,
+            scheme: Scheme::default(),
             linear_solver,
             status: Ok(()),
         }
