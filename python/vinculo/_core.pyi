@@ -145,6 +145,7 @@ def simulate(system: System, t_end: float, dt: float, alpha: float | None = None
     """Integrate; returns a dict of numpy arrays:
     times (s,), positions (s, n, 3), velocities (s, n, 3), multipliers (s, m),
     constraint_residual (s,) [max_k |s_k Phi_k| at each stored time, metres],
+    velocity_violation (s,) [max_k |s_k (Phi_q v + Phi_t)| at each stored time, m/s],
     newton_iterations (s,) int, step_sizes (s,), residual_norms (s,), increment_norms (s,)
     (row 0 is the initial state: 0 iterations, step 0, multipliers from the consistent
     initial accelerations; row n > 0 holds the multipliers of the step that ends at times[n], which

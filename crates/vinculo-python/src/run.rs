@@ -163,6 +163,10 @@ pub fn simulate<'py>(
         "constraint_residual",
         Array1::from(sol.constraint_residual.clone()).into_pyarray(py),
     )?;
+    out.set_item(
+        "velocity_violation",
+        Array1::from(sol.velocity_violation.clone()).into_pyarray(py),
+    )?;
     let stat = |f: &dyn Fn(&vinculo::StepStats) -> f64| Array1::from_iter(sol.stats.iter().map(f));
     out.set_item(
         "newton_iterations",

@@ -201,14 +201,10 @@ pub fn simulate_with_observer(
         .fold((crate::math::norm(g) * length).sqrt(), f64::max);
     let speed = if speed > 0.0 { speed } else { length };
     let (worst, k) = scaled_violation(system, &q, t0);
+    let velocity_worst = scaled_velocity_violation(system, &q, &v, t0);
     let checks = [
         ("positions", "Phi", (worst, k), length),
-        (
-            "velocities",
-            "Phi_q v + Phi_t",
-            scaled_velocity_violation(system, &q, &v, t0),
-            speed,
-        ),
+        ("velocities", "Phi_q v + Phi_t", velocity_worst, speed),
     ];
     for (level, quantity, (violation, k), scale) in checks {
         let tolerance = options.initial_tolerance * scale;
@@ -247,13 +243,22 @@ pub fn simulate_with_observer(
                 &v,
                 &vec![f64::NAN; sol.constraints],
                 worst,
+                velocity_worst.0,
                 StepStats::default(),
             );
             sol.status = Err(e);
             return Ok(sol);
         }
     };
-    sol.push(t0, &q, &v, &lambda, worst, StepStats::default());
+    sol.push(
+        t0,
+        &q,
+        &v,
+        &lambda,
+        worst,
+        velocity_worst.0,
+        StepStats::default(),
+    );
     let weight = system
         .particles()
         .iter()
@@ -349,7 +354,9 @@ pub fn simulate_with_observer(
                         residual_norm: report.residual,
                         increment_norm: report.increment,
                     };
-                    sol.push(t, &q, &v, &lambda, scaled_violation(system, &q, t).0, stats);
+                    let position = scaled_violation(system, &q, t).0;
+                    let velocity = scaled_velocity_violation(system, &q, &v, t).0;
+                    sol.push(t, &q, &v, &lambda, position, velocity, stats);
                 }
                 if let Some(e) = slack {
                     sol.status = Err(e);
