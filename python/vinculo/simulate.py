@@ -107,7 +107,9 @@ def simulate(
             iteration, after 8 iterations with one matrix, and whenever the step size changes (a
             step that fails with an old matrix is retried once with a fresh one). The converged
             states are the same to the Newton tolerance; ``Solution.factorisations`` counts the
-            factorisations. False: full Newton (a new matrix every iteration).
+            factorisations. Each step stops with an error near ``tolerance`` (full Newton stops
+            far below it), which enters the velocities divided by ``dt``: with small steps lower
+            the tolerance. False: full Newton (a new matrix every iteration).
 
     Returns:
         The :class:`Solution`.

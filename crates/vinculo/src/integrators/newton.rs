@@ -27,6 +27,9 @@ pub struct NewtonOptions {
     pub max_iterations: usize,
     /// Modified Newton: reuse the factorised iteration matrix across iterations and steps,
     /// refreshing it when convergence slows or the step size changes. `false`: full Newton.
+    /// Modified Newton converges linearly and stops with an error near the tolerance, where full
+    /// Newton stops far below it; an error delta in q_{n+1} becomes about delta/h in v_{n+1}, so
+    /// small steps call for a smaller tolerance.
     pub jacobian_reuse: bool,
 }
 
