@@ -136,18 +136,22 @@ class System:
         least mass-weighted change; returns {'position_change': max |dq|, 'velocity_change': max |dv|,
         'iterations': n}."""
 
-def simulate(system: System, t_end: float, dt: float, alpha: float = 0.5, t_start: float = 0.0,
+def simulate(system: System, t_end: float, dt: float, alpha: float | None = None, t_start: float = 0.0,
              tolerance: float = 1e-10, max_iterations: int = 25, max_halvings: int = 4,
              initial_tolerance: float = 1e-8, save_every: int = 1,
-             progress: Callable[[float, float], None] | None = None) -> dict:
+             progress: Callable[[float, float], None] | None = None,
+             jacobian_reuse: bool = False, scheme: str = "trapezoidal",
+             rho_inf: float | None = None) -> dict:
     """Integrate; returns a dict of numpy arrays:
     times (s,), positions (s, n, 3), velocities (s, n, 3), multipliers (s, m),
     constraint_residual (s,) [max_k |s_k Phi_k| at each stored time, metres],
+    velocity_violation (s,) [max_k |s_k (Phi_q v + Phi_t)| at each stored time, m/s],
     newton_iterations (s,) int, step_sizes (s,), residual_norms (s,), increment_norms (s,)
     (row 0 is the initial state: 0 iterations, step 0, multipliers from the consistent
     initial accelerations; row n > 0 holds the multipliers of the step that ends at times[n], which
-    act at t_{n-1} + alpha dt, where the scheme evaluates the dynamics),
-    steps_taken, steps_rejected (int), linear_solver (str), and
+    act at t_{n-1} + alpha dt for the trapezoidal schemes, where they evaluate the dynamics, and
+    at times[n] for generalized-alpha),
+    steps_taken, steps_rejected, factorisations (int), linear_solver, scheme (str), and
     'error': None, or a dict {'kind', 'message', 'time', 'step_size', 'residual', 'iterations',
     'equation'} when the run stopped early (the arrays then hold every step completed).
     progress(t, t_end) is called about twice a second of wall time.

@@ -55,8 +55,10 @@ def simulate(
     system: System,
     t_end: float,
     dt: float,
-    alpha: float = 0.5,
+    alpha: float | None = None,
     *,
+    scheme: str = "trapezoidal",
+    rho_inf: float | None = None,
     t_start: float = 0.0,
     tolerance: float = 1e-10,
     max_iterations: int = 25,
@@ -64,20 +66,29 @@ def simulate(
     initial_tolerance: float = 1e-8,
     save_every: int = 1,
     progress: bool | ProgressCallback = False,
+    jacobian_reuse: bool = False,
 ) -> Solution:
     """Integrate a constrained system from ``t_start`` to ``t_end``.
 
     The equations ``M v' + F(q, v, t) - Phi_q^T lambda = 0``, ``v = q'``, ``Phi(q, t) = 0`` are
-    discretised by the generalised trapezoidal rule with parameter ``alpha`` and solved step by step
-    with Newton's method. A step that does not converge is retried with half the step size, up to
-    ``max_halvings`` times.
+    discretised by the scheme named by ``scheme`` and solved step by step with Newton's method, the
+    position constraints holding at the end of every step. A step that does not converge is
+    retried with half the step size, up to ``max_halvings`` times.
 
     Arguments:
         system: the model (its initial positions and velocities are the initial state).
         t_end: final time, in s (not before ``t_start``).
         dt: step size, in s (positive).
-        alpha: 1/2 is the trapezoidal rule (second order, no numerical damping), 1 is backward Euler
-            (first order, strongly damped); values between add damping.
+        alpha: parameter of the generalised trapezoidal rule, in [1/2, 1] (default 1/2): 1/2 is the
+            trapezoidal rule (second order, no numerical damping), 1 is backward Euler (first
+            order, strongly damped); values between add damping but are first order.
+        scheme: 'trapezoidal' (the generalised trapezoidal rule with ``alpha``),
+            'backward-euler' (the same rule with alpha = 1), or 'generalized-alpha' (the
+            generalised-alpha scheme of Arnold and Brüls for index-3 systems: second order, with
+            numerical damping of the high frequencies set by ``rho_inf``).
+        rho_inf: spectral radius at infinite frequency of 'generalized-alpha', in [0, 1]
+            (default 0.9): 1 adds no numerical damping, 0 removes the highest frequencies in one
+            step; the low frequencies are barely damped in every case.
         t_start: initial time, in s.
         tolerance: Newton stops when the scaled residual and the last increment (both lengths, see
             formulation.md) are below ``tolerance * system.length_scale()``.
@@ -91,18 +102,34 @@ def simulate(
             models need it to keep the output in memory.
         progress: True draws a progress bar on standard error; a callable is called as
             ``progress(t, t_end)`` about twice a second of wall time.
+        jacobian_reuse: modified Newton: keep the factorised iteration matrix across iterations
+            and steps, refreshing it when the Newton increments shrink by less than half per
+            iteration, after 8 iterations with one matrix, and whenever the step size changes (a
+            step that fails with an old matrix is retried once with a fresh one). The converged
+            states are the same to the Newton tolerance; ``Solution.factorisations`` counts the
+            factorisations. Each step stops with an error near ``tolerance`` (full Newton stops
+            far below it), which enters the velocities divided by ``dt``: with small steps lower
+            the tolerance. False: full Newton (a new matrix every iteration).
 
     Returns:
         The :class:`Solution`.
 
     Raises:
-        InvalidInputError: a bad argument (``dt <= 0``, ``t_end < t_start``, ``alpha`` outside
-            [1/2, 1], a non-positive tolerance, ...).
+        InvalidInputError: a bad argument (``dt <= 0``, ``t_end < t_start``, an unknown
+            ``scheme``, ``alpha`` outside [1/2, 1], ``rho_inf`` outside [0, 1], a parameter of
+            another scheme, a non-positive tolerance, ...).
         InconsistentInitialStateError: the initial state violates a constraint by more than
             ``initial_tolerance`` (see ``System.project_initial_state``).
         ConvergenceError: a step failed even at the smallest step size; its ``solution`` attribute
             holds every step completed before.
     """
+    if not isinstance(scheme, str):
+        raise errors.InvalidInputError(
+            f"scheme must be a name ('trapezoidal', 'backward-euler' or 'generalized-alpha'), "
+            f"got {scheme!r}",
+            name="scheme",
+            value=scheme,
+        )
     bar: ProgressBar | None = None
     callback: ProgressCallback | None
     if progress is True:
@@ -131,6 +158,9 @@ def simulate(
             initial_tolerance=initial_tolerance,
             save_every=save_every,
             progress=callback,
+            jacobian_reuse=bool(jacobian_reuse),
+            scheme=scheme,
+            rho_inf=rho_inf,
         )
     finally:
         if bar is not None:

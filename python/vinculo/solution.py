@@ -18,6 +18,7 @@ _ARRAY_FIELDS = (
     "velocities",
     "multipliers",
     "constraint_residual",
+    "velocity_violation",
     "newton_iterations",
     "step_sizes",
     "residual_norms",
@@ -47,7 +48,12 @@ class Solution:
         multipliers: (s, m) Lagrange multipliers, one column per constraint equation. The force of
             constraint k on the particles is ``Phi_q[k]^T lambda_k``.
         constraint_residual: (s,) ``max_k |s_k Phi_k|`` at each stored time, in m (``s_k`` is the
-            constraint's scale, see ``System.constraint_scales``).
+            constraint's scale, see ``System.constraint_scales``): the position-level
+            violation, at the Newton tolerance or below (also :attr:`position_violation`).
+        velocity_violation: (s,) ``max_k |s_k (Phi_q v + Phi_t)|`` at each stored time, in m/s:
+            the velocity-level violation. The schemes enforce the position constraints only
+            (index 3), so the velocities drift off the velocity constraints by an amount that
+            shrinks with the step: a measure of the run's accuracy.
         newton_iterations: (s,) Newton iterations of each step.
         step_sizes: (s,) size of each step, in s (smaller than ``dt`` where steps were halved).
         residual_norms: (s,) final residual norm of each step's Newton solve.
@@ -59,6 +65,9 @@ class Solution:
         linear_solver: the linear solver the run used: 'dense LU' (small systems),
             'tree elimination' (tree-shaped constraint graphs: chains, ropes, branched strings)
             or 'sparse LU' (graphs with loops).
+        factorisations: number of Newton iteration matrices factorised over the run (one per
+            Newton iteration in full Newton, fewer with ``jacobian_reuse=True``).
+        scheme: the time discretisation: 'trapezoidal', 'backward-euler' or 'generalized-alpha'.
     """
 
     times: np.ndarray
@@ -66,6 +75,7 @@ class Solution:
     velocities: np.ndarray
     multipliers: np.ndarray
     constraint_residual: np.ndarray
+    velocity_violation: np.ndarray
     newton_iterations: np.ndarray
     step_sizes: np.ndarray
     residual_norms: np.ndarray
@@ -73,6 +83,8 @@ class Solution:
     error: dict[str, Any] | None
     system: System
     linear_solver: str = ""
+    factorisations: int = 0
+    scheme: str = ""
 
     @classmethod
     def from_core(cls, data: dict[str, Any], system: System) -> Solution:
@@ -95,12 +107,20 @@ class Solution:
             error=dict(error) if error is not None else None,
             system=system,
             linear_solver=str(data.get("linear_solver", "")),
+            factorisations=int(data.get("factorisations", 0)),
+            scheme=str(data.get("scheme", "")),
         )
 
     @property
     def success(self) -> bool:
         """True if the run reached ``t_end``."""
         return self.error is None
+
+    @property
+    def position_violation(self) -> np.ndarray:
+        """(s,) ``max_k |s_k Phi_k|`` at each stored time, in m (the same array as
+        :attr:`constraint_residual`)."""
+        return self.constraint_residual
 
     @property
     def num_steps(self) -> int:
@@ -230,6 +250,9 @@ class Solution:
         if self.num_steps > 0:
             iterations = self.newton_iterations[1:]
             lines.append(f"max constraint residual: {np.max(self.constraint_residual):.3e} m")
+            lines.append(
+                f"max velocity-constraint residual: {np.max(self.velocity_violation):.3e} m/s"
+            )
             lines.append(
                 f"Newton iterations per step: mean {np.mean(iterations):.2f}, "
                 f"max {int(np.max(iterations))}"

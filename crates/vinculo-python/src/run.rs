@@ -7,7 +7,7 @@ use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::time::{Duration, Instant};
-use vinculo::integrators::NewtonOptions;
+use vinculo::integrators::{NewtonOptions, Scheme};
 use vinculo::{simulate_with_observer, Observer, SimulationOptions};
 
 /// Calls the Python progress callback and checks for Ctrl-C about twice a second.
@@ -39,17 +39,56 @@ impl Observer for Progress {
     }
 }
 
+/// The scheme a name and its parameters select. A parameter of another scheme is refused rather
+/// than ignored (the ranges are checked by the core).
+fn scheme_by_name(name: &str, alpha: Option<f64>, rho_inf: Option<f64>) -> PyResult<Scheme> {
+    let only_alpha_point = "rho_inf applies to scheme='generalized-alpha' only";
+    match name {
+        "trapezoidal" => match rho_inf {
+            Some(rho) => Err(invalid("rho_inf", rho, only_alpha_point)),
+            None => Ok(Scheme::GeneralizedTrapezoidal {
+                alpha: alpha.unwrap_or(0.5),
+            }),
+        },
+        "backward-euler" => match (alpha, rho_inf) {
+            (Some(a), _) if a != 1.0 => Err(invalid(
+                "alpha",
+                a,
+                "backward-euler is alpha = 1; for another alpha use scheme='trapezoidal'",
+            )),
+            (_, Some(rho)) => Err(invalid("rho_inf", rho, only_alpha_point)),
+            _ => Ok(Scheme::GeneralizedTrapezoidal { alpha: 1.0 }),
+        },
+        "generalized-alpha" => match alpha {
+            Some(a) => Err(invalid(
+                "alpha",
+                a,
+                "alpha belongs to the trapezoidal schemes; generalized-alpha takes rho_inf",
+            )),
+            None => Ok(Scheme::GeneralizedAlpha {
+                rho_inf: rho_inf.unwrap_or(0.9),
+            }),
+        },
+        other => Err(invalid(
+            "scheme",
+            format!("'{other}'"),
+            "expected 'trapezoidal', 'backward-euler' or 'generalized-alpha'",
+        )),
+    }
+}
+
 /// Integrates the system; see the type stubs (`_core.pyi`) for the returned dictionary.
 #[pyfunction]
-#[pyo3(signature = (system, t_end, dt, alpha=0.5, t_start=0.0, tolerance=1e-10, max_iterations=25,
-                    max_halvings=4, initial_tolerance=1e-8, save_every=1, progress=None))]
+#[pyo3(signature = (system, t_end, dt, alpha=None, t_start=0.0, tolerance=1e-10, max_iterations=25,
+                    max_halvings=4, initial_tolerance=1e-8, save_every=1, progress=None,
+                    jacobian_reuse=false, scheme="trapezoidal", rho_inf=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
     system: PyRef<'py, PySystem>,
     t_end: f64,
     dt: f64,
-    alpha: f64,
+    alpha: Option<f64>,
     t_start: f64,
     tolerance: f64,
     max_iterations: i64,
@@ -57,6 +96,9 @@ pub fn simulate<'py>(
     initial_tolerance: f64,
     save_every: i64,
     progress: Option<Py<PyAny>>,
+    jacobian_reuse: bool,
+    scheme: &str,
+    rho_inf: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let count = |name: &str, v: i64, min: i64| -> PyResult<usize> {
         if v < min {
@@ -69,10 +111,11 @@ pub fn simulate<'py>(
         t_start,
         t_end,
         dt,
-        alpha,
+        scheme: scheme_by_name(scheme, alpha, rho_inf)?,
         newton: NewtonOptions {
             tolerance,
             max_iterations: count("max_iterations", max_iterations, 1)?,
+            jacobian_reuse,
         },
         max_halvings: count("max_halvings", max_halvings, 0)?,
         initial_tolerance,
@@ -120,6 +163,10 @@ pub fn simulate<'py>(
         "constraint_residual",
         Array1::from(sol.constraint_residual.clone()).into_pyarray(py),
     )?;
+    out.set_item(
+        "velocity_violation",
+        Array1::from(sol.velocity_violation.clone()).into_pyarray(py),
+    )?;
     let stat = |f: &dyn Fn(&vinculo::StepStats) -> f64| Array1::from_iter(sol.stats.iter().map(f));
     out.set_item(
         "newton_iterations",
@@ -136,7 +183,9 @@ pub fn simulate<'py>(
     )?;
     out.set_item("steps_taken", sol.steps_taken)?;
     out.set_item("steps_rejected", sol.steps_rejected)?;
+    out.set_item("factorisations", sol.factorisations)?;
     out.set_item("linear_solver", sol.linear_solver)?;
+    out.set_item("scheme", sol.scheme.name())?;
     match &sol.status {
         Ok(()) => out.set_item("error", py.None())?,
         Err(e) => {

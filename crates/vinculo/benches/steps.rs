@@ -1,9 +1,11 @@
 //! Steps per second of the simulation loop on the issue's reference models.
 //!
 //! Run with `cargo bench -p vinculo --bench steps`. Times only `simulate` (model building and
-//! analysis included, output included), after one warm-up run.
+//! analysis included, output included), after one warm-up run, with full Newton and with
+//! modified Newton (`jacobian_reuse`).
 
 use std::time::Instant;
+use vinculo::integrators::NewtonOptions;
 use vinculo::model::System;
 use vinculo::{simulate, SimulationOptions};
 
@@ -45,25 +47,33 @@ fn measure(name: &str, system: &System, t_end: f64, dt: f64) {
 }
 
 fn measure_with(name: &str, system: &System, t_end: f64, dt: f64, dense_limit: usize) {
-    let options = SimulationOptions {
-        t_end,
-        dt,
-        dense_limit,
-        ..Default::default()
-    };
-    simulate(system, &options).unwrap();
-    let start = Instant::now();
-    let sol = simulate(system, &options).unwrap();
-    let elapsed = start.elapsed().as_secs_f64();
-    assert!(sol.status.is_ok());
-    let steps = sol.len() - 1;
-    let iterations: usize = sol.stats.iter().map(|s| s.newton_iterations).sum();
-    println!(
-        "{name:<42} {steps:>7} steps  {:>10.0} steps/s  {:>5.2} Newton it./step  ({})",
-        steps as f64 / elapsed,
-        iterations as f64 / steps as f64,
-        sol.linear_solver
-    );
+    for (jacobian_reuse, mode) in [(false, "full"), (true, "modified")] {
+        let options = SimulationOptions {
+            t_end,
+            dt,
+            dense_limit,
+            newton: NewtonOptions {
+                jacobian_reuse,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        simulate(system, &options).unwrap();
+        let start = Instant::now();
+        let sol = simulate(system, &options).unwrap();
+        let elapsed = start.elapsed().as_secs_f64();
+        assert!(sol.status.is_ok());
+        let steps = sol.len() - 1;
+        let iterations: usize = sol.stats.iter().map(|s| s.newton_iterations).sum();
+        println!(
+            "{name:<42} {mode:<8} {steps:>7} steps  {:>10.0} steps/s  {:>5.2} Newton it./step  \
+             {:>5.2} factorisations/step  ({})",
+            steps as f64 / elapsed,
+            iterations as f64 / steps as f64,
+            sol.factorisations as f64 / steps as f64,
+            sol.linear_solver
+        );
+    }
 }
 
 fn main() {
@@ -80,6 +90,12 @@ fn main() {
             1e-3,
             0,
         );
+    }
+    for n in [100, 10000] {
+        for (hanging, shape) in [(true, "hanging"), (false, "swinging")] {
+            let name = format!("{shape} chain N = {n}, 0.1 m links, 1 s");
+            measure(&name, &chain(n, 0.1, hanging), 1.0, 1e-3);
+        }
     }
     measure(
         "hanging chain N = 1000, 0.1 m links, 1 s",

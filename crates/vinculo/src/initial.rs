@@ -60,6 +60,8 @@ pub(crate) fn singular_error(system: &System, layout: &Layout, t: f64, s: Singul
 /// Solves the saddle system at (q, t) for the right-hand side in `ws.r`, leaving the solution there.
 fn solve_saddle(system: &System, ws: &mut StepWorkspace, q: &[Vec3], t: f64) -> Result<()> {
     fill_saddle(system, ws, q, t);
+    // The solver no longer holds a step's iteration matrix.
+    ws.matrix.invalidate();
     ws.solver
         .factor(&ws.values)
         .map_err(|s| singular_error(system, &ws.layout, t, s))?;

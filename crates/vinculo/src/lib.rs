@@ -11,9 +11,11 @@
 //!
 //! Point masses ([`model::System`]) are linked by constraints ([`constraints::Constraint`]) enforced
 //! with Lagrange multipliers and loaded by forces ([`forces::Force`]). The generalised trapezoidal
-//! rule ([`integrators::GeneralizedTrapezoidal`]) turns each step into a nonlinear system that a
-//! Newton loop ([`integrators::newton`]) solves with the analytic Jacobian, assembled into a
-//! sparsity pattern computed once ([`assembly`]) and factorised by faer ([`linear`]).
+//! rule ([`integrators::GeneralizedTrapezoidal`]) or the generalised-alpha scheme
+//! ([`integrators::GeneralizedAlpha`]), chosen by [`integrators::Scheme`], turns each step into a
+//! nonlinear system that a Newton loop ([`integrators::newton`], full or modified) solves with the
+//! analytic Jacobian, assembled into a sparsity pattern computed once ([`assembly`]) and
+//! factorised by faer ([`linear`]).
 //!
 //! The entry point is [`simulate`], which returns a [`Solution`].
 //!

@@ -6,7 +6,10 @@ use crate::error::{Error, Result};
 use crate::initial::{
     consistent_accelerations, scaled_velocity_violation, scaled_violation, singular_error,
 };
-use crate::integrators::{GeneralizedTrapezoidal, NewtonFailure, NewtonOptions, StepWorkspace};
+use crate::integrators::{
+    AlphaState, GeneralizedAlpha, GeneralizedTrapezoidal, NewtonFailure, NewtonOptions, Scheme,
+    StepWorkspace,
+};
 use crate::linear::SparseSolver;
 use crate::math::Vec3;
 use crate::model::System;
@@ -22,8 +25,8 @@ pub struct SimulationOptions {
     pub t_end: f64,
     /// Nominal step (s).
     pub dt: f64,
-    /// Parameter of the generalised trapezoidal rule, in [1/2, 1].
-    pub alpha: f64,
+    /// The time discretisation (default: the trapezoidal rule, alpha = 1/2).
+    pub scheme: Scheme,
     /// Newton options (tolerance relative to the length scale).
     pub newton: NewtonOptions,
     /// How many times a failing step may be halved before the run stops.
@@ -48,7 +51,7 @@ impl Default for SimulationOptions {
             t_start: 0.0,
             t_end: 1.0,
             dt: 1e-3,
-            alpha: 0.5,
+            scheme: Scheme::default(),
             newton: NewtonOptions::default(),
             max_halvings: 4,
             initial_tolerance: 1e-8,
@@ -95,12 +98,22 @@ fn check_options(system: &System, o: &SimulationOptions) -> Result<()> {
     if !(o.dt.is_finite() && o.dt > 0.0) {
         return Err(bad("dt", o.dt, "must be finite and > 0"));
     }
-    if !(0.5..=1.0).contains(&o.alpha) {
-        return Err(bad(
-            "alpha",
-            o.alpha,
-            "must be in [0.5, 1] (0.5: trapezoidal, 1: backward Euler)",
-        ));
+    match o.scheme {
+        Scheme::GeneralizedTrapezoidal { alpha } if !(0.5..=1.0).contains(&alpha) => {
+            return Err(bad(
+                "alpha",
+                alpha,
+                "must be in [0.5, 1] (0.5: trapezoidal, 1: backward Euler)",
+            ));
+        }
+        Scheme::GeneralizedAlpha { rho_inf } if !(0.0..=1.0).contains(&rho_inf) => {
+            return Err(bad(
+                "rho_inf",
+                rho_inf,
+                "must be in [0, 1] (1: no numerical damping, 0: the most)",
+            ));
+        }
+        _ => {}
     }
     if !(o.newton.tolerance.is_finite() && o.newton.tolerance > 0.0) {
         return Err(bad(
@@ -188,14 +201,10 @@ pub fn simulate_with_observer(
         .fold((crate::math::norm(g) * length).sqrt(), f64::max);
     let speed = if speed > 0.0 { speed } else { length };
     let (worst, k) = scaled_violation(system, &q, t0);
+    let velocity_worst = scaled_velocity_violation(system, &q, &v, t0);
     let checks = [
         ("positions", "Phi", (worst, k), length),
-        (
-            "velocities",
-            "Phi_q v + Phi_t",
-            scaled_velocity_violation(system, &q, &v, t0),
-            speed,
-        ),
+        ("velocities", "Phi_q v + Phi_t", velocity_worst, speed),
     ];
     for (level, quantity, (violation, k), scale) in checks {
         let tolerance = options.initial_tolerance * scale;
@@ -213,14 +222,13 @@ pub fn simulate_with_observer(
     }
 
     let mut ws = StepWorkspace::with_solver(system, options.dense_limit, options.sparse_solver);
-    let scheme = GeneralizedTrapezoidal {
-        alpha: options.alpha,
-    };
+    let scheme = options.scheme;
     let newton = NewtonOptions {
         tolerance: options.newton.tolerance * length,
         ..options.newton
     };
     let mut sol = Solution::new(q.len(), system.constraints().len(), ws.solver.name());
+    sol.scheme = scheme;
     let start = consistent_accelerations(system, &mut ws, &q, &v, t0).map_err(|e| match e {
         // Name the culprits when the matrix is singular because constraints are redundant.
         Error::SingularMatrix { .. } => find_redundant(system, &q, t0, None).unwrap_or(e),
@@ -235,13 +243,22 @@ pub fn simulate_with_observer(
                 &v,
                 &vec![f64::NAN; sol.constraints],
                 worst,
+                velocity_worst.0,
                 StepStats::default(),
             );
             sol.status = Err(e);
             return Ok(sol);
         }
     };
-    sol.push(t0, &q, &v, &lambda, worst, StepStats::default());
+    sol.push(
+        t0,
+        &q,
+        &v,
+        &lambda,
+        worst,
+        velocity_worst.0,
+        StepStats::default(),
+    );
     let weight = system
         .particles()
         .iter()
@@ -263,6 +280,12 @@ pub fn simulate_with_observer(
     let mut t = t0;
     let mut step = 0usize;
     let mut q_new: Vec<Vec3> = q.clone();
+    // Generalised-alpha starts with a_0 = qdd_0, the consistent accelerations.
+    let mut alpha_state = AlphaState {
+        acceleration: acc.clone(),
+        algorithmic: acc.clone(),
+    };
+    let mut fresh_retry = false;
     while t < options.t_end {
         let h_nominal = unit * (1u64 << level) as f64;
         let remaining = options.t_end - t;
@@ -275,12 +298,41 @@ pub fn simulate_with_observer(
             }
         }
         ws.state.lambda.copy_from_slice(&lambda);
-        sol.steps_taken += 1;
-        match scheme.step(system, &mut ws, t, &q, &v, h_try, &newton) {
+        if !fresh_retry {
+            sol.steps_taken += 1;
+        }
+        // Modified Newton starting from a matrix of an earlier step gets one more attempt with a
+        // fresh matrix before the step counts as failed.
+        let stale = newton.jacobian_reuse && ws.matrix.holds(scheme.matrix_key(h_try));
+        let attempt = match scheme {
+            Scheme::GeneralizedTrapezoidal { alpha } => {
+                GeneralizedTrapezoidal { alpha }.step(system, &mut ws, t, &q, &v, h_try, &newton)
+            }
+            Scheme::GeneralizedAlpha { rho_inf } => GeneralizedAlpha { rho_inf }.step(
+                system,
+                &mut ws,
+                t,
+                &q,
+                &v,
+                &mut alpha_state,
+                h_try,
+                &newton,
+            ),
+        };
+        sol.factorisations = ws.matrix.factorisations;
+        fresh_retry = false;
+        match attempt {
             Ok(report) => {
-                for i in 0..q.len() {
-                    for k in 0..3 {
-                        acc[i][k] = (ws.state.v[i][k] - v[i][k]) / h_try;
+                match scheme {
+                    Scheme::GeneralizedTrapezoidal { .. } => {
+                        for i in 0..q.len() {
+                            for k in 0..3 {
+                                acc[i][k] = (ws.state.v[i][k] - v[i][k]) / h_try;
+                            }
+                        }
+                    }
+                    Scheme::GeneralizedAlpha { .. } => {
+                        acc.copy_from_slice(&alpha_state.acceleration);
                     }
                 }
                 q_new.copy_from_slice(&ws.state.q);
@@ -302,7 +354,9 @@ pub fn simulate_with_observer(
                         residual_norm: report.residual,
                         increment_norm: report.increment,
                     };
-                    sol.push(t, &q, &v, &lambda, scaled_violation(system, &q, t).0, stats);
+                    let position = scaled_violation(system, &q, t).0;
+                    let velocity = scaled_velocity_violation(system, &q, &v, t).0;
+                    sol.push(t, &q, &v, &lambda, position, velocity, stats);
                 }
                 if let Some(e) = slack {
                     sol.status = Err(e);
@@ -314,6 +368,10 @@ pub fn simulate_with_observer(
                     sol.status = Err(Error::Interrupted { t });
                     break;
                 }
+            }
+            Err(_) if stale => {
+                ws.matrix.invalidate();
+                fresh_retry = true;
             }
             Err(failure) => {
                 sol.steps_rejected += 1;

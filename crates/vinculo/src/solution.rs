@@ -1,6 +1,7 @@
 //! What a run returns: stored states, multipliers, constraint health and per-step statistics.
 
 use crate::error::Error;
+use crate::integrators::Scheme;
 
 /// Statistics of one stored step.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -31,14 +32,23 @@ pub struct Solution {
     pub velocities: Vec<f64>,
     /// Multipliers, steps x constraints (row 0: from the consistent initial accelerations).
     pub multipliers: Vec<f64>,
-    /// max_k |s_k Phi_k| at each stored time (a length, m).
+    /// max_k |s_k Phi_k| at each stored time (a length, m): the position-level violation.
     pub constraint_residual: Vec<f64>,
+    /// max_k |s_k (Phi_q v + Phi_t)| at each stored time (a speed, m/s): the velocity-level
+    /// violation. The index-3 schemes enforce only the positions, so this is not zero but
+    /// shrinks with the step (see [`crate::initial::scaled_velocity_violation`]).
+    pub velocity_violation: Vec<f64>,
     /// Per stored step.
     pub stats: Vec<StepStats>,
     /// Steps taken (stored or not), including retries with smaller steps.
     pub steps_taken: usize,
     /// Steps rejected because Newton failed (then retried with half the step).
     pub steps_rejected: usize,
+    /// Factorisations of Newton iteration matrices (one per iteration in full Newton; fewer with
+    /// [`NewtonOptions::jacobian_reuse`](crate::integrators::NewtonOptions::jacobian_reuse)).
+    pub factorisations: usize,
+    /// The time discretisation used ([`Scheme::name`] names it).
+    pub scheme: Scheme,
     /// Name of the linear solver used.
     pub linear_solver: &'static str,
     /// `Ok` when the run reached its end; otherwise the error that stopped it (the arrays hold
@@ -57,9 +67,12 @@ impl Solution {
             velocities: Vec::new(),
             multipliers: Vec::new(),
             constraint_residual: Vec::new(),
+            velocity_violation: Vec::new(),
             stats: Vec::new(),
             steps_taken: 0,
             steps_rejected: 0,
+            factorisations: 0,
+            scheme: Scheme::default(),
             linear_solver,
             status: Ok(()),
         }
@@ -95,6 +108,8 @@ impl Solution {
         ]
     }
 
+    /// Stores a state with its position- and velocity-level violations and statistics.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn push(
         &mut self,
         t: f64,
@@ -102,6 +117,7 @@ impl Solution {
         v: &[[f64; 3]],
         lambda: &[f64],
         residual: f64,
+        velocity_violation: f64,
         stats: StepStats,
     ) {
         self.times.push(t);
@@ -109,6 +125,7 @@ impl Solution {
         self.velocities.extend(v.iter().flatten());
         self.multipliers.extend_from_slice(lambda);
         self.constraint_residual.push(residual);
+        self.velocity_violation.push(velocity_violation);
         self.stats.push(stats);
     }
 }

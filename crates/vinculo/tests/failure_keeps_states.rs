@@ -20,6 +20,7 @@ fn newton_failure_reports_and_keeps_the_partial_run() {
         newton: NewtonOptions {
             tolerance: 1e-15,
             max_iterations: 1,
+            ..Default::default()
         },
         max_halvings: 2,
         ..Default::default()

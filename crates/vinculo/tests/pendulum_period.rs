@@ -18,7 +18,7 @@ fn period_matches_the_elliptic_integral() {
     let options = SimulationOptions {
         t_end: 2.5,
         dt: 2e-4,
-        alpha: 0.5,
+        scheme: vinculo::integrators::Scheme::GeneralizedTrapezoidal { alpha: 0.5 },
         ..Default::default()
     };
     let sol = simulate(&s, &options).unwrap();

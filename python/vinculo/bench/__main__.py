@@ -91,7 +91,7 @@ def _row(
     return agree
 
 
-def compare(quick: bool = False, repeat: int = 3, out=print) -> bool:
+def compare(quick: bool = False, repeat: int = 3, out=print, jacobian_reuse: bool = False) -> bool:
     """The side-by-side table; returns True if every pair that ran agrees."""
     exu = _import_exudyn()
     if exu is None:
@@ -102,7 +102,9 @@ def compare(quick: bool = False, repeat: int = 3, out=print) -> bool:
             "modified Newton (its defaults), sparse LU (dense if faster for <= 100 unknowns)"
         )
     out(
-        "vinculo: trapezoidal rule (alpha = 1/2), Newton tolerance 1e-10 of the length scale; "
+        "vinculo: trapezoidal rule (alpha = 1/2), "
+        f"{'modified' if jacobian_reuse else 'full'} Newton, "
+        "Newton tolerance 1e-10 of the length scale; "
         f"dt = 1e-3 for both; tip check: |tip_vinculo - tip_exudyn| <= {TIP_TOLERANCE:g} m"
     )
     out(
@@ -112,7 +114,7 @@ def compare(quick: bool = False, repeat: int = 3, out=print) -> bool:
     agree = True
     for model in comparison_models(quick) + robustness_models(quick):
         big = model.n >= 1_000
-        v = run_vinculo(model, repeat=1 if big else repeat)
+        v = run_vinculo(model, repeat=1 if big else repeat, jacobian_reuse=jacobian_reuse)
         e = None if exu is None else run_exudyn(model, exu, repeat=1 if big else repeat)
         agree &= _row(model, v, e, out)
     buoy = buoy_bench(quick)
@@ -134,11 +136,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="small models only (smoke run)")
     parser.add_argument("--no-scaling", action="store_true", help="skip the scaling run")
     parser.add_argument("--scaling-only", action="store_true", help="only the scaling run")
+    parser.add_argument(
+        "--jacobian-reuse", action="store_true", help="vinculo with modified Newton"
+    )
     args = parser.parse_args(argv)
     start = time.perf_counter()
     ok = True
     if not args.scaling_only:
-        ok = compare(quick=args.quick)
+        ok = compare(quick=args.quick, jacobian_reuse=args.jacobian_reuse)
         print()
     if not args.no_scaling:
         sizes = (1_000, 10_000) if args.quick else scaling.SIZES

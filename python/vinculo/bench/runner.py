@@ -36,16 +36,22 @@ class Run:
         return self.steps / self.seconds if self.tip is not None else float("nan")
 
 
-def run_vinculo(model: Chain, repeat: int = 1) -> Run:
+def run_vinculo(model: Chain, repeat: int = 1, jacobian_reuse: bool = False) -> Run:
     """Best of ``repeat`` runs of vinculo (alpha = 1/2, default tolerance 1e-10 of the length
-    scale), storing only the first and the last state."""
+    scale), storing only the first and the last state; ``jacobian_reuse`` selects modified
+    Newton (see :func:`vinculo.simulate`)."""
     system, tip = build_vinculo(model)
     best = None
     for _ in range(repeat):
         start = time.perf_counter()
         try:
             solution = vinculo.simulate(
-                system, t_end=model.t_end, dt=model.dt, alpha=0.5, save_every=model.steps
+                system,
+                t_end=model.t_end,
+                dt=model.dt,
+                alpha=0.5,
+                save_every=model.steps,
+                jacobian_reuse=jacobian_reuse,
             )
         except vinculo.ConvergenceError as error:
             return Run(time.perf_counter() - start, 0, None, f"failed: {error}")
@@ -56,7 +62,8 @@ def run_vinculo(model: Chain, repeat: int = 1) -> Run:
                 seconds,
                 model.steps,
                 solution.particle(tip)[-1],
-                f"{solution.linear_solver}, {np.mean(iterations):.1f} Newton it./step",
+                f"{solution.linear_solver}, {np.mean(iterations):.1f} Newton it./step, "
+                f"{solution.factorisations / model.steps:.2f} factorisations/step",
             )
     assert best is not None
     return best

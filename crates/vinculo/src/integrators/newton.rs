@@ -1,9 +1,19 @@
-//! Newton's method on a scaled nonlinear system R(x) = 0 (paper eqs. 26-30).
+//! Newton's method on a scaled nonlinear system R(x) = 0 (paper eqs. 26-30), full or modified.
 //!
 //! The loop does no I/O and chooses no step size. It stops when both the scaled residual and the
 //! last increment are below the tolerance (both are lengths after scaling, see
 //! [`StepProblem`](super::StepProblem)); it reports the equation that dominates the residual when
 //! it fails.
+//!
+//! Full Newton assembles and factorises the iteration matrix J(x_k) at every iteration. Modified
+//! Newton ([`NewtonOptions::jacobian_reuse`]) keeps the last factorisation, across iterations and
+//! across steps, as long as it was made for the same step size and scheme coefficients (the
+//! [`IterationMatrix`] key). The residual is always exact, so the converged point is the same;
+//! only the rate changes. With a matrix J~ the iteration x <- x - J~^{-1} R(x) contracts the
+//! increments by theta_k = |dx_k| / |dx_{k-1}| ~ |I - J~^{-1} J|; the matrix is refreshed at the
+//! current iterate when theta_k > [`MAX_CONTRACTION`] or after [`MAX_STALE_ITERATIONS`]
+//! iterations with one matrix. Since theta <= 1/2 when the loop stops, the distance to the
+//! solution, at most |dx| theta / (1 - theta), is below the last increment, as in full Newton.
 
 use crate::linear::{LinearSolver, Singular};
 
@@ -13,8 +23,44 @@ pub struct NewtonOptions {
     /// Tolerance on the infinity norms of the scaled residual and increment (absolute, in the
     /// problem's scaled units).
     pub tolerance: f64,
-    /// Maximum number of iterations (matrix factorisations).
+    /// Maximum number of iterations (linear solves).
     pub max_iterations: usize,
+    /// Modified Newton: reuse the factorised iteration matrix across iterations and steps,
+    /// refreshing it when convergence slows or the step size changes. `false`: full Newton.
+    /// Modified Newton converges linearly and stops with an error near the tolerance, where full
+    /// Newton stops far below it; an error delta in q_{n+1} becomes about delta/h in v_{n+1}, so
+    /// small steps call for a smaller tolerance.
+    pub jacobian_reuse: bool,
+}
+
+/// Largest contraction ratio |dx_k| / |dx_{k-1}| accepted before modified Newton refreshes its
+/// iteration matrix.
+pub const MAX_CONTRACTION: f64 = 0.5;
+
+/// Iterations modified Newton makes with one matrix before refreshing it.
+pub const MAX_STALE_ITERATIONS: usize = 8;
+
+/// What the linear solver's current factorisation is, for reuse by modified Newton.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct IterationMatrix {
+    /// Step size and scheme coefficients the factorisation was assembled for; `None` when the
+    /// solver holds no reusable factorisation (nothing factorised yet, or another matrix).
+    key: Option<[f64; 2]>,
+    /// Factorisations of iteration matrices made so far.
+    pub factorisations: usize,
+}
+
+impl IterationMatrix {
+    /// True when the current factorisation was made for `key`.
+    pub fn holds(&self, key: [f64; 2]) -> bool {
+        self.key == Some(key)
+    }
+
+    /// Marks the factorisation as unusable (the solver was used for another matrix, or the
+    /// caller wants a fresh one).
+    pub fn invalidate(&mut self) {
+        self.key = None;
+    }
 }
 
 impl Default for NewtonOptions {
@@ -22,6 +68,7 @@ impl Default for NewtonOptions {
         NewtonOptions {
             tolerance: 1e-10,
             max_iterations: 25,
+            jacobian_reuse: false,
         }
     }
 }
@@ -39,8 +86,10 @@ pub trait NewtonProblem {
 /// Outcome of a converged solve.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct NewtonReport {
-    /// Number of iterations (factorisations).
+    /// Number of iterations (linear solves).
     pub iterations: usize,
+    /// Factorisations made (equal to `iterations` in full Newton).
+    pub factorisations: usize,
     /// Final scaled residual norm.
     pub residual: f64,
     /// Last scaled increment norm.
@@ -79,14 +128,38 @@ fn inf_norm(x: &[f64]) -> (f64, usize) {
     (m, k)
 }
 
-/// Solves `problem` by Newton's method with the given linear solver and work arrays.
+/// Work arrays and the factorisation state one solve uses.
+pub struct LinearWork<'a> {
+    /// The solver holding the factorisation.
+    pub solver: &'a mut dyn LinearSolver,
+    /// Matrix values in pattern order.
+    pub values: &'a mut [f64],
+    /// Residual / increment.
+    pub r: &'a mut [f64],
+    /// What the solver's factorisation is.
+    pub matrix: &'a mut IterationMatrix,
+}
+
+/// Solves `problem` by Newton's method with the given linear solver and work arrays. `key`
+/// identifies the iteration matrix (step size and scheme coefficients): modified Newton reuses
+/// a factorisation only when it was made for the same key.
 pub fn solve(
     problem: &mut impl NewtonProblem,
-    solver: &mut dyn LinearSolver,
-    values: &mut [f64],
-    r: &mut [f64],
+    work: LinearWork<'_>,
+    key: [f64; 2],
     options: &NewtonOptions,
 ) -> Result<NewtonReport, NewtonFailure> {
+    let LinearWork {
+        solver,
+        values,
+        r,
+        matrix,
+    } = work;
+    let reuse = options.jacobian_reuse;
+    let mut refresh = !(reuse && matrix.holds(key));
+    let mut stale_iterations = 0;
+    let mut previous = f64::INFINITY;
+    let mut factorisations = 0;
     let mut increment = f64::INFINITY;
     let mut residual = f64::INFINITY;
     let mut worst = 0;
@@ -103,6 +176,7 @@ pub fn solve(
         if iteration > 0 && residual <= options.tolerance && increment <= options.tolerance {
             return Ok(NewtonReport {
                 iterations: iteration,
+                factorisations,
                 residual,
                 increment,
             });
@@ -110,11 +184,22 @@ pub fn solve(
         if iteration == options.max_iterations {
             break;
         }
-        values.fill(0.0);
-        problem.jacobian(values);
-        solver.factor(values).map_err(NewtonFailure::Singular)?;
+        if refresh || stale_iterations >= MAX_STALE_ITERATIONS {
+            values.fill(0.0);
+            problem.jacobian(values);
+            matrix.invalidate();
+            solver.factor(values).map_err(NewtonFailure::Singular)?;
+            matrix.key = Some(key);
+            matrix.factorisations += 1;
+            factorisations += 1;
+            stale_iterations = 0;
+            previous = f64::INFINITY;
+        }
         solver.solve_in_place(r);
         increment = inf_norm(r).0;
+        stale_iterations += 1;
+        refresh = !reuse || increment > MAX_CONTRACTION * previous;
+        previous = increment;
         if !increment.is_finite() {
             return Err(NewtonFailure::Singular(Singular {
                 column: None,

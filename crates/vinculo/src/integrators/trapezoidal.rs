@@ -23,7 +23,9 @@
 //! solved for in the unit lambda_k sigma / s_k. The scaled matrix is
 //! `[M/m_ref + O(h^2), -s G^T; s G, 0]`, and every scaled residual and increment is a length.
 
-use super::newton::{self, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport};
+use super::newton::{
+    self, IterationMatrix, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport,
+};
 use crate::assembly::{add, add_block, Layout, NONE};
 use crate::forces::Jacobian;
 use crate::linear::{for_layout, LinearSolver, SparseSolver, TreeElimination};
@@ -47,6 +49,8 @@ pub struct StepWorkspace {
     pub layout: Layout,
     /// The factorisation of the iteration matrix.
     pub solver: Box<dyn LinearSolver>,
+    /// What that factorisation is (for modified Newton) and how many were made.
+    pub matrix: IterationMatrix,
     /// Matrix values in pattern order.
     pub values: Vec<f64>,
     /// Residual / increment.
@@ -119,6 +123,7 @@ impl StepWorkspace {
             values: vec![0.0; layout.pattern.nnz()],
             r: vec![0.0; layout.unknowns()],
             solver,
+            matrix: IterationMatrix::default(),
             state: StepBuffers {
                 q: vec![[0.0; 3]; n],
                 v: vec![[0.0; 3]; n],
@@ -297,6 +302,11 @@ impl GeneralizedTrapezoidal {
         }
     }
 
+    /// What identifies the iteration matrix of a step of size `h` (for its reuse).
+    pub fn matrix_key(&self, h: f64) -> [f64; 2] {
+        [h, self.alpha]
+    }
+
     /// Takes one step of size `h` from (t_n, q_n, v_n). The caller sets the predictor in
     /// `ws.state.q` and `ws.state.lambda`; on success they hold q_{n+1}, lambda and `ws.state.v`
     /// holds v_{n+1}.
@@ -325,27 +335,26 @@ impl GeneralizedTrapezoidal {
             alpha: self.alpha,
             sigma,
         };
-        let report = newton::solve(
-            &mut problem,
-            ws.solver.as_mut(),
-            &mut ws.values,
-            &mut ws.r,
-            options,
-        )?;
+        let work = LinearWork {
+            solver: ws.solver.as_mut(),
+            values: &mut ws.values,
+            r: &mut ws.r,
+            matrix: &mut ws.matrix,
+        };
+        let report = newton::solve(&mut problem, work, self.matrix_key(h), options)?;
         problem.kinematics();
         Ok(report)
     }
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::laws::{Law, VectorLaw};
 
-    /// The assembled Jacobian equals finite differences of the assembled residual, for a system
-    /// with every constraint and force kind, fixed particles and non-zero multipliers.
-    #[test]
-    fn jacobian_matches_finite_differences_of_the_residual() {
+    /// A system with every constraint and force kind, fixed particles, added mass and
+    /// time-dependent laws.
+    pub(crate) fn every_kind() -> System {
         let mut s = System::new([0.1, -0.2, -9.81]);
         let a = s
             .add_particle(1.0, [0.0, 0.0, 0.0], [0.0; 3], true)
@@ -404,6 +413,68 @@ mod tests {
         )
         .unwrap();
 
+        s
+    }
+
+    /// Asserts that the problem's assembled Jacobian equals central finite differences of its
+    /// residual, column by column, at the current iterate (which it leaves unchanged).
+    pub(crate) fn assert_jacobian_matches(problem: &mut impl NewtonProblem, layout: &Layout) {
+        let n = layout.unknowns();
+        let mut r = vec![0.0; n];
+        problem.residual(&mut r); // refreshes the evaluation point
+        let mut values = vec![0.0; layout.pattern.nnz()];
+        problem.jacobian(&mut values);
+        let mut dense = vec![vec![0.0; n]; n];
+        for col in 0..n {
+            for k in layout.pattern.col_ptr[col]..layout.pattern.col_ptr[col + 1] {
+                dense[layout.pattern.row_idx[k]][col] += values[k];
+            }
+        }
+        let eps = 1e-7;
+        for col in 0..n {
+            let mut dx = vec![0.0; n];
+            dx[col] = -eps; // update() subtracts
+            let mut rp = vec![0.0; n];
+            let mut rm = vec![0.0; n];
+            problem.update(&dx);
+            problem.residual(&mut rp);
+            dx[col] = 2.0 * eps;
+            problem.update(&dx);
+            problem.residual(&mut rm);
+            dx[col] = -eps;
+            problem.update(&dx);
+            for row in 0..n {
+                let fd = (rp[row] - rm[row]) / (2.0 * eps);
+                assert!(
+                    (fd - dense[row][col]).abs() < 1e-6 * (1.0 + fd.abs()),
+                    "J[{row}][{col}] = {} but finite differences give {fd}",
+                    dense[row][col]
+                );
+            }
+        }
+    }
+
+    /// A perturbed iterate off the constraints, and non-zero multipliers.
+    pub(crate) fn perturbed_iterate(ws: &mut StepWorkspace, q_n: &[Vec3]) {
+        ws.state.q = q_n
+            .iter()
+            .enumerate()
+            .map(|(i, x)| {
+                if i == 0 {
+                    *x
+                } else {
+                    [x[0] + 0.01, x[1] - 0.02 * i as f64, x[2] + 0.005]
+                }
+            })
+            .collect();
+        ws.state.lambda = vec![0.8, -1.2, 0.5, 2.0, -0.7];
+    }
+
+    /// The assembled Jacobian equals finite differences of the assembled residual, for a system
+    /// with every constraint and force kind, fixed particles and non-zero multipliers.
+    #[test]
+    fn jacobian_matches_finite_differences_of_the_residual() {
+        let s = every_kind();
         for dense_limit in [0, 1000] {
             // The general sparse LU's layout (dense storage for dense_limit 1000).
             let mut ws = StepWorkspace::with_solver(&s, dense_limit, SparseSolver::SparseLu);
@@ -411,20 +482,7 @@ mod tests {
             let v_n = s.initial_velocities();
             let (h, alpha) = (0.01, 0.6);
             let sigma = alpha * h * h / ws.mass_ref;
-            // A perturbed iterate and non-zero multipliers.
-            ws.state.q = q_n
-                .iter()
-                .enumerate()
-                .map(|(i, x)| {
-                    if i == 0 {
-                        *x
-                    } else {
-                        [x[0] + 0.01, x[1] - 0.02 * i as f64, x[2] + 0.005]
-                    }
-                })
-                .collect();
-            ws.state.lambda = vec![0.8, -1.2, 0.5, 2.0, -0.7];
-            let n = ws.layout.unknowns();
+            perturbed_iterate(&mut ws, &q_n);
             let mut problem = StepProblem {
                 system: &s,
                 layout: &ws.layout,
@@ -438,44 +496,7 @@ mod tests {
                 alpha,
                 sigma,
             };
-            let mut values = vec![0.0; ws.layout.pattern.nnz()];
-            problem.jacobian_at(&mut values);
-            let mut dense = vec![vec![0.0; n]; n];
-            for col in 0..n {
-                for k in ws.layout.pattern.col_ptr[col]..ws.layout.pattern.col_ptr[col + 1] {
-                    dense[ws.layout.pattern.row_idx[k]][col] += values[k];
-                }
-            }
-            let eps = 1e-7;
-            for col in 0..n {
-                let mut dx = vec![0.0; n];
-                dx[col] = -eps; // update() subtracts
-                let mut rp = vec![0.0; n];
-                let mut rm = vec![0.0; n];
-                problem.update(&dx);
-                problem.residual(&mut rp);
-                dx[col] = 2.0 * eps;
-                problem.update(&dx);
-                problem.residual(&mut rm);
-                dx[col] = -eps;
-                problem.update(&dx);
-                for row in 0..n {
-                    let fd = (rp[row] - rm[row]) / (2.0 * eps);
-                    assert!(
-                        (fd - dense[row][col]).abs() < 1e-6 * (1.0 + fd.abs()),
-                        "J[{row}][{col}] = {} but finite differences give {fd} (dense_limit {dense_limit})",
-                        dense[row][col]
-                    );
-                }
-            }
-        }
-    }
-
-    impl StepProblem<'_> {
-        fn jacobian_at(&mut self, values: &mut [f64]) {
-            let mut r = vec![0.0; self.layout.unknowns()];
-            self.residual(&mut r); // refreshes the evaluation point
-            self.jacobian(values);
+            assert_jacobian_matches(&mut problem, &ws.layout);
         }
     }
 }
