@@ -99,20 +99,46 @@ def build_exudyn(model: Chain, exu):
     return sc, mbs, node
 
 
-def exudyn_settings(model: Chain, exu, dense: bool = False):
-    """Exudyn's defaults for generalised-alpha, index 3, at the fixed step ``model.dt``.
+@dataclass(frozen=True)
+class Integration:
+    """The time integration both codes use for a row: generalised-alpha (index 3) with spectral
+    radius ``rho_inf`` at the model's fixed step, and vinculo's Newton mode.
 
-    Spectral radius 0.9 (its default; second order like vinculo's alpha = 1/2, damping only
-    the highest frequencies: with 1.0 Exudyn's index-3 solver fails within the first second
-    on the pendulum and on swinging chains, and 0.99 fails on swinging chains too), its
-    default Newton tolerances (relative 1e-8, absolute 1e-10) and modified Newton, no
-    automatic step size, sparse (or dense) LU, no output written.
+    Attributes:
+        rho_inf: spectral radius at infinite frequency (0.9: Exudyn's default, damping only the
+            highest frequencies; 0: the most damping, still second order).
+        jacobian_reuse: vinculo with modified Newton (Exudyn's default mode) or full Newton.
+    """
+
+    rho_inf: float = 0.9
+    jacobian_reuse: bool = True
+
+    def describe(self) -> str:
+        """One line for the table headers."""
+        newton = "modified" if self.jacobian_reuse else "full"
+        return f"generalised-alpha rho_inf = {self.rho_inf:g}, vinculo with {newton} Newton"
+
+
+#: The comparison rows: Exudyn's defaults, in both codes.
+COMPARISON = Integration(rho_inf=0.9)
+#: The robustness rows (1 m chains released horizontally): the most high-frequency damping.
+ROBUSTNESS = Integration(rho_inf=0.0)
+
+
+def exudyn_settings(model: Chain, exu, dense: bool = False, rho_inf: float = 0.9):
+    """Exudyn's generalised-alpha, index 3, at the fixed step ``model.dt``.
+
+    Spectral radius ``rho_inf`` (0.9 is its default: with 1.0 Exudyn's index-3 solver fails
+    within the first second on the pendulum and on swinging chains, and 0.99 fails on swinging
+    chains too), its default Newton tolerances (relative 1e-8, absolute 1e-10) and modified
+    Newton, no automatic step size, sparse (or dense) LU, no output written.
 
     Arguments:
         model: the run, anything with ``steps``, ``t_end`` and ``dt`` (a :class:`Chain` or a
             :class:`vinculo.bench.buoy.BuoyBench`).
         exu: the ``exudyn`` module.
         dense: Exudyn's dense LU instead of its sparse one.
+        rho_inf: the spectral radius.
     """
     ss = exu.SimulationSettings()
     ti = ss.timeIntegration
@@ -120,7 +146,7 @@ def exudyn_settings(model: Chain, exu, dense: bool = False):
     ti.endTime = model.t_end
     ti.adaptiveStep = False
     ti.verboseMode = 0
-    ti.generalizedAlpha.spectralRadius = 0.9
+    ti.generalizedAlpha.spectralRadius = rho_inf
     ti.generalizedAlpha.useIndex2Constraints = False
     ti.generalizedAlpha.useNewmark = False
     ss.linearSolver.solverType = (

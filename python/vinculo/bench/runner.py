@@ -11,7 +11,14 @@ from dataclasses import dataclass
 import numpy as np
 
 import vinculo
-from vinculo.bench.models import Chain, build_exudyn, build_vinculo, exudyn_settings
+from vinculo.bench.models import (
+    COMPARISON,
+    Chain,
+    Integration,
+    build_exudyn,
+    build_vinculo,
+    exudyn_settings,
+)
 
 
 @dataclass
@@ -36,10 +43,9 @@ class Run:
         return self.steps / self.seconds if self.tip is not None else float("nan")
 
 
-def run_vinculo(model: Chain, repeat: int = 1, jacobian_reuse: bool = False) -> Run:
-    """Best of ``repeat`` runs of vinculo (alpha = 1/2, default tolerance 1e-10 of the length
-    scale), storing only the first and the last state; ``jacobian_reuse`` selects modified
-    Newton (see :func:`vinculo.simulate`)."""
+def run_vinculo(model: Chain, integration: Integration = COMPARISON, repeat: int = 1) -> Run:
+    """Best of ``repeat`` runs of vinculo with ``integration`` (default Newton tolerance, 1e-10
+    of the length scale), storing only the first and the last state."""
     system, tip = build_vinculo(model)
     best = None
     for _ in range(repeat):
@@ -49,9 +55,10 @@ def run_vinculo(model: Chain, repeat: int = 1, jacobian_reuse: bool = False) -> 
                 system,
                 t_end=model.t_end,
                 dt=model.dt,
-                alpha=0.5,
+                scheme="generalized-alpha",
+                rho_inf=integration.rho_inf,
                 save_every=model.steps,
-                jacobian_reuse=jacobian_reuse,
+                jacobian_reuse=integration.jacobian_reuse,
             )
         except vinculo.ConvergenceError as error:
             return Run(time.perf_counter() - start, 0, None, f"failed: {error}")
@@ -69,7 +76,7 @@ def run_vinculo(model: Chain, repeat: int = 1, jacobian_reuse: bool = False) -> 
     return best
 
 
-def run_exudyn(model: Chain, exu, repeat: int = 1) -> Run:
+def run_exudyn(model: Chain, exu, integration: Integration = COMPARISON, repeat: int = 1) -> Run:
     """Best of ``repeat`` runs of Exudyn (see ``exudyn_settings``); for models of at most 100
     coordinates the faster of its dense and sparse LU is kept."""
     dense_options = [False, True] if 3 * model.n <= 100 else [False]
@@ -77,7 +84,7 @@ def run_exudyn(model: Chain, exu, repeat: int = 1) -> Run:
     for dense in dense_options:
         for _ in range(repeat):
             _, mbs, tip = build_exudyn(model, exu)
-            settings = exudyn_settings(model, exu, dense=dense)
+            settings = exudyn_settings(model, exu, dense=dense, rho_inf=integration.rho_inf)
             start = time.perf_counter()
             try:
                 # Exudyn prints its own diagnostics; keep the table readable.
