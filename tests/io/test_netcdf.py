@@ -160,3 +160,15 @@ def test_loading_a_missing_or_foreign_file_is_an_invalid_input(tmp_path):
     (tmp_path / "text.nc").write_text("not netcdf")
     with pytest.raises(vinculo.InvalidInputError, match="cannot read"):
         load_netcdf(tmp_path / "text.nc")
+
+
+def test_the_file_gets_the_usual_permissions(tmp_path):
+    import os
+
+    solution, _ = small_run()
+    umask = os.umask(0o022)
+    try:
+        path = save_netcdf(solution, tmp_path / "run.nc")
+    finally:
+        os.umask(umask)
+    assert path.stat().st_mode & 0o777 == 0o644

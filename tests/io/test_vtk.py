@@ -110,3 +110,16 @@ def test_an_interrupted_export_leaves_nothing(tmp_path, monkeypatch):
     with pytest.raises(OSError, match="disk full"):
         export_vtk(solution, tmp_path / "series")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_files_get_the_usual_permissions(tmp_path):
+    import os
+
+    solution, _ = small_run()
+    umask = os.umask(0o022)
+    try:
+        index = export_vtk(solution, tmp_path / "series", every=100)
+    finally:
+        os.umask(umask)
+    assert (tmp_path / "series").stat().st_mode & 0o777 == 0o755
+    assert index.stat().st_mode & 0o777 == 0o644

@@ -326,8 +326,8 @@ def _scene(
         tie.set_data([q[attachment, 0]], [q[attachment, 2]])
         anchor.set_data([x_t], [0.0])
         label.set_text(
-            f"t = {run.time[k]:7.2f} s\ntank x = {x_t * 1e3:+6.2f} mm\n"
-            f"buoy x = {q[centre, 0] * 1e3:+6.2f} mm"
+            f"t = {run.time[k]:7.2f} s\ntank x = {round(x_t * 1e3, 2) + 0.0:+6.2f} mm\n"
+            f"buoy x = {round(q[centre, 0] * 1e3, 2) + 0.0:+6.2f} mm"
         )
         canvas.restore_region(background)
         for artist in moving:

@@ -19,6 +19,17 @@ from vinculo.errors import InvalidInputError
 __all__ = ["checked_file", "checked_folder", "file_written_in_place", "folder_written_in_place"]
 
 
+def _permissions(path: Path, mode: int) -> None:
+    """Give ``path`` the permissions a new file or folder gets (``mode`` less the umask).
+
+    Temporary files and folders are created private (0600, 0700); the results should be as
+    readable as any other file the user writes.
+    """
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(path, mode & ~umask)
+
+
 def checked_file(path: str | os.PathLike[str], suffixes: tuple[str, ...], what: str) -> Path:
     """Check an output file's path before anything is computed or written.
 
@@ -129,6 +140,7 @@ def file_written_in_place(target: Path) -> Iterator[Path]:
     temporary = Path(name)
     try:
         yield temporary
+        _permissions(temporary, 0o666)
         os.replace(temporary, target)
     finally:
         temporary.unlink(missing_ok=True)
@@ -152,6 +164,7 @@ def folder_written_in_place(target: Path) -> Iterator[Path]:
     temporary = Path(tempfile.mkdtemp(dir=parent, prefix=f".{target.name}.", suffix=".part"))
     try:
         yield temporary
+        _permissions(temporary, 0o777)
         if target.exists():
             old = Path(tempfile.mkdtemp(dir=parent, prefix=f".{target.name}.", suffix=".old"))
             os.replace(target, old / target.name)
