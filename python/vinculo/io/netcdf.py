@@ -52,7 +52,7 @@ from vinculo.io.output import checked_file, file_written_in_place
 from vinculo.io.topology import constraint_kinds
 from vinculo.solution import Solution
 
-__all__ = ["SUFFIXES", "load_netcdf", "save_netcdf", "tensions"]
+__all__ = ["SUFFIXES", "load_netcdf", "save_netcdf", "tensions", "to_dataset"]
 
 #: The accepted suffixes of a NetCDF file.
 SUFFIXES = (".nc", ".nc4")
