@@ -69,3 +69,12 @@ def test_inclined_plane():
     out = run_example("inclined_plane.py")
     assert number_after("acceleration:", out) == pytest.approx(G / 2, rel=1e-9)
     assert number_after("normal force:", out) == pytest.approx(G * np.cos(np.pi / 6), rel=1e-9)
+
+
+def test_result_files(tmp_path):
+    # At rest each link carries the weight of the beads below it: 4 x 0.1 kg x 9.81 at the top.
+    out = run_example("result_files.py", str(tmp_path / "files"), "--beads", "4")
+    assert number_after("top tension from the file:", out) == pytest.approx(4 * 0.1 * G, rel=1e-9)
+    assert number_after("largest tension error:", out) < 1e-9
+    assert (tmp_path / "files" / "chain.nc").is_file()
+    assert (tmp_path / "files" / "chain_vtk" / "state.pvd").is_file()

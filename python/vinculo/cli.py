@@ -5,6 +5,8 @@ Usage::
     vinculo demo [--output DIR]
     vinculo buoy [--output DIR] [--case FILE.toml] [--data FILE.csv] [--tank-motion FILE.csv]
                  [--PARAMETER VALUE ...]
+    vinculo buoy --animate FREQ [--animation-file FILE.gif|FILE.mp4] [--animation-frames N]
+                 [--output DIR] [--case FILE.toml] [--PARAMETER VALUE ...]
 
 ``demo`` runs the four demo models (pendulum, double pendulum, hanging chain, inclined plane),
 prints one line per model comparing the simulation with its reference value, and writes one PNG
@@ -12,7 +14,9 @@ plot per model into DIR (default ``output``).
 
 ``buoy`` runs the buoy study (see :mod:`vinculo.buoy`): every model over the frequency sweep, in
 parallel, and writes CSV tables, figures and a summary into DIR; ``vinculo buoy --help`` lists
-every parameter.
+every parameter. With ``--animate FREQ`` it runs only the particle model at FREQ Hz (for the
+sweep's duration at that frequency, ``(settle_periods + fit_periods) / FREQ``) and writes a side
+view of the run as an animation (default ``DIR/buoy_<FREQ>Hz.gif``).
 
 Exit codes: 0 on success, 1 when a simulation fails, 2 on bad arguments.
 """
@@ -100,6 +104,15 @@ def _add_buoy_parser(commands: Any) -> None:
     buoy.add_argument("--workers", type=int, default=None,
                       help="worker processes (default: one per CPU)")
     buoy.add_argument("--no-progress", action="store_true", help="do not draw a progress bar")
+    buoy.add_argument("--animate", metavar="FREQ", type=float, default=None,
+                      help="instead of the sweep, run the particle model at FREQ Hz and write a "
+                      "side view of the run as an animation")
+    buoy.add_argument("--animation-file", metavar="PATH", type=Path, default=None,
+                      help="the animation's file, .gif or .mp4 (mp4 needs ffmpeg; default: "
+                      "DIR/buoy_<FREQ>Hz.gif)")
+    buoy.add_argument("--animation-frames", metavar="N", type=int, default=250,
+                      help="the most frames, at 25 per simulated second: the animation shows "
+                      "the last N/25 s of the run (default: 250)")
     defaults = [(BuoyCase, "case"), (SweepSettings, "sweep")]
     for cls, table in defaults:
         group = buoy.add_argument_group(f"{table} parameters (override the TOML [{table}] table)")
@@ -170,12 +183,66 @@ def _buoy(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     output: Path = args.output
     if output.exists() and not output.is_dir():
         parser.error(f"--output {str(output)!r} exists and is not a folder")
+    if args.animate is not None:
+        return _buoy_animation(args, parser, case, settings)
     study = run_study(case, settings, models=models, workers=args.workers,
                       progress=not args.no_progress, motions=motions)
     paths = write_report(study, output, data)
     print(summary(study), flush=True)
     print(f"results: {len(paths)} files in {output}", flush=True)
     return 1 if study.failures() else 0
+
+
+def _buoy_animation(
+    args: argparse.Namespace, parser: argparse.ArgumentParser, case: Any, settings: Any
+) -> int:
+    """Run the particle model at args.animate Hz and write the animation of the run."""
+    import math
+
+    from vinculo.buoy.animation import animate_frequency
+    from vinculo.errors import InvalidInputError
+
+    frequency = float(args.animate)
+    if args.tank_motion:
+        parser.error("--animate runs the harmonic excitation; it cannot be combined with "
+                     "--tank-motion")
+    if not (math.isfinite(frequency) and frequency > 0):
+        parser.error(f"--animate {args.animate!r}: give a frequency in Hz greater than 0")
+    if args.animation_frames < 1:
+        parser.error(f"--animation-frames {args.animation_frames}: give a whole number >= 1")
+    path: Path = args.animation_file
+    if path is None:
+        path = args.output / f"buoy_{frequency:g}Hz.gif"
+        try:
+            args.output.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            parser.error(f"cannot create the output folder {str(args.output)!r}: {exc.strerror}")
+    show = not args.no_progress
+
+    def simulated(t: float, t_end: float) -> None:
+        print(f"\rsimulating: t = {t:7.2f} of {t_end:.2f} s", end="", file=sys.stderr,
+              flush=True)
+
+    def rendered(done: int, total: int) -> None:
+        start = "\n" if done == 1 else "\r"
+        end = "\n" if done == total else ""
+        print(f"{start}rendering: frame {done} of {total}", end=end, file=sys.stderr, flush=True)
+
+    t_end = settings.t_end(frequency)
+    try:
+        written, run = animate_frequency(
+            case, frequency, path, t_end=t_end, dt=settings.dt,
+            simulation_progress=simulated if show else None,
+            progress=rendered if show else None,
+            max_frames=args.animation_frames,
+        )
+    except InvalidInputError as exc:
+        parser.error(str(exc))
+    if run.error is not None:
+        print(f"run stopped early at t = {run.time[-1]:.3f} s: {run.error}", flush=True)
+    print(f"animation: {written} ({run.frequency:g} Hz, t = 0 to {run.time[-1]:.2f} s)",
+          flush=True)
+    return 1 if run.error is not None else 0
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -229,6 +229,23 @@ class Solution:
         """
         return self.kinetic_energy() + self.potential_energy()
 
+    def save_netcdf(self, path: Any, *, attributes: dict[str, Any] | None = None) -> Any:
+        """Write this run to a NetCDF4 file (see :func:`vinculo.io.save_netcdf`).
+
+        Arguments:
+            path: the file to write, ending in ``.nc`` or ``.nc4``.
+            attributes: parameters of the run to store as file attributes.
+
+        Returns:
+            The path written (a :class:`pathlib.Path`).
+
+        Raises:
+            InvalidInputError: a bad path or an attribute that cannot be stored.
+        """
+        from vinculo.io.netcdf import save_netcdf
+
+        return save_netcdf(self, path, attributes=attributes)
+
     def summary(self) -> str:
         """A short readable account of the run.
 

@@ -144,6 +144,8 @@ class ParticleRun:
         tension: string tension at the anchor (N), from the link's multiplier.
         solution: the full :class:`vinculo.Solution`.
         error: None, or the exception that stopped the run early (the histories then end there).
+        model: the :class:`BuoyModel` that was simulated (its handles locate the sphere, the
+            string's beads and the attachment in ``solution``).
     """
 
     frequency: float
@@ -155,6 +157,7 @@ class ParticleRun:
     tension: np.ndarray
     solution: vinculo.Solution
     error: vinculo.VinculoError | None = None
+    model: BuoyModel | None = None
 
 
 def run_particle_model(
@@ -212,6 +215,7 @@ def run_particle_model(
         tension=tension,
         solution=solution,
         error=error,
+        model=model,
     )
 
 
