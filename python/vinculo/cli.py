@@ -237,11 +237,19 @@ def _buoy_sweep(args: argparse.Namespace, parser: argparse.ArgumentParser) -> in
     points = grid(axes)
     models = tuple(m.strip() for m in args.models.split(",") if m.strip())
     output = _output_folder(args.output, parser)
-    study = run_parameter_study(
-        points, case=case, settings=settings, models=models, output=output,
-        workers=args.workers, scheduler=args.scheduler, retry_failed=args.retry_failed,
-        progress=not args.no_progress,
-    )
+    try:
+        study = run_parameter_study(
+            points, case=case, settings=settings, models=models, output=output,
+            workers=args.workers, scheduler=args.scheduler, retry_failed=args.retry_failed,
+            progress=not args.no_progress,
+        )
+    except KeyboardInterrupt:
+        print(
+            f"\ninterrupted: the finished runs are in {output / 'study.csv'}; run the same "
+            f"command again to resume",
+            file=sys.stderr,
+        )
+        return 130
     plot = plot_parameter_study(study, output / "study.png")
     failed = study.failures()
     print(

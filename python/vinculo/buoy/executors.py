@@ -62,7 +62,14 @@ def open_executor(
         yield None, "1 process"
         return
     method = "fork" if sys.platform.startswith("linux") else "spawn"
-    with ProcessPoolExecutor(
-        max_workers=workers, mp_context=multiprocessing.get_context(method)
-    ) as pool:
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method))
+    try:
         yield pool, f"{workers} local processes"
+    except BaseException:
+        # Interrupted (Ctrl-C) or failed: stop the runs under way and drop the queued ones
+        # instead of waiting for them (a Ctrl-C may reach this process only, not its workers).
+        for process in list((getattr(pool, "_processes", None) or {}).values()):
+            process.terminate()
+        pool.shutdown(wait=True, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
