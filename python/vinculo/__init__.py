@@ -22,6 +22,7 @@ from vinculo.errors import (
     InvalidInputError,
     NegativeTensionError,
     RedundantConstraintsError,
+    SchedulerError,
     UnknownHandleError,
     VinculoError,
 )
@@ -45,6 +46,7 @@ __all__ = [
     "NegativeTensionError",
     "ParticleId",
     "RedundantConstraintsError",
+    "SchedulerError",
     "Solution",
     "System",
     "UnknownHandleError",

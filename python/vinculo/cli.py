@@ -7,6 +7,8 @@ Usage::
                  [--PARAMETER VALUE ...]
     vinculo buoy --animate FREQ [--animation-file FILE.gif|FILE.mp4] [--animation-frames N]
                  [--output DIR] [--case FILE.toml] [--PARAMETER VALUE ...]
+    vinculo buoy sweep --param NAME=VALUES [...] [--scheduler ADDRESS] [--output DIR]
+    vinculo buoy calibrate --data FILE.csv [--fit NAMES] [--output DIR]
 
 ``demo`` runs the four demo models (pendulum, double pendulum, hanging chain, inclined plane),
 prints one line per model comparing the simulation with its reference value, and writes one PNG
@@ -16,7 +18,9 @@ plot per model into DIR (default ``output``).
 parallel, and writes CSV tables, figures and a summary into DIR; ``vinculo buoy --help`` lists
 every parameter. With ``--animate FREQ`` it runs only the particle model at FREQ Hz (for the
 sweep's duration at that frequency, ``(settle_periods + fit_periods) / FREQ``) and writes a side
-view of the run as an animation (default ``DIR/buoy_<FREQ>Hz.gif``).
+view of the run as an animation (default ``DIR/buoy_<FREQ>Hz.gif``). ``buoy sweep`` runs a
+parameter study (:mod:`vinculo.buoy.parameter_study`) and ``buoy calibrate`` fits the fluid
+coefficients to measurements (:mod:`vinculo.buoy.calibration`).
 
 Exit codes: 0 on success, 1 when a simulation fails, 2 on bad arguments.
 """
@@ -66,10 +70,6 @@ def _build_parser() -> argparse.ArgumentParser:
 
 def _add_buoy_parser(commands: Any) -> None:
     """``vinculo buoy``: every case and sweep parameter as an option."""
-    import dataclasses
-
-    from vinculo.buoy import BuoyCase, SweepSettings
-
     buoy = commands.add_parser(
         "buoy",
         help="the tethered buoy in a shaken tank: amplitude and phase against frequency",
@@ -77,13 +77,13 @@ def _add_buoy_parser(commands: Any) -> None:
             "Simulate the submerged sphere tied to the floor of a shaken water tank with the "
             "particle model and the 1-DOF and 2-DOF reference models over a frequency sweep; "
             "write time histories, amplitude and phase curves, CSV tables and a summary. "
-            "Defaults are the paper's parameters; the table amplitude X0 is an assumption."
+            "Defaults are the paper's parameters; the table amplitude X0 is an assumption. "
+            "See also 'vinculo buoy sweep --help' (parameter studies) and 'vinculo buoy "
+            "calibrate --help' (fitting Cd and Ca to measurements)."
         ),
     )
     buoy.add_argument("--output", "-o", metavar="DIR", type=Path, default=Path("output"),
                       help="folder for the results (default: output)")
-    buoy.add_argument("--case", metavar="FILE.toml", type=Path,
-                      help="TOML file with a [case] and/or [sweep] table; options override it")
     buoy.add_argument("--data", metavar="FILE.csv", type=Path,
                       help="measured frequency, amplitude (m), phase (deg) to plot beside the "
                       "models")
@@ -113,9 +113,22 @@ def _add_buoy_parser(commands: Any) -> None:
     buoy.add_argument("--animation-frames", metavar="N", type=int, default=250,
                       help="the most frames, at 25 per simulated second: the animation shows "
                       "the last N/25 s of the run (default: 250)")
-    defaults = [(BuoyCase, "case"), (SweepSettings, "sweep")]
-    for cls, table in defaults:
-        group = buoy.add_argument_group(f"{table} parameters (override the TOML [{table}] table)")
+    _add_case_options(buoy)
+    buoy.set_defaults(handler=_buoy)
+
+
+def _add_case_options(parser: argparse.ArgumentParser) -> None:
+    """``--case FILE.toml`` and every case and sweep parameter as an option."""
+    import dataclasses
+
+    from vinculo.buoy import BuoyCase, SweepSettings
+
+    parser.add_argument("--case", metavar="FILE.toml", type=Path,
+                        help="TOML file with a [case] and/or [sweep] table; options override it")
+    for cls, table in [(BuoyCase, "case"), (SweepSettings, "sweep")]:
+        group = parser.add_argument_group(
+            f"{table} parameters (override the TOML [{table}] table)"
+        )
         for f in dataclasses.fields(cls):
             if f.name == "tank_size":
                 continue
@@ -124,7 +137,165 @@ def _add_buoy_parser(commands: Any) -> None:
             group.add_argument(option, dest=f"{table}__{f.name}", metavar=f.name.upper(),
                                type=kind if kind in (int, float) else str, default=None,
                                help=f"default: {f.default}")
-    buoy.set_defaults(handler=_buoy)
+
+
+def _case_and_settings(args: argparse.Namespace) -> tuple[Any, Any]:
+    """The BuoyCase and SweepSettings of ``--case`` and the parameter options."""
+    from vinculo.buoy import BuoyCase, SweepSettings, load_study
+
+    case_values: dict[str, Any] = {}
+    sweep_values: dict[str, Any] = {}
+    if args.case is not None:
+        case, sweep = load_study(args.case)
+        case_values, sweep_values = case.to_dict(), sweep.to_dict()
+    for key, value in vars(args).items():
+        if value is None or "__" not in key:
+            continue
+        table, name = key.split("__", 1)
+        (case_values if table == "case" else sweep_values)[name] = value
+    return (
+        BuoyCase.from_mapping(case_values, source="the command line"),
+        SweepSettings.from_mapping(sweep_values, source="the command line"),
+    )
+
+
+def _study_parser() -> argparse.ArgumentParser:
+    """``vinculo buoy sweep``: a parameter study over a grid."""
+    parser = argparse.ArgumentParser(
+        prog="vinculo buoy sweep",
+        description=(
+            "Run the buoy models over a grid of any case parameters (and the frequency) in "
+            "parallel, on local processes or on a Dask cluster. Each run is appended to "
+            "DIR/study.csv as it finishes; running the same command again resumes the study "
+            "without recomputing finished runs. Without a frequency axis every point is swept "
+            "over --f-min/--f-max/--count."
+        ),
+    )
+    parser.add_argument("--param", "-p", metavar="NAME=VALUES", action="append", default=[],
+                        required=True,
+                        help="an axis: NAME=START:STOP:COUNT or NAME=V1,V2,... (repeat for a "
+                        "grid); NAME is a case parameter (drag_coefficient, amplitude, ...), "
+                        "frequency, dt, settle_periods or fit_periods")
+    parser.add_argument("--models", default="particle",
+                        help="comma-separated models to run at each point (default: particle)")
+    parser.add_argument("--output", "-o", metavar="DIR", type=Path,
+                        default=Path("output") / "study",
+                        help="folder of study.csv and the plot (default: output/study)")
+    parser.add_argument("--workers", type=int, default=None,
+                        help="local worker processes (default: one per CPU)")
+    parser.add_argument("--scheduler", metavar="ADDRESS",
+                        help="run on an existing Dask distributed cluster (tcp://host:8786)")
+    parser.add_argument("--retry-failed", action="store_true",
+                        help="run again the points whose earlier run failed")
+    parser.add_argument("--no-progress", action="store_true", help="do not draw a progress bar")
+    _add_case_options(parser)
+    parser.set_defaults(handler=_buoy_sweep)
+    return parser
+
+
+def _calibrate_parser() -> argparse.ArgumentParser:
+    """``vinculo buoy calibrate``: fit Cd and Ca (and more) to measured curves."""
+    parser = argparse.ArgumentParser(
+        prog="vinculo buoy calibrate",
+        description=(
+            "Fit the drag and added-mass coefficients (optionally the string length and the "
+            "table amplitude) so that a buoy model reproduces measured amplitude and phase "
+            "curves, by weighted least squares; report the values with uncertainties and plot "
+            "the fitted curves over the data."
+        ),
+    )
+    parser.add_argument("--data", metavar="FILE.csv", type=Path, required=True,
+                        help="measured frequency (Hz), amplitude (m), phase (deg), optionally "
+                        "amplitude_sd and phase_sd columns (standard uncertainties)")
+    parser.add_argument("--data-motion", choices=("absolute", "relative"), default="absolute",
+                        help="whether the data are of the absolute or the relative motion")
+    parser.add_argument("--fit", default="drag_coefficient,added_mass_coefficient",
+                        help="comma-separated parameters to fit (default: "
+                        "drag_coefficient,added_mass_coefficient; also string_length, "
+                        "amplitude)")
+    parser.add_argument("--model", default="particle",
+                        help="the model to fit: particle, two-dof or one-dof (default: particle)")
+    parser.add_argument("--max-evaluations", type=int, default=60,
+                        help="most model sweeps the optimiser may run (default: 60)")
+    parser.add_argument("--output", "-o", metavar="DIR", type=Path,
+                        default=Path("output") / "calibration",
+                        help="folder for the results (default: output/calibration)")
+    parser.add_argument("--workers", type=int, default=None,
+                        help="local worker processes (default: one per CPU)")
+    parser.add_argument("--scheduler", metavar="ADDRESS",
+                        help="run on an existing Dask distributed cluster (tcp://host:8786)")
+    parser.add_argument("--no-progress", action="store_true", help="print no progress lines")
+    _add_case_options(parser)
+    parser.set_defaults(handler=_buoy_calibrate)
+    return parser
+
+
+def _output_folder(output: Path, parser: argparse.ArgumentParser) -> Path:
+    """Create the output folder, or stop with a usage error naming it."""
+    if output.exists() and not output.is_dir():
+        parser.error(f"--output {str(output)!r} exists and is not a folder")
+    try:
+        output.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        parser.error(f"cannot create the output folder {str(output)!r}: {exc.strerror}")
+    return output
+
+
+def _buoy_sweep(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
+    """Run a parameter study and write its table and plot."""
+    from vinculo.buoy.parameter_study import grid, parse_axis, run_parameter_study
+    from vinculo.buoy.report import plot_parameter_study
+
+    case, settings = _case_and_settings(args)
+    axes = dict(parse_axis(text) for text in args.param)
+    points = grid(axes)
+    models = tuple(m.strip() for m in args.models.split(",") if m.strip())
+    output = _output_folder(args.output, parser)
+    try:
+        study = run_parameter_study(
+            points, case=case, settings=settings, models=models, output=output,
+            workers=args.workers, scheduler=args.scheduler, retry_failed=args.retry_failed,
+            progress=not args.no_progress,
+        )
+    except KeyboardInterrupt:
+        print(
+            f"\ninterrupted: the finished runs are in {output / 'study.csv'}; run the same "
+            f"command again to resume",
+            file=sys.stderr,
+        )
+        return 130
+    plot = plot_parameter_study(study, output / "study.png")
+    failed = study.failures()
+    print(
+        f"{len(study.rows)} runs ({study.computed} computed, {study.reused} reused from "
+        f"{study.path}) in {study.elapsed:.1f} s on {study.workers}; {len(failed)} failed",
+        flush=True,
+    )
+    for row in failed:
+        print(f"FAILED {row.model} {row.parameters}: {row.error}", flush=True)
+    print(f"results: {study.path}" + (f", {plot}" if plot else ""), flush=True)
+    return 1 if failed else 0
+
+
+def _buoy_calibrate(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
+    """Fit the requested parameters to the data and write the results."""
+    from vinculo.buoy import read_measurements
+    from vinculo.buoy.calibration import calibrate
+    from vinculo.buoy.report import write_calibration
+
+    case, settings = _case_and_settings(args)
+    data = read_measurements(args.data, motion=args.data_motion)
+    names = [n.strip() for n in args.fit.split(",") if n.strip()]
+    output = _output_folder(args.output, parser)
+    result = calibrate(
+        data, case=case, settings=settings, parameters=names, model=args.model,
+        workers=args.workers, scheduler=args.scheduler, max_evaluations=args.max_evaluations,
+        progress=not args.no_progress,
+    )
+    paths = write_calibration(result, output)
+    print(result.summary(), flush=True)
+    print(f"results: {len(paths)} files in {output}", flush=True)
+    return 0 if result.success else 1
 
 
 def _demo(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
@@ -155,28 +326,11 @@ def _demo(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
 
 def _buoy(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     """Run the buoy study and write its report into args.output."""
-    from vinculo.buoy import (
-        BuoyCase,
-        SweepSettings,
-        load_study,
-        read_measurements,
-        read_tank_motion,
-    )
+    from vinculo.buoy import read_measurements, read_tank_motion
     from vinculo.buoy.report import summary, write_report
     from vinculo.buoy.study import run_study
 
-    case_values: dict[str, Any] = {}
-    sweep_values: dict[str, Any] = {}
-    if args.case is not None:
-        case, sweep = load_study(args.case)
-        case_values, sweep_values = case.to_dict(), sweep.to_dict()
-    for key, value in vars(args).items():
-        if value is None or "__" not in key:
-            continue
-        table, name = key.split("__", 1)
-        (case_values if table == "case" else sweep_values)[name] = value
-    case = BuoyCase.from_mapping(case_values, source="the command line")
-    settings = SweepSettings.from_mapping(sweep_values, source="the command line")
+    case, settings = _case_and_settings(args)
     data = read_measurements(args.data, motion=args.data_motion) if args.data else None
     motions = [read_tank_motion(p, smoothing=args.tank_smoothing) for p in args.tank_motion]
     models = tuple(m.strip() for m in args.models.split(",") if m.strip())
@@ -257,7 +411,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     Raises:
         SystemExit: with code 2 on bad arguments (from argparse), or 0 after ``--help``.
     """
-    parser = _build_parser()
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:2] in (["buoy", "sweep"], ["buoy", "calibrate"]):
+        parser = _study_parser() if argv[1] == "sweep" else _calibrate_parser()
+        argv = argv[2:]
+    else:
+        parser = _build_parser()
     args = parser.parse_args(argv)
     try:
         return int(args.handler(args, parser))

@@ -21,6 +21,7 @@ __all__ = [
     "InvalidInputError",
     "NegativeTensionError",
     "RedundantConstraintsError",
+    "SchedulerError",
     "UnknownHandleError",
     "VinculoError",
 ]
@@ -112,6 +113,17 @@ class RedundantConstraintsError(InvalidInputError):
     index: int | None = None
     depends_on: list[str] | None = None
     depends_on_indices: list[int] | None = None
+
+
+class SchedulerError(VinculoError, ConnectionError):
+    """A Dask distributed scheduler cannot be used.
+
+    Raised by parameter studies given a scheduler address that cannot be reached (or when the
+    ``distributed`` package is not installed). Nothing has run; the message names the address.
+
+    Attributes:
+        address: the scheduler address given.
+    """
 
 
 class NegativeTensionError(VinculoError, RuntimeError):

@@ -8,9 +8,13 @@
   from CSV and smoothed by a spline;
 - :mod:`vinculo.buoy.harmonic`: steady-state amplitude and phase by least squares over
   whole periods;
-- :mod:`vinculo.buoy.data`: reading measured amplitude and phase curves from CSV.
+- :mod:`vinculo.buoy.data`: reading measured amplitude and phase curves from CSV;
+- :mod:`vinculo.buoy.parameter_study`: any parameters over a grid, in parallel (local processes
+  or a Dask cluster), resumable;
+- :mod:`vinculo.buoy.calibration`: fitting Cd and Ca (and more) to measured curves.
 """
 
+from vinculo.buoy.calibration import CALIBRATABLE, Calibration, calibrate
 from vinculo.buoy.case import (
     ASSUMPTIONS,
     ATTACHMENTS,
@@ -30,6 +34,12 @@ from vinculo.buoy.harmonic import (
     steady_window,
     wrap_phase,
 )
+from vinculo.buoy.parameter_study import (
+    ParameterStudy,
+    grid,
+    parse_axis,
+    run_parameter_study,
+)
 from vinculo.buoy.reference import (
     OneDofModel,
     ReferenceRun,
@@ -48,28 +58,35 @@ from vinculo.buoy.tank import (
 __all__ = [
     "ASSUMPTIONS",
     "ATTACHMENTS",
+    "CALIBRATABLE",
     "COLUMNS",
     "MOTIONS",
     "MOTION_COLUMNS",
     "PHASE_CONVENTION",
     "BuoyCase",
+    "Calibration",
     "HarmonicFit",
     "MeasuredTankMotion",
     "Measurements",
     "OneDofModel",
+    "ParameterStudy",
     "ReferenceRun",
     "SteadyResponse",
     "SweepSettings",
     "TankMotion",
     "TwoDofModel",
     "antiresonance_frequency",
+    "calibrate",
     "fit_harmonic",
+    "grid",
     "high_frequency_ratio",
     "load_case",
     "load_study",
     "load_sweep",
+    "parse_axis",
     "read_measurements",
     "read_tank_motion",
+    "run_parameter_study",
     "steady_response",
     "steady_window",
     "tank_motion",

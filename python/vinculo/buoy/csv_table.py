@@ -73,13 +73,20 @@ def _is_number(field: str) -> bool:
 
 
 def read_table(
-    path: str | Path, columns: tuple[str, ...], *, what: str, name: str = "data"
+    path: str | Path,
+    columns: tuple[str, ...],
+    *,
+    what: str,
+    name: str = "data",
+    optional: tuple[str, ...] = (),
 ) -> Table:
     """Read the required ``columns`` of a CSV file (format in the module docstring).
 
     Arguments:
         path: the CSV file.
         columns: the required column names, in their order for a file without a header.
+        optional: columns read when a header names them (NaN otherwise, and in empty fields);
+            they follow the required ones in :attr:`Table.values`.
         what: what the file is, for messages (``"measurement file"``).
         name: the ``name`` of the errors raised (the option or argument that gave the file).
 
@@ -127,7 +134,7 @@ def read_table(
                     f"the {len(columns)} columns in that order",
                     path, number, name,
                 )
-            indices = {c: names.index(c) for c in columns}
+            indices = {c: names.index(c) for c in (*columns, *optional) if c in names}
             width = len(fields)
             continue
         if len(fields) != width:
@@ -137,7 +144,10 @@ def read_table(
             )
         order = indices or {c: k for k, c in enumerate(columns)}
         values = []
-        for column in columns:
+        for column in (*columns, *optional):
+            if column not in order or (column in optional and not fields[order[column]]):
+                values.append(math.nan)
+                continue
             field = fields[order[column]]
             try:
                 value = float(field)

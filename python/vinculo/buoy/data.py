@@ -8,6 +8,9 @@ frequency with three comma-separated columns:
 - ``phase``, in degrees, in the convention of :data:`vinculo.buoy.harmonic.PHASE_CONVENTION`
   (phase lead of the buoy over the tank).
 
+Two optional columns, named in a header, give each value's standard uncertainty (used as weights
+by :mod:`vinculo.buoy.calibration`): ``amplitude_sd`` (m) and ``phase_sd`` (degrees).
+
 An optional header row names the columns (``frequency``, ``amplitude``, ``phase`` in any order,
 any letter case; a unit in parentheses or brackets, as in ``frequency (Hz)``, is allowed; other
 columns are ignored). Without a header the three columns come in that order. Anything after ``#``
@@ -21,6 +24,7 @@ on a line is a comment; blank lines are skipped::
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -29,13 +33,15 @@ import numpy as np
 from vinculo.buoy.csv_table import read_table
 from vinculo.errors import InvalidInputError
 
-__all__ = ["COLUMNS", "MOTIONS", "Measurements", "read_measurements"]
+__all__ = ["COLUMNS", "MOTIONS", "UNCERTAINTY_COLUMNS", "Measurements", "read_measurements"]
 
 #: The required columns, in their order when the file has no header.
 COLUMNS = ("frequency", "amplitude", "phase")
 #: What the measured amplitude and phase describe: the buoy's displacement in the laboratory, or
 #: relative to the tank.
 MOTIONS = ("absolute", "relative")
+#: Optional columns: standard uncertainties of the amplitude (m) and the phase (degrees).
+UNCERTAINTY_COLUMNS = ("amplitude_sd", "phase_sd")
 
 
 @dataclass(frozen=True)
@@ -48,6 +54,8 @@ class Measurements:
         phase_deg: its phase lead over the tank, in degrees.
         motion: ``"absolute"`` (laboratory frame) or ``"relative"`` (to the tank).
         path: the file they were read from.
+        amplitude_sd: standard uncertainty of each amplitude, in m (NaN: not given).
+        phase_sd: standard uncertainty of each phase, in degrees (NaN: not given).
     """
 
     frequency: np.ndarray
@@ -55,6 +63,13 @@ class Measurements:
     phase_deg: np.ndarray
     motion: str
     path: str
+    amplitude_sd: np.ndarray | None = None
+    phase_sd: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        for name in UNCERTAINTY_COLUMNS:
+            if getattr(self, name) is None:
+                object.__setattr__(self, name, np.full(self.frequency.shape, np.nan))
 
 
 def read_measurements(path: str | Path, motion: str = "absolute") -> Measurements:
@@ -80,8 +95,8 @@ def read_measurements(path: str | Path, motion: str = "absolute") -> Measurement
             name="motion",
             value=motion,
         )
-    table = read_table(path, COLUMNS, what="measurement file")
-    frequency, amplitude, phase = table.values.T
+    table = read_table(path, COLUMNS, what="measurement file", optional=UNCERTAINTY_COLUMNS)
+    frequency, amplitude, phase, amplitude_sd, phase_sd = table.values.T
     for row in range(len(frequency)):
         if frequency[row] <= 0.0:
             raise table.error(row, f"frequency {frequency[row]:g} Hz must be positive")
@@ -91,10 +106,15 @@ def read_measurements(path: str | Path, motion: str = "absolute") -> Measurement
                 f"amplitude {amplitude[row]:g} m must not be negative (give the phase to say the "
                 f"direction)",
             )
+        for label, sd in (("amplitude_sd", amplitude_sd[row]), ("phase_sd", phase_sd[row])):
+            if not (math.isnan(sd) or sd > 0.0):
+                raise table.error(row, f"{label} {sd:g} must be positive (or left empty)")
     return Measurements(
         frequency=frequency.copy(),
         amplitude=amplitude.copy(),
         phase_deg=phase.copy(),
         motion=motion,
         path=str(path),
+        amplitude_sd=amplitude_sd.copy(),
+        phase_sd=phase_sd.copy(),
     )

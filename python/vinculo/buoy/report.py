@@ -5,15 +5,25 @@ and a printed summary."""
 from __future__ import annotations
 
 import csv
+import os
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
+import numpy as np
+
+from vinculo.buoy.calibration import Calibration
 from vinculo.buoy.case import ASSUMPTIONS
 from vinculo.buoy.data import Measurements
 from vinculo.buoy.harmonic import PHASE_CONVENTION
+from vinculo.buoy.parameter_study import ParameterStudy
 from vinculo.buoy.reference import OneDofModel, TwoDofModel
 from vinculo.buoy.study import LABELS, MODELS, StudyResult
 
-__all__ = ["summary", "write_report"]
+__all__ = ["plot_parameter_study", "summary", "write_calibration", "write_report"]
+
+#: Most curves a parameter-study plot draws (the CSV holds every run).
+_MAX_CURVES = 12
 
 _STYLE = {
     "particle": {"color": "C0", "marker": "o", "linestyle": "-"},
@@ -261,4 +271,149 @@ def write_report(
     text = summary(study)
     (output / "summary.txt").write_text(text + "\n")
     written.append(output / "summary.txt")
+    return written
+
+
+def _replace_atomically(path: Path, write: Callable[[Path], None]) -> Path:
+    """Write ``path`` through a temporary file in the same folder, renamed when complete, so
+    that an interrupted write never leaves a file that looks finished."""
+    temporary = path.with_name(f".{path.name}.partial")
+    try:
+        write(temporary)
+        os.replace(temporary, path)
+    finally:
+        temporary.unlink(missing_ok=True)
+    return path
+
+
+def plot_parameter_study(study: ParameterStudy, path: Path) -> Path | None:
+    """Relative amplitude and phase against frequency, one curve per combination of the other
+    parameters (and model), for a study with a frequency axis and successful runs.
+
+    Arguments:
+        study: the result of :func:`vinculo.buoy.parameter_study.run_parameter_study`.
+        path: the PNG file.
+
+    Returns:
+        The path written, or None when there is nothing to plot.
+    """
+    ok = [r for r in study.rows if r.status == "ok"]
+    if "frequency" not in study.names or not ok:
+        return None
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    others = [n for n in study.names if n != "frequency"]
+    curves: dict[tuple[Any, ...], list[Any]] = {}
+    for r in ok:
+        curves.setdefault((r.model, *(r.parameters[n] for n in others)), []).append(r)
+    fig, axes = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
+    shown = sorted(curves.items(), key=lambda kv: tuple(map(str, kv[0])))[:_MAX_CURVES]
+    for key, rows in shown:
+        rows.sort(key=lambda r: r.parameters["frequency"])
+        f = [r.parameters["frequency"] for r in rows]
+        label = ", ".join(
+            [key[0]] + [f"{n} = {v:g}" if isinstance(v, float) else f"{n} = {v}"
+                        for n, v in zip(others, key[1:], strict=True)]
+        )
+        axes[0].plot(f, [r.results["relative_amplitude"] * 1e3 for r in rows], "o-", ms=3,
+                     label=label)
+        axes[1].plot(f, [r.results["relative_phase_deg"] for r in rows], "o-", ms=3)
+    axes[0].set_ylabel("relative amplitude (mm)")
+    axes[1].set_ylabel("relative phase (deg)")
+    axes[1].set_xlabel("excitation frequency (Hz)")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=7)
+    more = len(curves) - len(shown)
+    fig.suptitle(
+        f"parameter study: {len(ok)} runs" + (f" ({more} more curves not drawn)" if more else ""),
+        fontsize=10,
+    )
+    fig.tight_layout()
+    _replace_atomically(path, lambda p: fig.savefig(p, dpi=120, format="png"))
+    plt.close(fig)
+    return path
+
+
+def write_calibration(result: Calibration, output: Path) -> list[Path]:
+    """Write a calibration's tables, plot and summary into ``output``.
+
+    Files: ``calibration.csv`` (each parameter's start, fitted value and uncertainty),
+    ``calibration_curves.csv`` (the data with their weights and the starting and fitted model at
+    each measured frequency), ``calibration.png`` (both over the data, with error bars),
+    ``calibration.txt`` (the printed summary). Each file is written whole or not at all.
+
+    Returns:
+        The paths written.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    output.mkdir(parents=True, exist_ok=True)
+
+    def parameters(path: Path) -> None:
+        with path.open("w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(["parameter", "initial", "fitted", "standard_uncertainty"])
+            for row in zip(result.names, result.initial, result.values, result.uncertainties,
+                           strict=True):
+                w.writerow([row[0], *(repr(float(x)) for x in row[1:])])
+
+    data = result.data
+    motion = data.motion
+
+    def curves(path: Path) -> None:
+        with path.open("w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow([
+                "frequency_hz", f"measured_{motion}_amplitude_m", "amplitude_sd_m",
+                f"measured_{motion}_phase_deg", "phase_sd_deg", "initial_amplitude_m",
+                "initial_phase_deg", "fitted_amplitude_m", "fitted_phase_deg",
+            ])
+            columns = (data.frequency, data.amplitude, data.amplitude_sd, data.phase_deg,
+                       data.phase_sd, result.initial_amplitude, result.initial_phase_deg,
+                       result.fitted_amplitude, result.fitted_phase_deg)
+            for row in zip(*columns, strict=True):
+                w.writerow([repr(float(x)) for x in row])
+
+    fig, axes = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
+    order = np.argsort(data.frequency)
+    f = data.frequency[order]
+    for ax, measured, sd, start, fitted, scale, unit in (
+        (axes[0], data.amplitude, data.amplitude_sd, result.initial_amplitude,
+         result.fitted_amplitude, 1e3, "amplitude (mm)"),
+        (axes[1], data.phase_deg, data.phase_sd, result.initial_phase_deg,
+         result.fitted_phase_deg, 1.0, "phase (deg)"),
+    ):
+        errors = np.nan_to_num(sd[order]) * scale
+        ax.errorbar(f, measured[order] * scale, yerr=errors, fmt="ks", ms=4, capsize=2,
+                    label=LABELS["measured"])
+        ax.plot(f, start[order] * scale, ":", color="0.5", label="model, starting values")
+        ax.plot(f, fitted[order] * scale, "o-", color="C0", ms=3, label="model, fitted")
+        ax.set_ylabel(f"{motion} {unit}")
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8)
+    axes[1].set_xlabel("excitation frequency (Hz)")
+    fitted_text = ", ".join(
+        f"{n} = {v:.4g} +- {s:.2g}"
+        for n, v, s in zip(result.names, result.values, result.uncertainties, strict=True)
+    )
+    fig.suptitle(f"calibration of the {result.model} model: {fitted_text}", fontsize=9)
+    fig.tight_layout()
+    written = [
+        _replace_atomically(output / "calibration.csv", parameters),
+        _replace_atomically(output / "calibration_curves.csv", curves),
+        _replace_atomically(
+            output / "calibration.png", lambda p: fig.savefig(p, dpi=120, format="png")
+        ),
+        _replace_atomically(
+            output / "calibration.txt", lambda p: p.write_text(result.summary() + "\n")
+        ),
+    ]
+    plt.close(fig)
     return written
