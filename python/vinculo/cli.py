@@ -217,6 +217,9 @@ def _calibrate_parser() -> argparse.ArgumentParser:
                         help="the model to fit: particle, two-dof or one-dof (default: particle)")
     parser.add_argument("--max-evaluations", type=int, default=60,
                         help="most model sweeps the optimiser may run (default: 60)")
+    parser.add_argument("--curve-points", type=int, default=21,
+                        help="frequencies of the fitted curve drawn over the data (default: 21; "
+                        "0: only at the measured frequencies)")
     parser.add_argument("--output", "-o", metavar="DIR", type=Path,
                         default=Path("output") / "calibration",
                         help="folder for the results (default: output/calibration)")
@@ -290,7 +293,7 @@ def _buoy_calibrate(args: argparse.Namespace, parser: argparse.ArgumentParser) -
     result = calibrate(
         data, case=case, settings=settings, parameters=names, model=args.model,
         workers=args.workers, scheduler=args.scheduler, max_evaluations=args.max_evaluations,
-        progress=not args.no_progress,
+        curve_points=args.curve_points, progress=not args.no_progress,
     )
     paths = write_calibration(result, output)
     print(result.summary(), flush=True)

@@ -86,6 +86,7 @@ def test_cli_calibrate_writes_results(tmp_path, capsys):
         "buoy", "calibrate", "--data", str(path), "--fit", "drag_coefficient",
         "--settle-periods", "10", "--fit-periods", "4", "--dt", "5e-3",
         "--added-mass-coefficient", "0.7", "-o", str(output), "--no-progress",
+        "--curve-points", "3",
     ])
     assert code == 0
     rows = (output / "calibration.csv").read_text().splitlines()
@@ -93,6 +94,12 @@ def test_cli_calibrate_writes_results(tmp_path, capsys):
     assert name == "drag_coefficient" and float(start) == 0.22
     assert abs(float(value) - TRUE["drag_coefficient"]) < 3.0 * float(sd)
     assert (output / "calibration.png").is_file()
+    # the fitted curve at the measured ends equals the fitted model there (same runs)
+    curve = (output / "calibration_fitted_curve.csv").read_text().splitlines()[1:]
+    assert len(curve) == 3
+    fitted = (output / "calibration_curves.csv").read_text().splitlines()[1:]
+    first = {float(r.split(",")[0]): float(r.split(",")[7]) for r in fitted}
+    assert float(curve[0].split(",")[1]) == pytest.approx(first[0.7], rel=1e-12)
     assert not list(output.glob(".*partial"))
     assert "drag_coefficient" in capsys.readouterr().out
     assert math.isfinite(float(sd))

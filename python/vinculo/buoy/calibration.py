@@ -72,6 +72,8 @@ class Calibration:
         data: the measurements.
         fitted_amplitude, fitted_phase_deg: the fitted model at the measured frequencies.
         initial_amplitude, initial_phase_deg: the starting model there.
+        curve_frequency, curve_amplitude, curve_phase_deg: the fitted model on an even grid over
+            the measured range (for the plot; empty when ``curve_points`` was 0).
         evaluations: model sweeps run (each: one run per measured frequency).
         success: whether the optimiser reported convergence; ``message`` says why it stopped.
         elapsed: wall time, in s.
@@ -97,6 +99,9 @@ class Calibration:
     message: str = ""
     elapsed: float = 0.0
     log: list[str] = field(default_factory=list)
+    curve_frequency: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    curve_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    curve_phase_deg: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def reduced_chi_square(self) -> float:
@@ -188,6 +193,7 @@ def calibrate(
     workers: int | None = None,
     scheduler: str | None = None,
     max_evaluations: int = 60,
+    curve_points: int = 21,
     progress: bool | Callable[[str], None] = True,
     stream: IO[str] | None = None,
 ) -> Calibration:
@@ -203,6 +209,8 @@ def calibrate(
         workers: local worker processes (default: one per CPU).
         scheduler: a Dask distributed scheduler address to run on instead.
         max_evaluations: most model sweeps the optimiser may ask for.
+        curve_points: frequencies of the fitted curve drawn over the data, evenly spread over
+            the measured range (one more sweep; 0: none).
         progress: True prints one line per model sweep on ``stream`` (standard error); a
             callable receives each line.
         stream: where progress goes.
@@ -310,6 +318,15 @@ def calibrate(
             x_scale=1.0,
         )
         fitted_amplitude, fitted_phase = evaluate(result.x)
+        curve_frequency = np.linspace(
+            float(np.min(data.frequency)), float(np.max(data.frequency)), max(curve_points, 0)
+        )
+        curve_amplitude, curve_phase = (
+            model_curve(case_at(result.x), settings, curve_frequency, model=model,
+                        motion=data.motion, pool=pool)
+            if curve_points > 0
+            else (np.zeros(0), np.zeros(0))
+        )
     values = result.x * scale
     chi_square = float(np.sum(result.fun**2))
     dof = m - len(names)
@@ -344,6 +361,9 @@ def calibrate(
         message=str(result.message),
         elapsed=time.perf_counter() - started,
         log=log,
+        curve_frequency=curve_frequency,
+        curve_amplitude=curve_amplitude,
+        curve_phase_deg=curve_phase,
     )
 
 

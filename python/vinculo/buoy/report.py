@@ -343,7 +343,8 @@ def write_calibration(result: Calibration, output: Path) -> list[Path]:
 
     Files: ``calibration.csv`` (each parameter's start, fitted value and uncertainty),
     ``calibration_curves.csv`` (the data with their weights and the starting and fitted model at
-    each measured frequency), ``calibration.png`` (both over the data, with error bars),
+    each measured frequency), ``calibration_fitted_curve.csv`` (the fitted model on an even
+    frequency grid, when computed), ``calibration.png`` (both over the data, with error bars),
     ``calibration.txt`` (the printed summary). Each file is written whole or not at all.
 
     Returns:
@@ -381,20 +382,33 @@ def write_calibration(result: Calibration, output: Path) -> list[Path]:
             for row in zip(*columns, strict=True):
                 w.writerow([repr(float(x)) for x in row])
 
+    def fitted_curve(path: Path) -> None:
+        with path.open("w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(["frequency_hz", f"fitted_{motion}_amplitude_m", "fitted_phase_deg"])
+            for row in zip(result.curve_frequency, result.curve_amplitude,
+                           result.curve_phase_deg, strict=True):
+                w.writerow([repr(float(x)) for x in row])
+
     fig, axes = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
     order = np.argsort(data.frequency)
     f = data.frequency[order]
-    for ax, measured, sd, start, fitted, scale, unit in (
+    for ax, measured, sd, start, fitted, curve, scale, unit in (
         (axes[0], data.amplitude, data.amplitude_sd, result.initial_amplitude,
-         result.fitted_amplitude, 1e3, "amplitude (mm)"),
+         result.fitted_amplitude, result.curve_amplitude, 1e3, "amplitude (mm)"),
         (axes[1], data.phase_deg, data.phase_sd, result.initial_phase_deg,
-         result.fitted_phase_deg, 1.0, "phase (deg)"),
+         result.fitted_phase_deg, result.curve_phase_deg, 1.0, "phase (deg)"),
     ):
         errors = np.nan_to_num(sd[order]) * scale
         ax.errorbar(f, measured[order] * scale, yerr=errors, fmt="ks", ms=4, capsize=2,
                     label=LABELS["measured"])
         ax.plot(f, start[order] * scale, ":", color="0.5", label="model, starting values")
-        ax.plot(f, fitted[order] * scale, "o-", color="C0", ms=3, label="model, fitted")
+        if len(curve):
+            ax.plot(result.curve_frequency, curve * scale, "-", color="C0", lw=1.2,
+                    label="model, fitted")
+            ax.plot(f, fitted[order] * scale, "o", color="C0", ms=3)
+        else:
+            ax.plot(f, fitted[order] * scale, "o-", color="C0", ms=3, label="model, fitted")
         ax.set_ylabel(f"{motion} {unit}")
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=8)
@@ -408,6 +422,8 @@ def write_calibration(result: Calibration, output: Path) -> list[Path]:
     written = [
         _replace_atomically(output / "calibration.csv", parameters),
         _replace_atomically(output / "calibration_curves.csv", curves),
+        *([_replace_atomically(output / "calibration_fitted_curve.csv", fitted_curve)]
+          if len(result.curve_frequency) else []),
         _replace_atomically(
             output / "calibration.png", lambda p: fig.savefig(p, dpi=120, format="png")
         ),
