@@ -29,7 +29,7 @@ def _run(n: int):
 
 
 def _check(n: int) -> None:
-    model, solution, tip = _run(n)
+    _model, solution, _tip = _run(n)
     assert solution.success
     np.testing.assert_allclose(solution.step_sizes[1:], 1e-3, rtol=1e-9)  # no step was halved
     # lengths hold to the Newton tolerance (1e-10 of the model's length scale)
