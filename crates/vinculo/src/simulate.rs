@@ -73,11 +73,13 @@ impl Default for SimulationOptions {
 }
 
 /// Default of [`SimulationOptions::parallel_from`]: the number of free particles from which
-/// parallel assembly paid in whole steps on two cores. Measured on hanging and swinging chains
-/// (`benches/scaling.rs` with `serial` / `parallel`): at 10^6 particles a step took 18-27 % less
-/// time, at 300,000 up to 8 % less (or the same), at 100,000 and fewer the same or more (the
-/// residual's per-element buffers and the threads' start and wake-up cost about what two
-/// cores save, and the rest of the step, the linear solve above all, is serial).
+/// parallel assembly did not cost time in whole steps on two cores (shared with other work).
+/// Measured on chains (`benches/scaling.rs` with `serial` / `parallel`, repeated): at 10^6
+/// particles a hanging chain's step took 10-27 % less time, a swinging chain's between 18 %
+/// less and 5 % more; at 300,000 the same to 8 % less; at 100,000 and fewer the same or more.
+/// The assembly alone (`benches/kernels.rs`, `assembly`) is 20-27 % faster from 100,000 on, but
+/// it is a quarter to a half of a step and the rest (the linear solve above all) is serial,
+/// while the residual's per-element buffers and the threads' wake-ups cost a share of the gain.
 pub const PARALLEL_FROM: usize = 300_000;
 
 /// Receives progress and may stop a run.
