@@ -8,7 +8,8 @@
 //!   refill), for chains of 1,000 and 100,000 point masses. The step's problem is reached through
 //!   [`GeneralizedTrapezoidal::step`] with a linear solver that does nothing (returns a zero
 //!   increment), so only the assembly is timed; the Jacobian alone is roughly the difference of
-//!   the two rows minus one residual.
+//!   the two rows minus one residual. The `parallel` rows are the same on rayon's thread pool
+//!   (`StepWorkspace::assemble_in_parallel_from` with threshold 0).
 //! - `factor+solve`: factorisation of the step's iteration matrix and one solve, with the values
 //!   of a real first Newton iteration: tree elimination (chains of 1,000 and 100,000), dense LU
 //!   (a ring of 10 particles hung from a fixed point: a loop, 41 unknowns) and the general sparse
@@ -167,13 +168,19 @@ fn assembly(c: &mut Criterion) {
     for n in [1_000, 100_000] {
         let system = chain(n);
         let start = Start::initial(&system);
-        let (mut ws, _) = recording_workspace(&system, SparseSolver::Auto);
-        group.bench_function(BenchmarkId::new("residual", n), |b| {
-            b.iter(|| start.assemble(black_box(&system), &mut ws, 0))
-        });
-        group.bench_function(BenchmarkId::new("residual+jacobian", n), |b| {
-            b.iter(|| start.assemble(black_box(&system), &mut ws, 1))
-        });
+        for path in ["", " parallel"] {
+            let (mut ws, _) = recording_workspace(&system, SparseSolver::Auto);
+            if !path.is_empty() {
+                ws.assemble_in_parallel_from(&system, 0);
+            }
+            group.bench_function(BenchmarkId::new(format!("residual{path}"), n), |b| {
+                b.iter(|| start.assemble(black_box(&system), &mut ws, 0))
+            });
+            group.bench_function(
+                BenchmarkId::new(format!("residual+jacobian{path}"), n),
+                |b| b.iter(|| start.assemble(black_box(&system), &mut ws, 1)),
+            );
+        }
     }
     group.finish();
 }

@@ -3,7 +3,9 @@
 //!
 //! Run with `cargo bench -p vinculo --bench scaling` (all sizes, each in its own process so
 //! that the peak resident memory, VmHWM, is that of one size) or
-//! `cargo bench -p vinculo --bench scaling -- N [swinging]` for one size. The time per step is
+//! `cargo bench -p vinculo --bench scaling -- N [swinging]` for one size. A further argument
+//! `serial` or `parallel` forces the assembly's path (`SimulationOptions::parallel_from` at
+//! `usize::MAX` or 0; by default the options' threshold decides). The time per step is
 //! measured between the first and the last accepted step (model analysis excluded); a run
 //! stores only its first and last states. Prints the fitted exponent of time per step against N.
 
@@ -49,13 +51,14 @@ fn peak_memory_mb() -> f64 {
 }
 
 /// One size, in this process: prints "N seconds_per_step iterations_per_step peak_MB solver".
-fn one(n: usize, hanging: bool) {
+fn one(n: usize, hanging: bool, parallel_from: usize) {
     let steps = (2_000_000 / n).clamp(6, 200);
     let system = chain(n, hanging);
     let options = SimulationOptions {
         t_end: steps as f64 * 1e-3,
         dt: 1e-3,
         save_every: usize::MAX,
+        parallel_from,
         ..Default::default()
     };
     let mut clock = Clock(Vec::with_capacity(steps + 1));
@@ -76,13 +79,21 @@ fn main() {
         .skip(1)
         .filter(|a| a != "--bench")
         .collect();
+    let has = |word: &str| args.iter().any(|a| a == word);
+    let (assembly, parallel_from) = if has("serial") {
+        ("serial", usize::MAX)
+    } else if has("parallel") {
+        ("parallel", 0)
+    } else {
+        ("default", SimulationOptions::default().parallel_from)
+    };
     if let Some(n) = args.first().and_then(|a| a.parse::<usize>().ok()) {
-        one(n, args.get(1).map(String::as_str) != Some("swinging"));
+        one(n, !has("swinging"), parallel_from);
         return;
     }
     let exe = std::env::current_exe().unwrap();
     for shape in ["hanging", "swinging"] {
-        println!("{shape} chains, 0.1 m links, dt = 1e-3");
+        println!("{shape} chains, 0.1 m links, dt = 1e-3, {assembly} assembly");
         println!(
             "{:>9} {:>14} {:>10} {:>14} {:>12}  solver",
             "N", "s/step", "us/particle", "Newton it.", "peak MB"
@@ -92,6 +103,7 @@ fn main() {
             let out = Command::new(&exe)
                 .arg(n.to_string())
                 .arg(shape)
+                .arg(assembly)
                 .output()
                 .unwrap();
             let text = String::from_utf8_lossy(&out.stdout);

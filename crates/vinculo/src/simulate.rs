@@ -43,6 +43,14 @@ pub struct SimulationOptions {
     pub sparse_solver: SparseSolver,
     /// Largest memory the stored states may take (bytes); larger runs are refused up front.
     pub max_output_bytes: f64,
+    /// Models with at least this many free particles assemble their residuals and Jacobians
+    /// in parallel, on rayon's global thread pool (as many threads as cores, or
+    /// `RAYON_NUM_THREADS`): the kinematics and the inertia and gravity rows per particle, the
+    /// forces, and the constraints' rows, gradient terms, Hessian blocks and Jacobian rows and
+    /// columns. Smaller models, and `usize::MAX`, use the serial loops. The linear solvers and
+    /// the rest of a step are serial. The residual is the same bit for bit; the Jacobian equals
+    /// the serial one to round-off (its entries are summed in another order).
+    pub parallel_from: usize,
 }
 
 impl Default for SimulationOptions {
@@ -59,9 +67,20 @@ impl Default for SimulationOptions {
             dense_limit: 48,
             sparse_solver: SparseSolver::Auto,
             max_output_bytes: 8.0 * (1u64 << 30) as f64,
+            parallel_from: PARALLEL_FROM,
         }
     }
 }
+
+/// Default of [`SimulationOptions::parallel_from`]: the number of free particles from which
+/// parallel assembly did not cost time in whole steps on two cores (shared with other work).
+/// Measured on chains (`benches/scaling.rs` with `serial` / `parallel`, repeated): at 10^6
+/// particles a hanging chain's step took 10-27 % less time, a swinging chain's between 18 %
+/// less and 5 % more; at 300,000 the same to 8 % less; at 100,000 and fewer the same or more.
+/// The assembly alone (`benches/kernels.rs`, `assembly`) is 20-27 % faster from 100,000 on, but
+/// it is a quarter to a half of a step and the rest (the linear solve above all) is serial,
+/// while the residual's per-element buffers and the threads' wake-ups cost a share of the gain.
+pub const PARALLEL_FROM: usize = 300_000;
 
 /// Receives progress and may stop a run.
 pub trait Observer {
@@ -222,6 +241,7 @@ pub fn simulate_with_observer(
     }
 
     let mut ws = StepWorkspace::with_solver(system, options.dense_limit, options.sparse_solver);
+    ws.assemble_in_parallel_from(system, options.parallel_from);
     let scheme = options.scheme;
     let newton = NewtonOptions {
         tolerance: options.newton.tolerance * length,

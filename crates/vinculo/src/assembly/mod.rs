@@ -4,8 +4,10 @@
 //!
 //! Unknowns are ordered x = (q of the free particles, 3 each; lambda, one per constraint).
 
+mod parallel;
 mod pattern;
 
+pub use parallel::{JacobianTerms, ParallelAssembly, ResidualTerms, MIN_TASK};
 pub use pattern::{Pattern, Storage};
 
 use crate::model::System;

@@ -59,7 +59,11 @@
 
 use super::newton::{self, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport};
 use super::trapezoidal::{StepBuffers, StepWorkspace};
-use crate::assembly::{add, add_block, Layout, NONE};
+use rayon::prelude::*;
+
+use crate::assembly::{
+    add, add_block, JacobianTerms, Layout, ParallelAssembly, ResidualTerms, MIN_TASK, NONE,
+};
 use crate::forces::Jacobian;
 use crate::math::{Mat3, Vec3};
 use crate::model::System;
@@ -143,6 +147,7 @@ impl GeneralizedAlpha {
             buffers: &mut ws.state,
             scales: &ws.scales,
             inertia: &ws.inertia,
+            parallel: ws.parallel.as_mut(),
             q_n,
             v_n,
             a_n: &state.algorithmic,
@@ -183,6 +188,7 @@ pub struct AlphaStepProblem<'a> {
     buffers: &'a mut StepBuffers,
     scales: &'a [f64],
     inertia: &'a [f64],
+    parallel: Option<&'a mut ParallelAssembly>,
     q_n: &'a [Vec3],
     v_n: &'a [Vec3],
     a_n: &'a [Vec3],
@@ -196,10 +202,79 @@ pub struct AlphaStepProblem<'a> {
 impl AlphaStepProblem<'_> {
     /// a_{n+1} of coordinate x of particle i at the current iterate.
     fn algorithmic(&self, i: usize, x: usize) -> f64 {
-        let (h, k) = (self.h, &self.k);
         let q = self.buffers.q[i][x];
-        (q - self.q_n[i][x] - h * self.v_n[i][x] - h * h * (0.5 - k.beta) * self.a_n[i][x])
-            / (k.beta * h * h)
+        algorithmic(
+            q,
+            self.q_n[i][x],
+            self.v_n[i][x],
+            self.a_n[i][x],
+            self.h,
+            self.k.beta,
+        )
+    }
+
+    /// The residual on rayon's thread pool (same result as the serial loops, bit for bit).
+    fn residual_parallel(&mut self, r: &mut [f64]) {
+        let (h, sigma, k) = (self.h, self.sigma, self.k);
+        let (q_n, v_n, a_n, qdd_n, inertia) =
+            (self.q_n, self.v_n, self.a_n, self.qdd_n, self.inertia);
+        let (system, layout) = (self.system, self.layout);
+        let b = &mut *self.buffers;
+        b.q.par_iter()
+            .zip(b.v.par_iter_mut())
+            .zip(q_n.par_iter().zip(v_n.par_iter()).zip(a_n.par_iter()))
+            .with_min_len(MIN_TASK)
+            .for_each(|((q, v), ((q_n, v_n), a_n))| {
+                for x in 0..3 {
+                    let a = algorithmic(q[x], q_n[x], v_n[x], a_n[x], h, k.beta);
+                    v[x] = v_n[x] + h * (1.0 - k.gamma) * a_n[x] + h * k.gamma * a;
+                }
+            });
+        let b = &*self.buffers;
+        let g = system.gravity();
+        let particles = system.particles();
+        let t1 = self.t_n + h;
+        let terms = ResidualTerms {
+            q_eval: &b.q,
+            v_eval: &b.v,
+            t_eval: t1,
+            q_end: &b.q,
+            t_end: t1,
+            sigma,
+            lambda: &b.lambda,
+            scales: self.scales,
+        };
+        let parallel = self.parallel.as_deref_mut().expect("parallel assembly");
+        parallel.residual(system, layout, &terms, r, |i, x| {
+            let a = algorithmic(b.q[i][x], q_n[i][x], v_n[i][x], a_n[i][x], h, k.beta);
+            let qdd = ((1.0 - k.alpha_m) * a + k.alpha_m * a_n[i][x] - k.alpha_f * qdd_n[i][x])
+                / (1.0 - k.alpha_f);
+            sigma * (inertia[i] * qdd - particles[i].mass * g[x])
+        });
+    }
+
+    /// The Jacobian on rayon's thread pool (equal to the serial one to round-off).
+    fn jacobian_parallel(&mut self, values: &mut [f64]) {
+        let (h, sigma, k, inertia) = (self.h, self.sigma, self.k, self.inertia);
+        let c = (1.0 - k.alpha_m) / ((1.0 - k.alpha_f) * k.beta * h * h);
+        let b = &*self.buffers;
+        let t1 = self.t_n + h;
+        let terms = JacobianTerms {
+            q_eval: &b.q,
+            v_eval: &b.v,
+            t_eval: t1,
+            q_end: &b.q,
+            t_end: t1,
+            force_dq: -sigma,
+            force_dv: -sigma * (k.gamma / (k.beta * h)),
+            hessian: -sigma,
+            lambda: &b.lambda,
+            scales: self.scales,
+        };
+        let parallel = self.parallel.as_deref().expect("parallel assembly");
+        parallel.jacobian(self.system, self.layout, &terms, values, |i| {
+            sigma * c * inertia[i]
+        });
     }
 
     /// Updates v_{n+1} from the iterate q.
@@ -215,8 +290,17 @@ impl AlphaStepProblem<'_> {
     }
 }
 
+/// a_{n+1} of one coordinate from its iterate q and its old values.
+#[inline]
+fn algorithmic(q: f64, q_n: f64, v_n: f64, a_n: f64, h: f64, beta: f64) -> f64 {
+    (q - q_n - h * v_n - h * h * (0.5 - beta) * a_n) / (beta * h * h)
+}
+
 impl NewtonProblem for AlphaStepProblem<'_> {
     fn residual(&mut self, r: &mut [f64]) {
+        if self.parallel.is_some() {
+            return self.residual_parallel(r);
+        }
         self.kinematics();
         let (system, layout, sigma, k) = (self.system, self.layout, self.sigma, self.k);
         let t1 = self.t_n + self.h;
@@ -261,6 +345,9 @@ impl NewtonProblem for AlphaStepProblem<'_> {
     }
 
     fn jacobian(&mut self, values: &mut [f64]) {
+        if self.parallel.is_some() {
+            return self.jacobian_parallel(values);
+        }
         let (system, layout, h, sigma, k) = (self.system, self.layout, self.h, self.sigma, self.k);
         let t1 = self.t_n + h;
         let b = &*self.buffers;
@@ -339,7 +426,8 @@ impl NewtonProblem for AlphaStepProblem<'_> {
 mod tests {
     use super::*;
     use crate::integrators::trapezoidal::tests::{
-        assert_jacobian_matches, every_kind, perturbed_iterate,
+        assert_jacobian_matches, assert_same_assembly, chain, cloth, every_kind, perturbed_iterate,
+        wiggled_iterate,
     };
     use crate::linear::SparseSolver;
 
@@ -371,6 +459,7 @@ mod tests {
                     buffers: &mut ws.state,
                     scales: &ws.scales,
                     inertia: &ws.inertia,
+                    parallel: None,
                     q_n: &q_n,
                     v_n: &v_n,
                     a_n: &a_n,
@@ -382,6 +471,53 @@ mod tests {
                 };
                 assert_jacobian_matches(&mut problem, &ws.layout);
             }
+        }
+    }
+
+    /// Parallel assembly (forced by a zero threshold) gives the serial residual and Jacobian.
+    #[test]
+    fn parallel_assembly_matches_serial() {
+        for s in [every_kind(), chain(5_000), cloth(50)] {
+            let q_n = s.initial_positions();
+            let v_n = s.initial_velocities();
+            let a_n: Vec<Vec3> = (0..q_n.len())
+                .map(|i| [0.3, -1.0, 0.01 * i as f64])
+                .collect();
+            let qdd_n: Vec<Vec3> = (0..q_n.len())
+                .map(|i| [-0.1, 0.4, 0.7 / (1.0 + i as f64)])
+                .collect();
+            let k = GeneralizedAlpha { rho_inf: 0.6 }.coefficients();
+            let h = 0.01;
+            let c = (1.0 - k.alpha_m) / ((1.0 - k.alpha_f) * k.beta * h * h);
+            let assemble = |parallel: bool| {
+                let mut ws = StepWorkspace::new(&s, 48);
+                if parallel {
+                    ws.assemble_in_parallel_from(&s, 0);
+                }
+                wiggled_iterate(&mut ws, &q_n);
+                let mut problem = AlphaStepProblem {
+                    system: &s,
+                    layout: &ws.layout,
+                    buffers: &mut ws.state,
+                    scales: &ws.scales,
+                    inertia: &ws.inertia,
+                    parallel: ws.parallel.as_mut(),
+                    q_n: &q_n,
+                    v_n: &v_n,
+                    a_n: &a_n,
+                    qdd_n: &qdd_n,
+                    t_n: 0.3,
+                    h,
+                    k,
+                    sigma: 1.0 / (c * ws.mass_ref),
+                };
+                let mut r = vec![0.0; ws.layout.unknowns()];
+                let mut values = vec![0.0; ws.layout.pattern.nnz()];
+                problem.residual(&mut r);
+                problem.jacobian(&mut values);
+                (r, values)
+            };
+            assert_same_assembly(&assemble(false), &assemble(true));
         }
     }
 

@@ -26,7 +26,11 @@
 use super::newton::{
     self, IterationMatrix, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport,
 };
-use crate::assembly::{add, add_block, Layout, NONE};
+use rayon::prelude::*;
+
+use crate::assembly::{
+    add, add_block, JacobianTerms, Layout, ParallelAssembly, ResidualTerms, MIN_TASK, NONE,
+};
 use crate::forces::Jacobian;
 use crate::linear::{for_layout, LinearSolver, SparseSolver, TreeElimination};
 use crate::math::{Mat3, Vec3};
@@ -64,6 +68,9 @@ pub struct StepWorkspace {
     pub inertia: Vec<f64>,
     /// s_k of each constraint.
     pub scales: Vec<f64>,
+    /// Colouring and buffers of parallel assembly, when the model is large enough for it to
+    /// pay (see [`StepWorkspace::assemble_in_parallel_from`]); `None`: serial assembly.
+    pub parallel: Option<ParallelAssembly>,
 }
 
 /// Per-particle arrays of a step.
@@ -135,7 +142,16 @@ impl StepWorkspace {
             mass_ref,
             inertia: system.inertia(),
             layout,
+            parallel: None,
         }
+    }
+
+    /// Assembles residuals and Jacobians on rayon's thread pool when the model has at least
+    /// `threshold` free particles, serially otherwise (`usize::MAX`: always serially). The
+    /// colouring this needs is computed here, once.
+    pub fn assemble_in_parallel_from(&mut self, system: &System, threshold: usize) {
+        self.parallel =
+            (self.layout.free >= threshold).then(|| ParallelAssembly::new(system, &self.layout));
     }
 }
 
@@ -146,6 +162,7 @@ pub struct StepProblem<'a> {
     buffers: &'a mut StepBuffers,
     scales: &'a [f64],
     inertia: &'a [f64],
+    parallel: Option<&'a mut ParallelAssembly>,
     q_n: &'a [Vec3],
     v_n: &'a [Vec3],
     t_n: f64,
@@ -172,10 +189,75 @@ impl StepProblem<'_> {
     fn t_alpha(&self) -> f64 {
         self.t_n + self.alpha * self.h
     }
+
+    /// The residual on rayon's thread pool (same result as the serial loops, bit for bit).
+    fn residual_parallel(&mut self, r: &mut [f64]) {
+        let (a, h, sigma) = (self.alpha, self.h, self.sigma);
+        let (q_n, v_n, inertia) = (self.q_n, self.v_n, self.inertia);
+        let (system, layout) = (self.system, self.layout);
+        let ta = self.t_alpha();
+        let b = &mut *self.buffers;
+        b.q.par_iter()
+            .zip(b.v.par_iter_mut())
+            .zip(b.v_alpha.par_iter_mut())
+            .zip(b.q_alpha.par_iter_mut())
+            .zip(q_n.par_iter().zip(v_n.par_iter()))
+            .with_min_len(MIN_TASK)
+            .for_each(|((((q, v), v_alpha), q_alpha), (q_n, v_n))| {
+                for k in 0..3 {
+                    let va = (q[k] - q_n[k]) / h;
+                    v_alpha[k] = va;
+                    v[k] = (va - (1.0 - a) * v_n[k]) / a;
+                    q_alpha[k] = (1.0 - a) * q_n[k] + a * q[k];
+                }
+            });
+        let b = &*self.buffers;
+        let g = system.gravity();
+        let particles = system.particles();
+        let terms = ResidualTerms {
+            q_eval: &b.q_alpha,
+            v_eval: &b.v_alpha,
+            t_eval: ta,
+            q_end: &b.q,
+            t_end: self.t_n + h,
+            sigma,
+            lambda: &b.lambda,
+            scales: self.scales,
+        };
+        let parallel = self.parallel.as_deref_mut().expect("parallel assembly");
+        parallel.residual(system, layout, &terms, r, |i, k| {
+            sigma * (inertia[i] * (b.v[i][k] - v_n[i][k]) / h - particles[i].mass * g[k])
+        });
+    }
+
+    /// The Jacobian on rayon's thread pool (equal to the serial one to round-off).
+    fn jacobian_parallel(&mut self, values: &mut [f64]) {
+        let (a, h, sigma, inertia) = (self.alpha, self.h, self.sigma, self.inertia);
+        let b = &*self.buffers;
+        let terms = JacobianTerms {
+            q_eval: &b.q_alpha,
+            v_eval: &b.v_alpha,
+            t_eval: self.t_alpha(),
+            q_end: &b.q,
+            t_end: self.t_n + h,
+            force_dq: -sigma * a,
+            force_dv: -sigma / h,
+            hessian: -sigma * a,
+            lambda: &b.lambda,
+            scales: self.scales,
+        };
+        let parallel = self.parallel.as_deref().expect("parallel assembly");
+        parallel.jacobian(self.system, self.layout, &terms, values, |i| {
+            sigma * inertia[i] / (a * h * h)
+        });
+    }
 }
 
 impl NewtonProblem for StepProblem<'_> {
     fn residual(&mut self, r: &mut [f64]) {
+        if self.parallel.is_some() {
+            return self.residual_parallel(r);
+        }
         self.kinematics();
         let (system, layout, h, sigma) = (self.system, self.layout, self.h, self.sigma);
         let ta = self.t_alpha();
@@ -218,6 +300,9 @@ impl NewtonProblem for StepProblem<'_> {
     }
 
     fn jacobian(&mut self, values: &mut [f64]) {
+        if self.parallel.is_some() {
+            return self.jacobian_parallel(values);
+        }
         let (system, layout, h, a, sigma) =
             (self.system, self.layout, self.h, self.alpha, self.sigma);
         let ta = self.t_alpha();
@@ -328,6 +413,7 @@ impl GeneralizedTrapezoidal {
             buffers: &mut ws.state,
             scales: &ws.scales,
             inertia: &ws.inertia,
+            parallel: ws.parallel.as_mut(),
             q_n,
             v_n,
             t_n,
@@ -470,6 +556,137 @@ pub(super) mod tests {
         ws.state.lambda = vec![0.8, -1.2, 0.5, 2.0, -0.7];
     }
 
+    /// A horizontal chain of `n` point masses (0.1 m links, 0.1 kg) from a fixed anchor.
+    pub(crate) fn chain(n: usize) -> System {
+        let mut s = System::new([0.0, 0.0, -9.81]);
+        let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
+        for i in 1..=n {
+            let p = s
+                .add_particle(0.1, [0.1 * i as f64, 0.0, 0.0], [0.0; 3], false)
+                .unwrap();
+            s.add_distance(prev, p, None).unwrap();
+            prev = p;
+        }
+        s
+    }
+
+    /// An `n` x `n` cloth: a square grid of point masses hung from its two top corners, linked
+    /// to their row and column neighbours by distance constraints (a constraint graph full of
+    /// loops) and along the diagonals by spring-dampers (two-particle forces), with drag on
+    /// every particle (one-particle forces).
+    pub(crate) fn cloth(n: usize) -> System {
+        let mut s = System::new([0.0, 0.0, -9.81]);
+        let mut id = Vec::with_capacity(n * n);
+        for j in 0..n {
+            for i in 0..n {
+                let fixed = j == 0 && (i == 0 || i == n - 1);
+                let x = [0.1 * i as f64, 0.01 * (i * j % 7) as f64, -0.1 * j as f64];
+                id.push(s.add_particle(0.05, x, [0.0, 0.2, 0.0], fixed).unwrap());
+            }
+        }
+        for j in 0..n {
+            for i in 0..n {
+                let p = id[j * n + i];
+                if i + 1 < n {
+                    s.add_distance(p, id[j * n + i + 1], None).unwrap();
+                }
+                if j + 1 < n {
+                    s.add_distance(p, id[(j + 1) * n + i], None).unwrap();
+                }
+                if i + 1 < n && j + 1 < n {
+                    s.add_spring_damper(p, id[(j + 1) * n + i + 1], 30.0, 0.2, None)
+                        .unwrap();
+                }
+                s.add_quadratic_drag(p, 0.01).unwrap();
+            }
+        }
+        s
+    }
+
+    /// An iterate off the constraints with non-zero multipliers, for any system.
+    pub(crate) fn wiggled_iterate(ws: &mut StepWorkspace, q_n: &[Vec3]) {
+        for (i, (q, x)) in ws.state.q.iter_mut().zip(q_n).enumerate() {
+            let u = i as f64;
+            *q = [
+                x[0] + 0.01 * (0.7 * u).sin(),
+                x[1] - 0.02 * (1.3 * u).cos(),
+                x[2] + 0.005 * (0.3 * u).sin(),
+            ];
+        }
+        for (k, l) in ws.state.lambda.iter_mut().enumerate() {
+            *l = 1.5 * (0.9 * k as f64).sin() - 0.2;
+        }
+    }
+
+    /// Asserts that the parallel residuals are the serial ones bit for bit, and the Jacobians
+    /// equal to 1e-14 (relative to the entry, or to 1 for small entries: the scaled matrix's
+    /// entries are O(1)).
+    pub(crate) fn assert_same_assembly(
+        serial: &(Vec<f64>, Vec<f64>),
+        parallel: &(Vec<f64>, Vec<f64>),
+    ) {
+        assert_eq!(serial.0.len(), parallel.0.len());
+        for (i, (s, p)) in serial.0.iter().zip(&parallel.0).enumerate() {
+            assert_eq!(
+                s.to_bits(),
+                p.to_bits(),
+                "residual {i}: serial {s}, parallel {p}"
+            );
+        }
+        assert_eq!(serial.1.len(), parallel.1.len());
+        for (k, (s, p)) in serial.1.iter().zip(&parallel.1).enumerate() {
+            assert!(
+                (s - p).abs() <= 1e-14 * s.abs().max(1.0),
+                "Jacobian slot {k}: serial {s}, parallel {p}"
+            );
+        }
+    }
+
+    /// Parallel assembly (forced by a zero threshold) gives the serial residual and Jacobian,
+    /// on a chain and a cloth large enough to be split among threads and on the system with
+    /// every constraint and force kind.
+    #[test]
+    fn parallel_assembly_matches_serial() {
+        for (name, s) in [
+            ("every kind", every_kind()),
+            ("chain", chain(5_000)),
+            ("cloth", cloth(50)),
+        ] {
+            let q_n = s.initial_positions();
+            let v_n = s.initial_velocities();
+            let assemble = |parallel: bool| {
+                let mut ws = StepWorkspace::new(&s, 48);
+                if parallel {
+                    ws.assemble_in_parallel_from(&s, 0);
+                    let colours = ws.parallel.as_ref().unwrap().constraint_colours();
+                    assert!(colours >= 1 && (name != "chain" || colours == 2), "{name}");
+                }
+                wiggled_iterate(&mut ws, &q_n);
+                let (h, alpha) = (0.01, 0.6);
+                let mut problem = StepProblem {
+                    system: &s,
+                    layout: &ws.layout,
+                    buffers: &mut ws.state,
+                    scales: &ws.scales,
+                    inertia: &ws.inertia,
+                    parallel: ws.parallel.as_mut(),
+                    q_n: &q_n,
+                    v_n: &v_n,
+                    t_n: 0.3,
+                    h,
+                    alpha,
+                    sigma: alpha * h * h / ws.mass_ref,
+                };
+                let mut r = vec![0.0; ws.layout.unknowns()];
+                let mut values = vec![0.0; ws.layout.pattern.nnz()];
+                problem.residual(&mut r);
+                problem.jacobian(&mut values);
+                (r, values)
+            };
+            assert_same_assembly(&assemble(false), &assemble(true));
+        }
+    }
+
     /// The assembled Jacobian equals finite differences of the assembled residual, for a system
     /// with every constraint and force kind, fixed particles and non-zero multipliers.
     #[test]
@@ -489,6 +706,7 @@ pub(super) mod tests {
                 buffers: &mut ws.state,
                 scales: &ws.scales,
                 inertia: &ws.inertia,
+                parallel: None,
                 q_n: &q_n,
                 v_n: &v_n,
                 t_n: 0.3,

@@ -1,0 +1,450 @@
+//! Residual and Jacobian assembly on rayon's thread pool, for large models.
+//!
+//! The residual is assembled without shared writes and in the serial order of operations, so it
+//! equals the serial residual bit for bit:
+//!
+//! 1. in parallel over the elements, each force's local forces and each constraint's gradient
+//!    go into per-element buffers (and each constraint's own residual row is written);
+//! 2. in parallel over the free particles, each particle's three rows start from the inertia
+//!    and gravity terms and subtract its incident forces and then its incident constraints'
+//!    gradient terms, each in increasing element index: the serial loops' order.
+//!
+//! The Jacobian's slots are scattered through the value array, so it is written through a
+//! shared pointer, colour by colour (see [`SharedValues`] for the safety argument). The forces
+//! and the constraints are cut into chunks of consecutive elements, each assembled by one task
+//! in the serial order (writing slots near each other, as the serial loop does), and the chunks
+//! are greedily coloured once per run so that no two chunks of a colour touch the same free
+//! particle (a chain needs two colours: even and odd chunks). Where two chunks share a particle
+//! its diagonal block may receive their contributions in another order than in the serial
+//! loops, so the parallel Jacobian equals the serial one to round-off (a unit in the last
+//! place), not bit for bit.
+
+use rayon::prelude::*;
+
+use super::{Block, Layout, NONE};
+use crate::constraints::{Gradient, Hessian};
+use crate::forces::{Jacobian, Local};
+use crate::math::{Mat3, Vec3};
+use crate::model::System;
+
+/// Elements handed to one rayon task at least (smaller tasks cost more to schedule than they
+/// compute).
+pub const MIN_TASK: usize = 2048;
+
+/// Consecutive elements one task assembles into the Jacobian, in the serial loops' order (so
+/// that a task writes slots near each other, as the serial loop does).
+const CHUNK: usize = 1024;
+
+/// The colouring, incidence lists and buffers of parallel assembly, built once per run.
+#[derive(Debug, Clone)]
+pub struct ParallelAssembly {
+    /// Free particles in unknown order (`free[j]` is the particle of unknowns 3j..3j+3).
+    free: Vec<usize>,
+    /// Per particle, the range of `force_incidence` of the forces touching it.
+    force_start: Vec<usize>,
+    /// Entries 2 f + x: force f touches the particle as its particle x; increasing in f.
+    force_incidence: Vec<usize>,
+    /// Per particle, the range of `constraint_incidence` of the constraints touching it.
+    constraint_start: Vec<usize>,
+    /// Entries 2 c + x: constraint c touches the particle as its particle x; increasing in c.
+    constraint_incidence: Vec<usize>,
+    /// Chunks of [`CHUNK`] forces, grouped by colour (`force_colour_start` delimits the
+    /// groups).
+    force_colours: Vec<usize>,
+    force_colour_start: Vec<usize>,
+    /// Chunks of [`CHUNK`] constraints, grouped by colour (`constraint_colour_start` delimits
+    /// the groups).
+    constraint_colours: Vec<usize>,
+    constraint_colour_start: Vec<usize>,
+    /// Local forces of every force at the current iterate.
+    forces: Vec<Local>,
+    /// Gradient of every constraint at the evaluation point.
+    gradients: Vec<Gradient>,
+}
+
+/// Where and with which weights one step's residual is evaluated.
+pub struct ResidualTerms<'a> {
+    /// Positions, velocities and time at which forces and constraint gradients are evaluated.
+    pub q_eval: &'a [Vec3],
+    /// Velocities at the evaluation point.
+    pub v_eval: &'a [Vec3],
+    /// Time of the evaluation point.
+    pub t_eval: f64,
+    /// Positions and time of the constraint rows (the step's end).
+    pub q_end: &'a [Vec3],
+    /// Time of the constraint rows.
+    pub t_end: f64,
+    /// Scale of the dynamics rows.
+    pub sigma: f64,
+    /// Multipliers.
+    pub lambda: &'a [f64],
+    /// Scale of each constraint row.
+    pub scales: &'a [f64],
+}
+
+/// Where and with which weights one step's Jacobian is evaluated (besides the mass block).
+pub struct JacobianTerms<'a> {
+    /// Positions at which forces, Hessians and the -Phi_q^T columns are evaluated.
+    pub q_eval: &'a [Vec3],
+    /// Velocities of the evaluation point.
+    pub v_eval: &'a [Vec3],
+    /// Time of the evaluation point.
+    pub t_eval: f64,
+    /// Positions of the Phi_q rows (the step's end).
+    pub q_end: &'a [Vec3],
+    /// Time of the Phi_q rows.
+    pub t_end: f64,
+    /// Weight of df/dq.
+    pub force_dq: f64,
+    /// Weight of df/dv.
+    pub force_dv: f64,
+    /// Weight of lambda_k d2Phi_k/dq2.
+    pub hessian: f64,
+    /// Multipliers.
+    pub lambda: &'a [f64],
+    /// Scale of each constraint row.
+    pub scales: &'a [f64],
+}
+
+/// The matrix's value array shared by the tasks of one colour.
+///
+/// Safety argument: every slot is an entry (row, column) of the matrix, and every slot written
+/// through this type is written by one task only, because it is partitioned by its row:
+/// - a particle's mass block (rows of that particle) is written by that particle's task alone;
+/// - an element's blocks (rows of its free particles) and -Phi_q^T entries (rows of its free
+///   particles, its multiplier's column) are written by the task of the element's chunk;
+///   within one colour no two chunks touch the same free particle, so no two tasks share such
+///   a row, and colours are processed one after the other (each colour's parallel loop returns
+///   before the next starts, as the mass pass returns before the first colour);
+/// - a constraint's Phi_q entries (its multiplier's row) are written by the task of its chunk,
+///   and no other task writes that row.
+///
+/// Slots are bounds-checked against the array's length before every write.
+struct SharedValues {
+    ptr: *mut f64,
+    len: usize,
+}
+
+// SAFETY: see the type's documentation: concurrent tasks write disjoint slots only.
+unsafe impl Sync for SharedValues {}
+
+impl SharedValues {
+    fn new(values: &mut [f64]) -> SharedValues {
+        SharedValues {
+            ptr: values.as_mut_ptr(),
+            len: values.len(),
+        }
+    }
+
+    /// Adds `value` at `slot` unless the slot is absent.
+    ///
+    /// # Safety
+    /// No other task may access `slot` concurrently (see the type's documentation).
+    #[inline]
+    unsafe fn add(&self, slot: usize, value: f64) {
+        if slot != NONE {
+            assert!(slot < self.len, "slot {slot} outside the value array");
+            // SAFETY: in bounds (checked above); exclusive by the caller's contract.
+            unsafe { *self.ptr.add(slot) += value };
+        }
+    }
+
+    /// Adds `s m` into the block `b`.
+    ///
+    /// # Safety
+    /// As for [`SharedValues::add`], for every slot of the block.
+    #[inline]
+    unsafe fn add_block(&self, b: &Block, s: f64, m: &Mat3) {
+        if b[0] == NONE {
+            return;
+        }
+        for r in 0..3 {
+            for c in 0..3 {
+                // SAFETY: forwarded from the caller.
+                unsafe { self.add(b[3 * r + c], s * m[r][c]) };
+            }
+        }
+    }
+}
+
+/// Incidence lists: for each particle, entries 2 e + x of the elements e touching it (as their
+/// particle x), in increasing e. Fixed particles are left out when `free_only`.
+fn incidence<'a>(
+    particles: usize,
+    elements: impl Iterator<Item = &'a [usize]> + Clone,
+    dof: &[usize],
+    free_only: bool,
+) -> (Vec<usize>, Vec<usize>) {
+    let keep = |p: usize| !free_only || dof[p] != NONE;
+    let mut start = vec![0usize; particles + 1];
+    for parts in elements.clone() {
+        for &p in parts.iter().filter(|&&p| keep(p)) {
+            start[p + 1] += 1;
+        }
+    }
+    for i in 0..particles {
+        start[i + 1] += start[i];
+    }
+    let mut next = start.clone();
+    let mut entries = vec![0usize; start[particles]];
+    for (e, parts) in elements.enumerate() {
+        for (x, &p) in parts.iter().enumerate().filter(|&(_, &p)| keep(p)) {
+            entries[next[p]] = 2 * e + x;
+            next[p] += 1;
+        }
+    }
+    (start, entries)
+}
+
+/// Greedy colouring of the chunks of [`CHUNK`] consecutive elements (given by their particles;
+/// elements that write nothing have none) such that no two chunks of a colour touch the same
+/// free particle. Returns the chunks grouped by colour, and the start of each group.
+fn colour_chunks<'a>(
+    particles: usize,
+    elements: impl Iterator<Item = &'a [usize]> + Clone,
+    dof: &[usize],
+) -> (Vec<usize>, Vec<usize>) {
+    let (start, entries) = incidence(particles, elements.clone(), dof, true);
+    let chunks = elements.clone().count().div_ceil(CHUNK);
+    let mut colours = vec![0usize; chunks];
+    let mut taken: Vec<usize> = Vec::new();
+    let mut parts = elements.enumerate().peekable();
+    for k in 0..chunks {
+        // Colours of the earlier (already coloured) chunks sharing a free particle with chunk k.
+        taken.clear();
+        while let Some((_, ps)) = parts.next_if(|&(e, _)| e / CHUNK == k) {
+            for &p in ps.iter().filter(|&&p| dof[p] != NONE) {
+                for &entry in &entries[start[p]..start[p + 1]] {
+                    let other = entry / 2 / CHUNK;
+                    if other < k {
+                        taken.push(colours[other]);
+                    }
+                }
+            }
+        }
+        taken.sort_unstable();
+        taken.dedup();
+        // The smallest colour not taken.
+        colours[k] = taken
+            .iter()
+            .enumerate()
+            .find(|&(c, &t)| c != t)
+            .map_or(taken.len(), |(c, _)| c);
+    }
+    let groups = colours.iter().max().map_or(0, |&c| c + 1);
+    let mut group_start = vec![0usize; groups + 1];
+    for &c in &colours {
+        group_start[c + 1] += 1;
+    }
+    for g in 0..groups {
+        group_start[g + 1] += group_start[g];
+    }
+    let mut next = group_start.clone();
+    let mut order = vec![0usize; chunks];
+    for (k, &c) in colours.iter().enumerate() {
+        order[next[c]] = k;
+        next[c] += 1;
+    }
+    (order, group_start)
+}
+
+impl ParallelAssembly {
+    /// Colours the elements of `system` and allocates the buffers (once per run).
+    pub fn new(system: &System, layout: &Layout) -> ParallelAssembly {
+        let n = system.particles().len();
+        let dof = &layout.dof;
+        let free = (0..n).filter(|&i| dof[i] != NONE).collect();
+        let forces = system.forces();
+        let constraints = system.constraints();
+        let (force_start, force_incidence) =
+            incidence(n, forces.iter().map(|f| f.particles()), dof, true);
+        let (constraint_start, constraint_incidence) =
+            incidence(n, constraints.iter().map(|c| c.particles()), dof, true);
+        let none: &[usize] = &[];
+        let (force_colours, force_colour_start) = colour_chunks(
+            n,
+            forces.iter().map(|f| {
+                if f.has_jacobian() {
+                    f.particles()
+                } else {
+                    none
+                }
+            }),
+            dof,
+        );
+        let (constraint_colours, constraint_colour_start) =
+            colour_chunks(n, constraints.iter().map(|c| c.particles()), dof);
+        ParallelAssembly {
+            free,
+            force_start,
+            force_incidence,
+            constraint_start,
+            constraint_incidence,
+            force_colours,
+            force_colour_start,
+            constraint_colours,
+            constraint_colour_start,
+            forces: vec![Default::default(); forces.len()],
+            gradients: vec![Default::default(); constraints.len()],
+        }
+    }
+
+    /// Number of colours of the chunks of constraints (two for a long chain).
+    pub fn constraint_colours(&self) -> usize {
+        self.constraint_colour_start.len() - 1
+    }
+
+    /// Writes the scaled residual: `row(i, k)` is the start of row k of particle i (its
+    /// inertia and gravity terms), then forces and constraint gradients are subtracted and the
+    /// constraint rows written, as in the serial loops and with the same result.
+    pub fn residual(
+        &mut self,
+        system: &System,
+        layout: &Layout,
+        at: &ResidualTerms<'_>,
+        r: &mut [f64],
+        row: impl Fn(usize, usize) -> f64 + Sync,
+    ) {
+        let m3 = 3 * layout.free;
+        let (dynamics, constraint_rows) = r.split_at_mut(m3);
+        system
+            .forces()
+            .par_iter()
+            .zip(self.forces.par_iter_mut())
+            .with_min_len(MIN_TASK)
+            .for_each(|(f, out)| *out = f.force(at.q_eval, at.v_eval, at.t_eval));
+        system
+            .constraints()
+            .par_iter()
+            .zip(self.gradients.par_iter_mut())
+            .zip(constraint_rows.par_iter_mut())
+            .enumerate()
+            .with_min_len(MIN_TASK)
+            .for_each(|(c, ((con, grad), r))| {
+                *grad = con.gradient(at.q_eval, at.t_eval);
+                *r = at.scales[c] * con.residual(at.q_end, at.t_end);
+            });
+        let sigma = at.sigma;
+        let this = &*self;
+        dynamics
+            .par_chunks_mut(3)
+            .zip(this.free.par_iter())
+            .with_min_len(MIN_TASK)
+            .for_each(|(out, &i)| {
+                for (k, o) in out.iter_mut().enumerate() {
+                    *o = row(i, k);
+                }
+                for &e in &this.force_incidence[this.force_start[i]..this.force_start[i + 1]] {
+                    let fl = &this.forces[e / 2][e % 2];
+                    for k in 0..3 {
+                        out[k] -= sigma * fl[k];
+                    }
+                }
+                let incident = &this.constraint_incidence
+                    [this.constraint_start[i]..this.constraint_start[i + 1]];
+                for &e in incident {
+                    let (c, x) = (e / 2, e % 2);
+                    let grad = &this.gradients[c][x];
+                    for k in 0..3 {
+                        out[k] -= sigma * grad[k] * at.lambda[c];
+                    }
+                }
+            });
+    }
+
+    /// Adds the scaled Jacobian into `values` (zeroed by the caller): `mass(i)` on the diagonal
+    /// of particle i's block, then the forces' and constraints' terms.
+    pub fn jacobian(
+        &self,
+        system: &System,
+        layout: &Layout,
+        at: &JacobianTerms<'_>,
+        values: &mut [f64],
+        mass: impl Fn(usize) -> f64 + Sync,
+    ) {
+        let shared = SharedValues::new(values);
+        let shared = &shared;
+        self.free.par_iter().with_min_len(MIN_TASK).for_each(|&i| {
+            let blk = &layout.particle_block[i];
+            let m = mass(i);
+            for k in 0..3 {
+                // SAFETY: particle i's own diagonal entries, written by this task only.
+                unsafe { shared.add(blk[4 * k], m) };
+            }
+        });
+        let forces = system.forces();
+        for g in 0..self.force_colour_start.len() - 1 {
+            let group =
+                &self.force_colours[self.force_colour_start[g]..self.force_colour_start[g + 1]];
+            group.par_iter().for_each(|&chunk| {
+                let end = (chunk * CHUNK + CHUNK).min(forces.len());
+                for (fi, f) in forces.iter().enumerate().take(end).skip(chunk * CHUNK) {
+                    if !f.has_jacobian() {
+                        continue;
+                    }
+                    let mut dq: Jacobian = Default::default();
+                    let mut dv: Jacobian = Default::default();
+                    f.add_jacobian(at.q_eval, at.v_eval, at.t_eval, &mut dq, &mut dv);
+                    let n = f.particles().len();
+                    for x in 0..n {
+                        for y in 0..n {
+                            let blk = &layout.force_block[fi][x][y];
+                            // SAFETY: rows of this chunk's free particles, which no other chunk
+                            // of this colour touches (see `SharedValues`).
+                            unsafe {
+                                shared.add_block(blk, at.force_dq, &dq[x][y]);
+                                shared.add_block(blk, at.force_dv, &dv[x][y]);
+                            }
+                        }
+                    }
+                }
+            });
+        }
+        let constraints = system.constraints();
+        let same_point =
+            std::ptr::eq(at.q_eval, at.q_end) && at.t_eval.to_bits() == at.t_end.to_bits();
+        for g in 0..self.constraint_colour_start.len() - 1 {
+            let group = &self.constraint_colours
+                [self.constraint_colour_start[g]..self.constraint_colour_start[g + 1]];
+            group.par_iter().for_each(|&chunk| {
+                let end = (chunk * CHUNK + CHUNK).min(constraints.len());
+                for c in chunk * CHUNK..end {
+                    let con = &constraints[c];
+                    let n = con.particles().len();
+                    let mut hess: Hessian = Default::default();
+                    con.add_hessian(at.q_eval, at.t_eval, at.hessian * at.lambda[c], &mut hess);
+                    let s = at.scales[c];
+                    let grad_eval = con.gradient(at.q_eval, at.t_eval);
+                    let grad_end = if same_point {
+                        grad_eval
+                    } else {
+                        con.gradient(at.q_end, at.t_end)
+                    };
+                    for x in 0..n {
+                        for y in 0..n {
+                            // SAFETY: rows of this chunk's free particles, which no other chunk
+                            // of this colour touches (see `SharedValues`).
+                            unsafe {
+                                shared.add_block(
+                                    &layout.constraint_hessian[c][x][y],
+                                    1.0,
+                                    &hess[x][y],
+                                )
+                            };
+                        }
+                    }
+                    for x in 0..n {
+                        for k in 0..3 {
+                            // SAFETY: the column entry is in a row of this constraint's particle
+                            // x (as above); the row entry is in this constraint's own row.
+                            unsafe {
+                                shared.add(layout.constraint_column[c][x][k], -s * grad_eval[x][k]);
+                                shared.add(layout.constraint_row[c][x][k], s * grad_end[x][k]);
+                            }
+                        }
+                    }
+                }
+            });
+        }
+    }
+}
