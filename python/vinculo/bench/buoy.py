@@ -32,7 +32,7 @@ import numpy as np
 
 import vinculo
 from vinculo.bench.models import COMPARISON, Integration
-from vinculo.bench.runner import Run, _quiet
+from vinculo.bench.runner import Run, time_exudyn
 from vinculo.buoy.case import BuoyCase
 from vinculo.buoy.model import BuoyModel, build_model, tank_law
 from vinculo.buoy.tank import tank_motion
@@ -269,26 +269,8 @@ def run_exudyn_buoy(
         The :class:`~vinculo.bench.runner.Run`; its ``tip`` is the sphere centre's position at
         ``t_end``.
     """
-    from vinculo.bench.models import exudyn_settings
+    def build():
+        _, mbs, centre, _anchor = build_exudyn_buoy(bench, exu)
+        return mbs, centre
 
-    best = None
-    for dense in (False, True):
-        for _ in range(repeat):
-            _, mbs, centre, _anchor = build_exudyn_buoy(bench, exu)
-            settings = exudyn_settings(bench, exu, dense=dense, rho_inf=integration.rho_inf)
-            start = time.perf_counter()
-            try:
-                with _quiet():
-                    ok = mbs.SolveDynamic(settings)
-            except Exception as error:
-                ok, why = False, str(error).strip().splitlines()[-1][:60]
-            else:
-                why = "SolveDynamic returned False"
-            seconds = time.perf_counter() - start
-            if not ok:
-                return Run(seconds, 0, None, f"failed: {why}")
-            position = np.array(mbs.GetNodeOutput(centre, exu.OutputVariableType.Position))
-            if best is None or seconds < best.seconds:
-                best = Run(seconds, bench.steps, position, "dense LU" if dense else "sparse LU")
-    assert best is not None
-    return best
+    return time_exudyn(build, bench, exu, integration, repeat, (False, True))

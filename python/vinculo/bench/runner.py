@@ -79,11 +79,34 @@ def run_vinculo(model: Chain, integration: Integration = COMPARISON, repeat: int
 def run_exudyn(model: Chain, exu, integration: Integration = COMPARISON, repeat: int = 1) -> Run:
     """Best of ``repeat`` runs of Exudyn (see ``exudyn_settings``); for models of at most 100
     coordinates the faster of its dense and sparse LU is kept."""
-    dense_options = [False, True] if 3 * model.n <= 100 else [False]
+
+    def build():
+        _, mbs, tip = build_exudyn(model, exu)
+        return mbs, tip
+
+    dense_options = (False, True) if 3 * model.n <= 100 else (False,)
+    return time_exudyn(build, model, exu, integration, repeat, dense_options)
+
+
+def time_exudyn(build, model, exu, integration: Integration, repeat: int, dense_options) -> Run:
+    """Best of ``repeat`` Exudyn runs per linear solver of ``dense_options`` (False: sparse LU).
+
+    Arguments:
+        build: builds a fresh Exudyn model, returning ``(main system, node to report)``.
+        model: the run's ``steps``, ``t_end`` and ``dt``.
+        exu: the ``exudyn`` module.
+        integration: the scheme parameters shared with vinculo.
+        repeat: timed runs per solver.
+        dense_options: which of Exudyn's LU solvers to try.
+
+    Returns:
+        The fastest :class:`Run`, the reported node's position at ``t_end`` as its ``tip``; the
+        first failure ends the timing with a failed run.
+    """
     best = None
     for dense in dense_options:
         for _ in range(repeat):
-            _, mbs, tip = build_exudyn(model, exu)
+            mbs, node = build()
             settings = exudyn_settings(model, exu, dense=dense, rho_inf=integration.rho_inf)
             start = time.perf_counter()
             try:
@@ -97,7 +120,7 @@ def run_exudyn(model: Chain, exu, integration: Integration = COMPARISON, repeat:
             seconds = time.perf_counter() - start
             if not ok:
                 return Run(seconds, 0, None, f"failed: {why}")
-            position = np.array(mbs.GetNodeOutput(tip, exu.OutputVariableType.Position))
+            position = np.array(mbs.GetNodeOutput(node, exu.OutputVariableType.Position))
             if best is None or seconds < best.seconds:
                 best = Run(seconds, model.steps, position, "dense LU" if dense else "sparse LU")
     assert best is not None
