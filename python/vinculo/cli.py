@@ -178,16 +178,9 @@ def _study_parser() -> argparse.ArgumentParser:
                         "frequency, dt, settle_periods or fit_periods")
     parser.add_argument("--models", default="particle",
                         help="comma-separated models to run at each point (default: particle)")
-    parser.add_argument("--output", "-o", metavar="DIR", type=Path,
-                        default=Path("output") / "study",
-                        help="folder of study.csv and the plot (default: output/study)")
-    parser.add_argument("--workers", type=int, default=None,
-                        help="local worker processes (default: one per CPU)")
-    parser.add_argument("--scheduler", metavar="ADDRESS",
-                        help="run on an existing Dask distributed cluster (tcp://host:8786)")
     parser.add_argument("--retry-failed", action="store_true",
                         help="run again the points whose earlier run failed")
-    parser.add_argument("--no-progress", action="store_true", help="do not draw a progress bar")
+    _add_execution_options(parser, "study", "study.csv and the plot")
     _add_case_options(parser)
     parser.set_defaults(handler=_buoy_sweep)
     return parser
@@ -220,17 +213,22 @@ def _calibrate_parser() -> argparse.ArgumentParser:
     parser.add_argument("--curve-points", type=int, default=21,
                         help="frequencies of the fitted curve drawn over the data (default: 21; "
                         "0: only at the measured frequencies)")
+    _add_execution_options(parser, "calibration", "the results")
+    _add_case_options(parser)
+    parser.set_defaults(handler=_buoy_calibrate)
+    return parser
+
+
+def _add_execution_options(parser: argparse.ArgumentParser, folder: str, holds: str) -> None:
+    """``--output``, ``--workers``, ``--scheduler`` and ``--no-progress`` of a study command."""
     parser.add_argument("--output", "-o", metavar="DIR", type=Path,
-                        default=Path("output") / "calibration",
-                        help="folder for the results (default: output/calibration)")
+                        default=Path("output") / folder,
+                        help=f"folder of {holds} (default: output/{folder})")
     parser.add_argument("--workers", type=int, default=None,
                         help="local worker processes (default: one per CPU)")
     parser.add_argument("--scheduler", metavar="ADDRESS",
                         help="run on an existing Dask distributed cluster (tcp://host:8786)")
-    parser.add_argument("--no-progress", action="store_true", help="print no progress lines")
-    _add_case_options(parser)
-    parser.set_defaults(handler=_buoy_calibrate)
-    return parser
+    parser.add_argument("--no-progress", action="store_true", help="show no progress")
 
 
 def _output_folder(output: Path, parser: argparse.ArgumentParser) -> Path:
