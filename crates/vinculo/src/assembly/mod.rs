@@ -203,6 +203,66 @@ impl Layout {
     }
 }
 
+impl Layout {
+    /// Adds constraint `c`'s part of the iteration matrix: its Hessian-term blocks `hess` between
+    /// its `n` touched particles, `-s grad_column` into its multiplier's column (the -Phi_q^T
+    /// block) and `s grad_row` into its row (the Phi_q block). The schemes differ only in where
+    /// they evaluate the two gradients and the Hessian.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn add_constraint_blocks(
+        &self,
+        values: &mut [f64],
+        c: usize,
+        n: usize,
+        hess: &[[crate::math::Mat3; 2]; 2],
+        s: f64,
+        grad_column: &[crate::math::Vec3; 2],
+        grad_row: &[crate::math::Vec3; 2],
+    ) {
+        for x in 0..n {
+            for y in 0..n {
+                add_block(values, &self.constraint_hessian[c][x][y], 1.0, &hess[x][y]);
+            }
+        }
+        for x in 0..n {
+            for k in 0..3 {
+                add(
+                    values,
+                    self.constraint_column[c][x][k],
+                    -s * grad_column[x][k],
+                );
+                add(values, self.constraint_row[c][x][k], s * grad_row[x][k]);
+            }
+        }
+    }
+
+    /// Applies a Newton increment `dx` (in scaled unknowns) to the positions of the free
+    /// particles and to the multipliers, whose unknowns are lambda_k sigma / s_k.
+    #[inline]
+    pub fn apply_increment(
+        &self,
+        q: &mut [crate::math::Vec3],
+        lambda: &mut [f64],
+        dx: &[f64],
+        scales: &[f64],
+        sigma: f64,
+    ) {
+        for (i, qi) in q.iter_mut().enumerate() {
+            let d = self.dof[i];
+            if d != NONE {
+                for k in 0..3 {
+                    qi[k] -= dx[d + k];
+                }
+            }
+        }
+        let m3 = 3 * self.free;
+        for (c, l) in lambda.iter_mut().enumerate() {
+            *l -= dx[m3 + c] * scales[c] / sigma;
+        }
+    }
+}
+
 /// Adds `value` at `slot` unless the slot is absent.
 #[inline]
 pub fn add(values: &mut [f64], slot: usize, value: f64) {

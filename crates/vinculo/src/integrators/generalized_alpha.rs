@@ -62,7 +62,7 @@ use super::trapezoidal::{StepBuffers, StepWorkspace};
 use rayon::prelude::*;
 
 use crate::assembly::{
-    add, add_block, JacobianTerms, Layout, ParallelAssembly, ResidualTerms, MIN_TASK, NONE,
+    add_block, JacobianTerms, Layout, ParallelAssembly, ResidualTerms, MIN_TASK, NONE,
 };
 use crate::forces::Jacobian;
 use crate::math::{Mat3, Vec3};
@@ -383,42 +383,15 @@ impl NewtonProblem for AlphaStepProblem<'_> {
             let n = con.particles().len();
             let mut hess: [[Mat3; 2]; 2] = Default::default();
             con.add_hessian(&b.q, t1, -sigma * b.lambda[ci], &mut hess);
-            for x in 0..n {
-                for y in 0..n {
-                    add_block(
-                        values,
-                        &layout.constraint_hessian[ci][x][y],
-                        1.0,
-                        &hess[x][y],
-                    );
-                }
-            }
-            let s = self.scales[ci];
             let grad = con.gradient(&b.q, t1);
-            for x in 0..n {
-                for y in 0..3 {
-                    add(values, layout.constraint_column[ci][x][y], -s * grad[x][y]);
-                    add(values, layout.constraint_row[ci][x][y], s * grad[x][y]);
-                }
-            }
+            layout.add_constraint_blocks(values, ci, n, &hess, self.scales[ci], &grad, &grad);
         }
     }
 
     fn update(&mut self, dx: &[f64]) {
-        let layout = self.layout;
         let b = &mut *self.buffers;
-        for (i, q) in b.q.iter_mut().enumerate() {
-            let d = layout.dof[i];
-            if d != NONE {
-                for x in 0..3 {
-                    q[x] -= dx[d + x];
-                }
-            }
-        }
-        let m3 = 3 * layout.free;
-        for (c, l) in b.lambda.iter_mut().enumerate() {
-            *l -= dx[m3 + c] * self.scales[c] / self.sigma;
-        }
+        self.layout
+            .apply_increment(&mut b.q, &mut b.lambda, dx, self.scales, self.sigma);
     }
 }
 

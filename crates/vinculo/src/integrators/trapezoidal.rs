@@ -29,7 +29,7 @@ use super::newton::{
 use rayon::prelude::*;
 
 use crate::assembly::{
-    add, add_block, JacobianTerms, Layout, ParallelAssembly, ResidualTerms, MIN_TASK, NONE,
+    add_block, JacobianTerms, Layout, ParallelAssembly, ResidualTerms, MIN_TASK, NONE,
 };
 use crate::forces::Jacobian;
 use crate::linear::{for_layout, LinearSolver, SparseSolver, TreeElimination};
@@ -337,43 +337,16 @@ impl NewtonProblem for StepProblem<'_> {
             let n = con.particles().len();
             let mut hess: [[Mat3; 2]; 2] = Default::default();
             con.add_hessian(&b.q_alpha, ta, -sigma * a * b.lambda[c], &mut hess);
-            for x in 0..n {
-                for y in 0..n {
-                    add_block(
-                        values,
-                        &layout.constraint_hessian[c][x][y],
-                        1.0,
-                        &hess[x][y],
-                    );
-                }
-            }
-            let s = self.scales[c];
             let grad_a = con.gradient(&b.q_alpha, ta);
             let grad_1 = con.gradient(&b.q, t1);
-            for x in 0..n {
-                for k in 0..3 {
-                    add(values, layout.constraint_column[c][x][k], -s * grad_a[x][k]);
-                    add(values, layout.constraint_row[c][x][k], s * grad_1[x][k]);
-                }
-            }
+            layout.add_constraint_blocks(values, c, n, &hess, self.scales[c], &grad_a, &grad_1);
         }
     }
 
     fn update(&mut self, dx: &[f64]) {
-        let layout = self.layout;
         let b = &mut *self.buffers;
-        for (i, q) in b.q.iter_mut().enumerate() {
-            let d = layout.dof[i];
-            if d != NONE {
-                for k in 0..3 {
-                    q[k] -= dx[d + k];
-                }
-            }
-        }
-        let m3 = 3 * layout.free;
-        for (c, l) in b.lambda.iter_mut().enumerate() {
-            *l -= dx[m3 + c] * self.scales[c] / self.sigma;
-        }
+        self.layout
+            .apply_increment(&mut b.q, &mut b.lambda, dx, self.scales, self.sigma);
     }
 }
 
