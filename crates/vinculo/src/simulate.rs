@@ -301,10 +301,7 @@ pub fn simulate_with_observer(
     let mut step = 0usize;
     let mut q_new: Vec<Vec3> = q.clone();
     // Generalised-alpha starts with a_0 = qdd_0, the consistent accelerations.
-    let mut alpha_state = AlphaState {
-        acceleration: acc.clone(),
-        algorithmic: acc.clone(),
-    };
+    let mut alpha_state = AlphaState::new(&acc);
     let mut fresh_retry = false;
     while t < options.t_end {
         let h_nominal = unit * (1u64 << level) as f64;

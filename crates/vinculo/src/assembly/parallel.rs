@@ -345,8 +345,9 @@ impl ParallelAssembly {
                 for &e in incident {
                     let (c, x) = (e / 2, e % 2);
                     let grad = &this.gradients[c][x];
+                    let weight = sigma * at.lambda[c];
                     for k in 0..3 {
-                        out[k] -= sigma * grad[k] * at.lambda[c];
+                        out[k] -= weight * grad[k];
                     }
                 }
             });

@@ -41,6 +41,14 @@ impl Distance {
         ]
     }
 
+    #[inline]
+    pub(crate) fn residual_and_gradient(&self, q: &[Vec3]) -> (f64, Gradient) {
+        let d = sub(q[self.particles[0]], q[self.particles[1]]);
+        let phi = self.length * self.length - dot(d, d);
+        let g = [-2.0 * d[0], -2.0 * d[1], -2.0 * d[2]];
+        (phi, [g, [-g[0], -g[1], -g[2]]])
+    }
+
     pub(crate) fn add_hessian(&self, _q: &[Vec3], _t: f64, w: f64, out: &mut Hessian) {
         for a in 0..2 {
             for b in 0..2 {

@@ -95,6 +95,88 @@ pub struct AlphaState {
     pub acceleration: Vec<Vec3>,
     /// Algorithmic accelerations a_n.
     pub algorithmic: Vec<Vec3>,
+    /// Per step: the parts of q_{n+1} and v_{n+1} known before the step (see [`Predictors`]).
+    predicted_q: Vec<Vec3>,
+    predicted_v: Vec<Vec3>,
+}
+
+impl AlphaState {
+    /// The state at the start of a run: a_0 = qdd_0 = the consistent accelerations.
+    pub fn new(accelerations: &[Vec3]) -> AlphaState {
+        AlphaState {
+            acceleration: accelerations.to_vec(),
+            algorithmic: accelerations.to_vec(),
+            predicted_q: vec![[0.0; 3]; accelerations.len()],
+            predicted_v: vec![[0.0; 3]; accelerations.len()],
+        }
+    }
+
+    /// Computes the predictors p and w of a step of size `h` from (q_n, v_n) and a_n.
+    fn predict(&mut self, k: &AlphaCoefficients, h: f64, q_n: &[Vec3], v_n: &[Vec3]) {
+        let (hh, half) = (h * h, 0.5 - k.beta);
+        for i in 0..q_n.len() {
+            let a_n = self.algorithmic[i];
+            for x in 0..3 {
+                self.predicted_q[i][x] = q_n[i][x] + h * v_n[i][x] + hh * half * a_n[x];
+                self.predicted_v[i][x] = v_n[i][x] + h * (1.0 - k.gamma) * a_n[x];
+            }
+        }
+    }
+}
+
+/// The step's linear relations with what is known before the step gathered per particle,
+///
+/// ```text
+/// p = q_n + h v_n + h^2 (1/2 - beta) a_n,   w = v_n + h (1 - gamma) a_n
+/// a_{n+1} = (q - p) / (beta h^2),           v_{n+1} = w + h gamma a_{n+1}
+/// sigma (M qdd_{n+1} - m g) = sigma (M (c_a a_{n+1} + c_m a_n - c_f qdd_n) - m g)
+/// ```
+///
+/// with c_a = (1 - alpha_m)/(1 - alpha_f), c_m = alpha_m/(1 - alpha_f), c_f = alpha_f/(1 - alpha_f),
+/// so that an iterate costs a subtraction and a few products per coordinate, no division.
+#[derive(Debug, Clone, Copy)]
+struct Predictors {
+    inv_beta_h2: f64,
+    h_gamma: f64,
+    c_a: f64,
+    c_m: f64,
+    c_f: f64,
+}
+
+impl Predictors {
+    fn new(k: &AlphaCoefficients, h: f64) -> Predictors {
+        Predictors {
+            inv_beta_h2: 1.0 / (k.beta * h * h),
+            h_gamma: h * k.gamma,
+            c_a: (1.0 - k.alpha_m) / (1.0 - k.alpha_f),
+            c_m: k.alpha_m / (1.0 - k.alpha_f),
+            c_f: k.alpha_f / (1.0 - k.alpha_f),
+        }
+    }
+
+    /// a_{n+1} and v_{n+1} of one particle from its iterate q and predictors p, w.
+    #[inline(always)]
+    fn kinematics(&self, q: &Vec3, p: &Vec3, w: &Vec3) -> (Vec3, Vec3) {
+        let a: Vec3 = std::array::from_fn(|x| (q[x] - p[x]) * self.inv_beta_h2);
+        let v: Vec3 = std::array::from_fn(|x| w[x] + self.h_gamma * a[x]);
+        (a, v)
+    }
+
+    /// The scaled inertia-and-gravity row of one coordinate, sigma (M qdd_{n+1} - m g).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn inertia_row(
+        &self,
+        sigma: f64,
+        inertia: f64,
+        mass: f64,
+        g: f64,
+        a: f64,
+        a_n: f64,
+        qdd_n: f64,
+    ) -> f64 {
+        sigma * (inertia * (self.c_a * a + self.c_m * a_n - self.c_f * qdd_n) - mass * g)
+    }
 }
 
 impl GeneralizedAlpha {
@@ -141,6 +223,8 @@ impl GeneralizedAlpha {
     ) -> Result<NewtonReport, NewtonFailure> {
         let k = self.coefficients();
         let c = (1.0 - k.alpha_m) / ((1.0 - k.alpha_f) * k.beta * h * h);
+        let known = Predictors::new(&k, h);
+        state.predict(&k, h, q_n, v_n);
         let mut problem = AlphaStepProblem {
             system,
             layout: &ws.layout,
@@ -148,13 +232,14 @@ impl GeneralizedAlpha {
             scales: &ws.scales,
             inertia: &ws.inertia,
             parallel: ws.parallel.as_mut(),
-            q_n,
-            v_n,
+            p: &state.predicted_q,
+            w: &state.predicted_v,
             a_n: &state.algorithmic,
             qdd_n: &state.acceleration,
             t_n,
             h,
             k,
+            known,
             sigma: 1.0 / (c * ws.mass_ref),
         };
         let work = LinearWork {
@@ -164,18 +249,15 @@ impl GeneralizedAlpha {
             matrix: &mut ws.matrix,
         };
         let report = newton::solve(&mut problem, work, self.matrix_key(h), options)?;
-        problem.kinematics();
-        let hh = h * h;
-        for (i, q) in ws.state.q.iter().enumerate() {
+        let b = &mut ws.state;
+        for i in 0..b.q.len() {
+            let (a, v) = known.kinematics(&b.q[i], &state.predicted_q[i], &state.predicted_v[i]);
+            b.v[i] = v;
             for x in 0..3 {
-                let a_n = state.algorithmic[i][x];
-                let a =
-                    (q[x] - q_n[i][x] - h * v_n[i][x] - hh * (0.5 - k.beta) * a_n) / (k.beta * hh);
-                state.acceleration[i][x] = ((1.0 - k.alpha_m) * a + k.alpha_m * a_n
-                    - k.alpha_f * state.acceleration[i][x])
-                    / (1.0 - k.alpha_f);
-                state.algorithmic[i][x] = a;
+                state.acceleration[i][x] = known.c_a * a[x] + known.c_m * state.algorithmic[i][x]
+                    - known.c_f * state.acceleration[i][x];
             }
+            state.algorithmic[i] = a;
         }
         Ok(report)
     }
@@ -189,47 +271,30 @@ pub struct AlphaStepProblem<'a> {
     scales: &'a [f64],
     inertia: &'a [f64],
     parallel: Option<&'a mut ParallelAssembly>,
-    q_n: &'a [Vec3],
-    v_n: &'a [Vec3],
+    /// The predictors p and w of q_{n+1} and v_{n+1} (see [`Predictors`]).
+    p: &'a [Vec3],
+    w: &'a [Vec3],
     a_n: &'a [Vec3],
     qdd_n: &'a [Vec3],
     t_n: f64,
     h: f64,
     k: AlphaCoefficients,
+    known: Predictors,
     sigma: f64,
 }
 
 impl AlphaStepProblem<'_> {
-    /// a_{n+1} of coordinate x of particle i at the current iterate.
-    fn algorithmic(&self, i: usize, x: usize) -> f64 {
-        let q = self.buffers.q[i][x];
-        algorithmic(
-            q,
-            self.q_n[i][x],
-            self.v_n[i][x],
-            self.a_n[i][x],
-            self.h,
-            self.k.beta,
-        )
-    }
-
     /// The residual on rayon's thread pool (same result as the serial loops, bit for bit).
     fn residual_parallel(&mut self, r: &mut [f64]) {
-        let (h, sigma, k) = (self.h, self.sigma, self.k);
-        let (q_n, v_n, a_n, qdd_n, inertia) =
-            (self.q_n, self.v_n, self.a_n, self.qdd_n, self.inertia);
+        let (h, sigma, known) = (self.h, self.sigma, self.known);
+        let (p, w, a_n, qdd_n, inertia) = (self.p, self.w, self.a_n, self.qdd_n, self.inertia);
         let (system, layout) = (self.system, self.layout);
         let b = &mut *self.buffers;
         b.q.par_iter()
             .zip(b.v.par_iter_mut())
-            .zip(q_n.par_iter().zip(v_n.par_iter()).zip(a_n.par_iter()))
+            .zip(p.par_iter().zip(w.par_iter()))
             .with_min_len(MIN_TASK)
-            .for_each(|((q, v), ((q_n, v_n), a_n))| {
-                for x in 0..3 {
-                    let a = algorithmic(q[x], q_n[x], v_n[x], a_n[x], h, k.beta);
-                    v[x] = v_n[x] + h * (1.0 - k.gamma) * a_n[x] + h * k.gamma * a;
-                }
-            });
+            .for_each(|((q, v), (p, w))| *v = known.kinematics(q, p, w).1);
         let b = &*self.buffers;
         let g = system.gravity();
         let particles = system.particles();
@@ -246,10 +311,9 @@ impl AlphaStepProblem<'_> {
         };
         let parallel = self.parallel.as_deref_mut().expect("parallel assembly");
         parallel.residual(system, layout, &terms, r, |i, x| {
-            let a = algorithmic(b.q[i][x], q_n[i][x], v_n[i][x], a_n[i][x], h, k.beta);
-            let qdd = ((1.0 - k.alpha_m) * a + k.alpha_m * a_n[i][x] - k.alpha_f * qdd_n[i][x])
-                / (1.0 - k.alpha_f);
-            sigma * (inertia[i] * qdd - particles[i].mass * g[x])
+            let a = (b.q[i][x] - p[i][x]) * known.inv_beta_h2;
+            let mass = particles[i].mass;
+            known.inertia_row(sigma, inertia[i], mass, g[x], a, a_n[i][x], qdd_n[i][x])
         });
     }
 
@@ -276,24 +340,6 @@ impl AlphaStepProblem<'_> {
             sigma * c * inertia[i]
         });
     }
-
-    /// Updates v_{n+1} from the iterate q.
-    fn kinematics(&mut self) {
-        let (h, gamma) = (self.h, self.k.gamma);
-        for i in 0..self.buffers.q.len() {
-            for x in 0..3 {
-                let a = self.algorithmic(i, x);
-                self.buffers.v[i][x] =
-                    self.v_n[i][x] + h * (1.0 - gamma) * self.a_n[i][x] + h * gamma * a;
-            }
-        }
-    }
-}
-
-/// a_{n+1} of one coordinate from its iterate q and its old values.
-#[inline]
-fn algorithmic(q: f64, q_n: f64, v_n: f64, a_n: f64, h: f64, beta: f64) -> f64 {
-    (q - q_n - h * v_n - h * h * (0.5 - beta) * a_n) / (beta * h * h)
 }
 
 impl NewtonProblem for AlphaStepProblem<'_> {
@@ -301,19 +347,26 @@ impl NewtonProblem for AlphaStepProblem<'_> {
         if self.parallel.is_some() {
             return self.residual_parallel(r);
         }
-        self.kinematics();
-        let (system, layout, sigma, k) = (self.system, self.layout, self.sigma, self.k);
+        let (system, layout, sigma, known) = (self.system, self.layout, self.sigma, self.known);
         let t1 = self.t_n + self.h;
         let g = system.gravity();
+        let b = &mut *self.buffers;
         for (i, p) in system.particles().iter().enumerate() {
+            let (a, v) = known.kinematics(&b.q[i], &self.p[i], &self.w[i]);
+            b.v[i] = v;
             let d = layout.dof[i];
             if d != NONE {
+                let (a_n, qdd_n) = (self.a_n[i], self.qdd_n[i]);
                 for x in 0..3 {
-                    let qdd = ((1.0 - k.alpha_m) * self.algorithmic(i, x)
-                        + k.alpha_m * self.a_n[i][x]
-                        - k.alpha_f * self.qdd_n[i][x])
-                        / (1.0 - k.alpha_f);
-                    r[d + x] = sigma * (self.inertia[i] * qdd - p.mass * g[x]);
+                    r[d + x] = known.inertia_row(
+                        sigma,
+                        self.inertia[i],
+                        p.mass,
+                        g[x],
+                        a[x],
+                        a_n[x],
+                        qdd_n[x],
+                    );
                 }
             }
         }
@@ -331,16 +384,18 @@ impl NewtonProblem for AlphaStepProblem<'_> {
         }
         let m3 = 3 * layout.free;
         for (c, con) in system.constraints().iter().enumerate() {
-            let grad = con.gradient(&b.q, t1);
+            let (phi, grad) = con.residual_and_gradient(&b.q, t1);
+            let weight = sigma * b.lambda[c];
             for (x, &p) in con.particles().iter().enumerate() {
                 let d = layout.dof[p];
                 if d != NONE {
+                    let row = &mut r[d..d + 3];
                     for y in 0..3 {
-                        r[d + y] -= sigma * grad[x][y] * b.lambda[c];
+                        row[y] -= weight * grad[x][y];
                     }
                 }
             }
-            r[m3 + c] = self.scales[c] * con.residual(&b.q, t1);
+            r[m3 + c] = self.scales[c] * phi;
         }
     }
 
@@ -425,6 +480,9 @@ mod tests {
                 let k = scheme.coefficients();
                 let h = 0.01;
                 let c = (1.0 - k.alpha_m) / ((1.0 - k.alpha_f) * k.beta * h * h);
+                let mut state = AlphaState::new(&a_n);
+                state.acceleration = qdd_n;
+                state.predict(&k, h, &q_n, &v_n);
                 perturbed_iterate(&mut ws, &q_n);
                 let mut problem = AlphaStepProblem {
                     system: &s,
@@ -433,13 +491,14 @@ mod tests {
                     scales: &ws.scales,
                     inertia: &ws.inertia,
                     parallel: None,
-                    q_n: &q_n,
-                    v_n: &v_n,
-                    a_n: &a_n,
-                    qdd_n: &qdd_n,
+                    p: &state.predicted_q,
+                    w: &state.predicted_v,
+                    a_n: &state.algorithmic,
+                    qdd_n: &state.acceleration,
                     t_n: 0.3,
                     h,
                     k,
+                    known: Predictors::new(&k, h),
                     sigma: 1.0 / (c * ws.mass_ref),
                 };
                 assert_jacobian_matches(&mut problem, &ws.layout);
@@ -462,6 +521,9 @@ mod tests {
             let k = GeneralizedAlpha { rho_inf: 0.6 }.coefficients();
             let h = 0.01;
             let c = (1.0 - k.alpha_m) / ((1.0 - k.alpha_f) * k.beta * h * h);
+            let mut state = AlphaState::new(&a_n);
+            state.acceleration = qdd_n;
+            state.predict(&k, h, &q_n, &v_n);
             let assemble = |parallel: bool| {
                 let mut ws = StepWorkspace::new(&s, 48);
                 if parallel {
@@ -475,13 +537,14 @@ mod tests {
                     scales: &ws.scales,
                     inertia: &ws.inertia,
                     parallel: ws.parallel.as_mut(),
-                    q_n: &q_n,
-                    v_n: &v_n,
-                    a_n: &a_n,
-                    qdd_n: &qdd_n,
+                    p: &state.predicted_q,
+                    w: &state.predicted_v,
+                    a_n: &state.algorithmic,
+                    qdd_n: &state.acceleration,
                     t_n: 0.3,
                     h,
                     k,
+                    known: Predictors::new(&k, h),
                     sigma: 1.0 / (c * ws.mass_ref),
                 };
                 let mut r = vec![0.0; ws.layout.unknowns()];

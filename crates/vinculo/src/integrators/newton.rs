@@ -112,20 +112,47 @@ pub enum NewtonFailure {
     Singular(Singular),
 }
 
-fn inf_norm(x: &[f64]) -> (f64, usize) {
+/// The infinity norm of `x`, NaN if any entry is NaN. Four independent running maxima and a
+/// NaN flag, with no early exit, so that the compiler turns the pass into vector instructions.
+fn inf_norm(x: &[f64]) -> f64 {
+    let mut m = [0.0f64; 4];
+    let mut nan = false;
+    let chunks = x.chunks_exact(4);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for l in 0..4 {
+            let a = c[l].abs();
+            m[l] = if a > m[l] { a } else { m[l] };
+            nan |= a.is_nan();
+        }
+    }
+    for (l, v) in rest.iter().enumerate() {
+        let a = v.abs();
+        m[l] = if a > m[l] { a } else { m[l] };
+        nan |= a.is_nan();
+    }
+    if nan {
+        f64::NAN
+    } else {
+        m[0].max(m[1]).max(m[2].max(m[3]))
+    }
+}
+
+/// The index of the entry of `x` of largest magnitude (the first NaN, if any).
+fn worst_entry(x: &[f64]) -> usize {
     let mut m = 0.0;
     let mut k = 0;
     for (i, v) in x.iter().enumerate() {
         let a = v.abs();
-        if a > m || a.is_nan() {
+        if a.is_nan() {
+            return i;
+        }
+        if a > m {
             m = a;
             k = i;
-            if a.is_nan() {
-                break;
-            }
         }
     }
-    (m, k)
+    k
 }
 
 /// Work arrays and the factorisation state one solve uses.
@@ -165,12 +192,12 @@ pub fn solve(
     let mut worst = 0;
     for iteration in 0..=options.max_iterations {
         problem.residual(r);
-        (residual, worst) = inf_norm(r);
+        residual = inf_norm(r);
         if !residual.is_finite() {
             return Err(NewtonFailure::NotConverged {
                 iterations: iteration,
                 residual,
-                worst,
+                worst: worst_entry(r),
             });
         }
         if iteration > 0 && residual <= options.tolerance && increment <= options.tolerance {
@@ -182,6 +209,7 @@ pub fn solve(
             });
         }
         if iteration == options.max_iterations {
+            worst = worst_entry(r);
             break;
         }
         if refresh || stale_iterations >= MAX_STALE_ITERATIONS {
@@ -196,7 +224,7 @@ pub fn solve(
             previous = f64::INFINITY;
         }
         solver.solve_in_place(r);
-        increment = inf_norm(r).0;
+        increment = inf_norm(r);
         stale_iterations += 1;
         refresh = !reuse || increment > MAX_CONTRACTION * previous;
         previous = increment;

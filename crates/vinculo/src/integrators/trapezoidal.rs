@@ -171,18 +171,42 @@ pub struct StepProblem<'a> {
     sigma: f64,
 }
 
+/// The rule's kinematic relations with the divisions done once per step:
+/// v_a = (q - q_n)/h, v_{n+1} = (v_a - (1 - alpha) v_n)/alpha, q_a = (1 - alpha) q_n + alpha q.
+#[derive(Debug, Clone, Copy)]
+struct Kinematics {
+    alpha: f64,
+    inv_h: f64,
+    inv_alpha: f64,
+}
+
+impl Kinematics {
+    fn new(alpha: f64, h: f64) -> Kinematics {
+        Kinematics {
+            alpha,
+            inv_h: 1.0 / h,
+            inv_alpha: 1.0 / alpha,
+        }
+    }
+
+    /// (v_{n+1}, q_a, v_a) of one particle from its iterate q and (q_n, v_n).
+    #[inline(always)]
+    fn of(&self, q: &Vec3, q_n: &Vec3, v_n: &Vec3) -> (Vec3, Vec3, Vec3) {
+        let a = self.alpha;
+        let va: Vec3 = std::array::from_fn(|k| (q[k] - q_n[k]) * self.inv_h);
+        let v = std::array::from_fn(|k| (va[k] - (1.0 - a) * v_n[k]) * self.inv_alpha);
+        let qa = std::array::from_fn(|k| (1.0 - a) * q_n[k] + a * q[k]);
+        (v, qa, va)
+    }
+}
+
 impl StepProblem<'_> {
     /// Updates v_{n+1}, q_a, v_a from the iterate q.
     fn kinematics(&mut self) {
-        let (a, h) = (self.alpha, self.h);
+        let rule = Kinematics::new(self.alpha, self.h);
         let b = &mut *self.buffers;
         for i in 0..b.q.len() {
-            for k in 0..3 {
-                let va = (b.q[i][k] - self.q_n[i][k]) / h;
-                b.v_alpha[i][k] = va;
-                b.v[i][k] = (va - (1.0 - a) * self.v_n[i][k]) / a;
-                b.q_alpha[i][k] = (1.0 - a) * self.q_n[i][k] + a * b.q[i][k];
-            }
+            (b.v[i], b.q_alpha[i], b.v_alpha[i]) = rule.of(&b.q[i], &self.q_n[i], &self.v_n[i]);
         }
     }
 
@@ -197,6 +221,7 @@ impl StepProblem<'_> {
         let (system, layout) = (self.system, self.layout);
         let ta = self.t_alpha();
         let b = &mut *self.buffers;
+        let rule = Kinematics::new(a, h);
         b.q.par_iter()
             .zip(b.v.par_iter_mut())
             .zip(b.v_alpha.par_iter_mut())
@@ -204,12 +229,7 @@ impl StepProblem<'_> {
             .zip(q_n.par_iter().zip(v_n.par_iter()))
             .with_min_len(MIN_TASK)
             .for_each(|((((q, v), v_alpha), q_alpha), (q_n, v_n))| {
-                for k in 0..3 {
-                    let va = (q[k] - q_n[k]) / h;
-                    v_alpha[k] = va;
-                    v[k] = (va - (1.0 - a) * v_n[k]) / a;
-                    q_alpha[k] = (1.0 - a) * q_n[k] + a * q[k];
-                }
+                (*v, *q_alpha, *v_alpha) = rule.of(q, q_n, v_n);
             });
         let b = &*self.buffers;
         let g = system.gravity();
@@ -225,8 +245,9 @@ impl StepProblem<'_> {
             scales: self.scales,
         };
         let parallel = self.parallel.as_deref_mut().expect("parallel assembly");
+        let inv_h = 1.0 / h;
         parallel.residual(system, layout, &terms, r, |i, k| {
-            sigma * (inertia[i] * (b.v[i][k] - v_n[i][k]) / h - particles[i].mass * g[k])
+            sigma * (inertia[i] * ((b.v[i][k] - v_n[i][k]) * inv_h) - particles[i].mass * g[k])
         });
     }
 
@@ -263,12 +284,14 @@ impl NewtonProblem for StepProblem<'_> {
         let ta = self.t_alpha();
         let g = system.gravity();
         let b = &*self.buffers;
+        let inv_h = 1.0 / h;
         for (i, p) in system.particles().iter().enumerate() {
             let d = layout.dof[i];
             if d != NONE {
                 for k in 0..3 {
                     r[d + k] = sigma
-                        * (self.inertia[i] * (b.v[i][k] - self.v_n[i][k]) / h - p.mass * g[k]);
+                        * (self.inertia[i] * ((b.v[i][k] - self.v_n[i][k]) * inv_h)
+                            - p.mass * g[k]);
                 }
             }
         }
@@ -287,11 +310,13 @@ impl NewtonProblem for StepProblem<'_> {
         let m3 = 3 * layout.free;
         for (c, con) in system.constraints().iter().enumerate() {
             let grad = con.gradient(&b.q_alpha, ta);
+            let weight = sigma * b.lambda[c];
             for (x, &p) in con.particles().iter().enumerate() {
                 let d = layout.dof[p];
                 if d != NONE {
+                    let row = &mut r[d..d + 3];
                     for k in 0..3 {
-                        r[d + k] -= sigma * grad[x][k] * b.lambda[c];
+                        row[k] -= weight * grad[x][k];
                     }
                 }
             }

@@ -295,7 +295,9 @@ fn gather(out: &mut [f64], slots: &[u32], values: &[f64]) {
 }
 
 /// In-place LU with partial pivoting of the n x n row-major matrix `a`; returns the local
-/// column of a negligible pivot.
+/// column of a negligible pivot. On return the strict lower triangle holds L (unit diagonal),
+/// the strict upper triangle U, and the diagonal the reciprocals of U's pivots, so that the
+/// solves multiply where they would divide.
 #[inline(always)]
 fn lu_in_place(a: &mut [f64], n: usize, perm: &mut [u32]) -> Result<(), usize> {
     // Slices of known length let the unrolled copies drop their bounds checks.
@@ -329,29 +331,28 @@ fn lu_in_place(a: &mut [f64], n: usize, perm: &mut [u32]) -> Result<(), usize> {
                 }
             }
         }
+        a[k * n + k] = inv;
     }
     Ok(())
 }
 
 /// Solves with the factors of `lu_in_place` for the n x m row-major right-hand side `x`.
+/// Branch-free (the row interchanges are applied as swaps, identity ones included), so that the
+/// copies for a fixed n unroll completely.
 #[inline(always)]
 fn lu_solve(a: &[f64], n: usize, perm: &[u32], x: &mut [f64], m: usize) {
     let (a, perm, x) = (&a[..n * n], &perm[..n], &mut x[..n * m]);
     for k in 0..n {
-        let p = perm[k] as usize;
-        if p != k {
-            for c in 0..m {
-                x.swap(k * m + c, p * m + c);
-            }
+        let p = (perm[k] as usize).min(n - 1);
+        for c in 0..m {
+            x.swap(k * m + c, p * m + c);
         }
     }
     for i in 1..n {
         for j in 0..i {
             let l = a[i * n + j];
-            if l != 0.0 {
-                for c in 0..m {
-                    x[i * m + c] -= l * x[j * m + c];
-                }
+            for c in 0..m {
+                x[i * m + c] -= l * x[j * m + c];
             }
         }
     }
@@ -362,7 +363,7 @@ fn lu_solve(a: &[f64], n: usize, perm: &[u32], x: &mut [f64], m: usize) {
                 x[i * m + c] -= u * x[j * m + c];
             }
         }
-        let inv = 1.0 / a[i * n + i];
+        let inv = a[i * n + i];
         for c in 0..m {
             x[i * m + c] *= inv;
         }
@@ -414,6 +415,63 @@ fn forward(
             }
             zp[r] -= acc;
         }
+    }
+}
+
+/// [`forward`] for a block of N unknowns known at compile time: the same operations on
+/// fixed-size arrays, unrolled, with the running sums kept in registers.
+#[inline(always)]
+fn forward_fixed<const N: usize>(
+    d: &[f64],
+    perm: &[u32],
+    zb: &mut [f64],
+    coupling: Option<(&[f64], &mut [f64])>,
+) {
+    let z: &mut [f64; N] = (&mut zb[..N]).try_into().expect("block of N unknowns");
+    let (d, perm) = (&d[..N * N], &perm[..N]);
+    for k in 0..N {
+        z.swap(k, (perm[k] as usize).min(N - 1));
+    }
+    for i in 1..N {
+        let mut s = z[i];
+        for j in 0..i {
+            s -= d[i * N + j] * z[j];
+        }
+        z[i] = s;
+    }
+    for i in (0..N).rev() {
+        let mut s = z[i];
+        for j in i + 1..N {
+            s -= d[i * N + j] * z[j];
+        }
+        z[i] = s * d[i * N + i];
+    }
+    if let Some((low, zp)) = coupling {
+        let (low, zp) = (&low[..3 * N], &mut zp[..3]);
+        for r in 0..3 {
+            let mut acc = 0.0;
+            for j in 0..N {
+                acc += low[r * N + j] * z[j];
+            }
+            zp[r] -= acc;
+        }
+    }
+}
+
+/// Backward step of the solve for one block: x_b = z_b - W_b x_P.
+#[inline(always)]
+fn backward(w: &[f64], xp: [f64; 3], zb: &mut [f64]) {
+    for (x, wj) in zb.iter_mut().zip(w.chunks_exact(3)) {
+        *x -= wj[0] * xp[0] + wj[1] * xp[1] + wj[2] * xp[2];
+    }
+}
+
+/// [`backward`] for a block of N unknowns known at compile time.
+#[inline(always)]
+fn backward_fixed<const N: usize>(w: &[f64], xp: [f64; 3], zb: &mut [f64]) {
+    let (w, zb) = (&w[..3 * N], &mut zb[..N]);
+    for j in 0..N {
+        zb[j] -= w[3 * j] * xp[0] + w[3 * j + 1] * xp[1] + w[3 * j + 2] * xp[2];
     }
 }
 
@@ -484,10 +542,11 @@ impl LinearSolver for TreeElimination {
                     &mut tail[self.start[pb as usize] - e..],
                 ))
             };
+            // Blocks of 3 (a free particle), 4 (a particle and its link) and 5 get unrolled copies.
             match nb {
-                3 => forward(d, 3, perm, zb, coupling),
-                4 => forward(d, 4, perm, zb, coupling),
-                5 => forward(d, 5, perm, zb, coupling),
+                3 => forward_fixed::<3>(d, perm, zb, coupling),
+                4 => forward_fixed::<4>(d, perm, zb, coupling),
+                5 => forward_fixed::<5>(d, perm, zb, coupling),
                 _ => forward(d, nb, perm, zb, coupling),
             }
         }
@@ -499,10 +558,13 @@ impl LinearSolver for TreeElimination {
             let (s, e) = (self.start[b], self.start[b + 1]);
             let (head, tail) = self.z.split_at_mut(e);
             let zp = &tail[self.start[pb as usize] - e..];
-            let (xp0, xp1, xp2) = (zp[0], zp[1], zp[2]);
-            let w = &self.w[3 * s..3 * e];
-            for (j, x) in head[s..].iter_mut().enumerate() {
-                *x -= w[3 * j] * xp0 + w[3 * j + 1] * xp1 + w[3 * j + 2] * xp2;
+            let xp = [zp[0], zp[1], zp[2]];
+            let (w, zb) = (&self.w[3 * s..3 * e], &mut head[s..]);
+            match e - s {
+                3 => backward_fixed::<3>(w, xp, zb),
+                4 => backward_fixed::<4>(w, xp, zb),
+                5 => backward_fixed::<5>(w, xp, zb),
+                _ => backward(w, xp, zb),
             }
         }
         for (z, &u) in self.z.iter().zip(&self.unknowns) {
