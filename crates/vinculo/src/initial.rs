@@ -25,12 +25,7 @@ fn fill_saddle(system: &System, ws: &mut StepWorkspace, q: &[Vec3], t: f64) {
     let values = &mut ws.values;
     values.fill(0.0);
     for (i, m) in ws.inertia.iter().enumerate() {
-        let blk = &layout.particle_block[i];
-        if blk[0] != NONE {
-            for k in 0..3 {
-                values[blk[4 * k]] += m / ws.mass_ref;
-            }
-        }
+        layout.add_to_particle_diagonal(values, i, m / ws.mass_ref);
     }
     for (c, con) in system.constraints().iter().enumerate() {
         let g = con.gradient(q, t);

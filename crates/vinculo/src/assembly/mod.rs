@@ -12,11 +12,19 @@ pub use pattern::{Pattern, Storage};
 
 use crate::model::System;
 
-/// Marks an absent block entry (a fixed particle, or no coupling).
+/// Marks an absent unknown (a fixed particle has no coordinates among the unknowns).
 pub const NONE: usize = usize::MAX;
 
+/// Position of a matrix entry in the value array. 32 bits: the slot tables are the largest
+/// per-element arrays of a model (a chain link has 45 slots), and four billion entries is far
+/// beyond any model that fits in memory.
+pub type Slot = u32;
+
+/// Marks an absent block entry (a fixed particle, or no coupling).
+pub const NO_SLOT: Slot = Slot::MAX;
+
 /// Slots of a 3x3 block, row-major.
-pub type Block = [usize; 9];
+pub type Block = [Slot; 9];
 
 /// Where each element writes in the matrix.
 #[derive(Debug, Clone)]
@@ -34,9 +42,9 @@ pub struct Layout {
     /// Per constraint: blocks [a][b] of the Hessian term between its touched particles.
     pub constraint_hessian: Vec<[[Block; 2]; 2]>,
     /// Per constraint: slots of -Phi_q^T (rows of particle a, its multiplier's column).
-    pub constraint_column: Vec<[[usize; 3]; 2]>,
+    pub constraint_column: Vec<[[Slot; 3]; 2]>,
     /// Per constraint: slots of Phi_q (its row, columns of particle a).
-    pub constraint_row: Vec<[[usize; 3]; 2]>,
+    pub constraint_row: Vec<[[Slot; 3]; 2]>,
     /// Per force: blocks [a][b] of its Jacobian.
     pub force_block: Vec<[[Block; 2]; 2]>,
 }
@@ -118,20 +126,26 @@ impl Layout {
             }
         }
         let pattern = Pattern::new(n, entries, n <= dense_limit);
+        assert!(
+            pattern.nnz() < NO_SLOT as usize,
+            "the iteration matrix has {} entries, more than 32-bit slots can address",
+            pattern.nnz()
+        );
+        let slot = |row: usize, col: usize| pattern.slot(row, col) as Slot;
 
         let block_slots = |a: usize, b: usize| -> Block {
-            let mut s = [NONE; 9];
+            let mut s = [NO_SLOT; 9];
             if a != NONE && b != NONE {
                 for r in 0..3 {
                     for c in 0..3 {
-                        s[3 * r + c] = pattern.slot(a + r, b + c);
+                        s[3 * r + c] = slot(a + r, b + c);
                     }
                 }
             }
             s
         };
         let pair_blocks = |parts: &[usize]| -> [[Block; 2]; 2] {
-            let mut out = [[[NONE; 9]; 2]; 2];
+            let mut out = [[[NO_SLOT; 9]; 2]; 2];
             for (x, &a) in parts.iter().enumerate() {
                 for (y, &b) in parts.iter().enumerate() {
                     out[x][y] = block_slots(dof[a], dof[b]);
@@ -145,13 +159,13 @@ impl Layout {
         let mut constraint_row = Vec::with_capacity(m);
         for (k, c) in system.constraints().iter().enumerate() {
             constraint_hessian.push(pair_blocks(c.particles()));
-            let mut col = [[NONE; 3]; 2];
-            let mut row = [[NONE; 3]; 2];
+            let mut col = [[NO_SLOT; 3]; 2];
+            let mut row = [[NO_SLOT; 3]; 2];
             for (x, &p) in c.particles().iter().enumerate() {
                 if dof[p] != NONE {
                     for r in 0..3 {
-                        col[x][r] = pattern.slot(dof[p] + r, lambda(k));
-                        row[x][r] = pattern.slot(lambda(k), dof[p] + r);
+                        col[x][r] = slot(dof[p] + r, lambda(k));
+                        row[x][r] = slot(lambda(k), dof[p] + r);
                     }
                 }
             }
@@ -165,7 +179,7 @@ impl Layout {
                 if f.has_jacobian() {
                     pair_blocks(f.particles())
                 } else {
-                    [[[NONE; 9]; 2]; 2]
+                    [[[NO_SLOT; 9]; 2]; 2]
                 }
             })
             .collect();
@@ -237,6 +251,18 @@ impl Layout {
         }
     }
 
+    /// Adds `m` to the three diagonal entries of particle `i`'s block (nothing for a fixed
+    /// particle): the mass term of the iteration matrix.
+    #[inline]
+    pub fn add_to_particle_diagonal(&self, values: &mut [f64], i: usize, m: f64) {
+        let blk = &self.particle_block[i];
+        if blk[0] != NO_SLOT {
+            for k in 0..3 {
+                values[blk[4 * k] as usize] += m;
+            }
+        }
+    }
+
     /// Applies a Newton increment `dx` (in scaled unknowns) to the positions of the free
     /// particles and to the multipliers, whose unknowns are lambda_k sigma / s_k.
     #[inline]
@@ -265,21 +291,21 @@ impl Layout {
 
 /// Adds `value` at `slot` unless the slot is absent.
 #[inline]
-pub fn add(values: &mut [f64], slot: usize, value: f64) {
-    if slot != NONE {
-        values[slot] += value;
+pub fn add(values: &mut [f64], slot: Slot, value: f64) {
+    if slot != NO_SLOT {
+        values[slot as usize] += value;
     }
 }
 
 /// Adds the 3x3 matrix `m` (scaled by `s`) into the block `b`.
 #[inline]
 pub fn add_block(values: &mut [f64], b: &Block, s: f64, m: &crate::math::Mat3) {
-    if b[0] == NONE {
+    if b[0] == NO_SLOT {
         return;
     }
     for r in 0..3 {
         for c in 0..3 {
-            values[b[3 * r + c]] += s * m[r][c];
+            values[b[3 * r + c] as usize] += s * m[r][c];
         }
     }
 }

@@ -21,7 +21,7 @@
 
 use rayon::prelude::*;
 
-use super::{Block, Layout, NONE};
+use super::{Block, Layout, Slot, NONE, NO_SLOT};
 use crate::constraints::{Gradient, Hessian};
 use crate::forces::{Jacobian, Local};
 use crate::math::{Mat3, Vec3};
@@ -141,8 +141,9 @@ impl SharedValues {
     /// # Safety
     /// No other task may access `slot` concurrently (see the type's documentation).
     #[inline]
-    unsafe fn add(&self, slot: usize, value: f64) {
-        if slot != NONE {
+    unsafe fn add(&self, slot: Slot, value: f64) {
+        if slot != NO_SLOT {
+            let slot = slot as usize;
             assert!(slot < self.len, "slot {slot} outside the value array");
             // SAFETY: in bounds (checked above); exclusive by the caller's contract.
             unsafe { *self.ptr.add(slot) += value };
@@ -155,7 +156,7 @@ impl SharedValues {
     /// As for [`SharedValues::add`], for every slot of the block.
     #[inline]
     unsafe fn add_block(&self, b: &Block, s: f64, m: &Mat3) {
-        if b[0] == NONE {
+        if b[0] == NO_SLOT {
             return;
         }
         for r in 0..3 {

@@ -410,13 +410,7 @@ impl NewtonProblem for AlphaStepProblem<'_> {
         let c = (1.0 - k.alpha_m) / ((1.0 - k.alpha_f) * k.beta * h * h);
         let dv_dq = k.gamma / (k.beta * h);
         for i in 0..system.particles().len() {
-            let blk = &layout.particle_block[i];
-            if blk[0] != NONE {
-                let m = sigma * c * self.inertia[i];
-                for x in 0..3 {
-                    values[blk[4 * x]] += m;
-                }
-            }
+            layout.add_to_particle_diagonal(values, i, sigma * c * self.inertia[i]);
         }
         for (fi, f) in system.forces().iter().enumerate() {
             if !f.has_jacobian() {

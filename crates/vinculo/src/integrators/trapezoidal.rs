@@ -334,13 +334,7 @@ impl NewtonProblem for StepProblem<'_> {
         let t1 = self.t_n + h;
         let b = &*self.buffers;
         for i in 0..system.particles().len() {
-            let blk = &layout.particle_block[i];
-            if blk[0] != NONE {
-                let m = sigma * self.inertia[i] / (a * h * h);
-                for k in 0..3 {
-                    values[blk[4 * k]] += m;
-                }
-            }
+            layout.add_to_particle_diagonal(values, i, sigma * self.inertia[i] / (a * h * h));
         }
         for (fi, f) in system.forces().iter().enumerate() {
             if !f.has_jacobian() {

@@ -52,6 +52,8 @@ pub struct TreeElimination {
     perm: Vec<u32>,
     /// Work vector in local (block) order.
     z: Vec<f64>,
+    /// The common size of every block, or 0 when the sizes differ.
+    uniform: usize,
     factored: bool,
 }
 
@@ -264,7 +266,12 @@ impl TreeElimination {
         if covered != pattern.nnz() {
             return None;
         }
+        let uniform = match start.windows(2).map(|w| w[1] - w[0]).min() {
+            Some(nb) if start[blocks] == nb * blocks => nb,
+            _ => 0,
+        };
         Some(TreeElimination {
+            uniform,
             diag: vec![0.0; diag_at[blocks]],
             low: vec![0.0; 3 * n],
             w: vec![0.0; 3 * n],
@@ -526,6 +533,25 @@ impl LinearSolver for TreeElimination {
         for (z, &u) in self.z.iter_mut().zip(&self.unknowns) {
             *z = rhs[u as usize];
         }
+        match self.uniform {
+            3 => self.sweeps_uniform::<3>(),
+            4 => self.sweeps_uniform::<4>(),
+            5 => self.sweeps_uniform::<5>(),
+            _ => self.sweeps(),
+        }
+        for (z, &u) in self.z.iter().zip(&self.unknowns) {
+            rhs[u as usize] = *z;
+        }
+    }
+
+    fn name(&self) -> &'static str {
+        "tree elimination"
+    }
+}
+
+impl TreeElimination {
+    /// The forward and backward sweeps of the solve on the work vector `z` (blocks of any size).
+    fn sweeps(&mut self) {
         for b in 0..self.blocks() {
             let (s, e) = (self.start[b], self.start[b + 1]);
             let nb = e - s;
@@ -567,13 +593,39 @@ impl LinearSolver for TreeElimination {
                 _ => backward(w, xp, zb),
             }
         }
-        for (z, &u) in self.z.iter().zip(&self.unknowns) {
-            rhs[u as usize] = *z;
-        }
     }
 
-    fn name(&self) -> &'static str {
-        "tree elimination"
+    /// [`TreeElimination::sweeps`] when every block has N unknowns (a chain whose links each
+    /// join a particle's block): block b starts at N b and its factors at N^2 b, so the loops
+    /// walk the arrays in chunks of fixed size.
+    fn sweeps_uniform<const N: usize>(&mut self) {
+        let z = &mut self.z;
+        let blocks = self
+            .diag
+            .chunks_exact(N * N)
+            .zip(self.perm.chunks_exact(N))
+            .zip(self.low.chunks_exact(3 * N))
+            .zip(&self.parent);
+        for (b, (((d, perm), low), &pb)) in blocks.enumerate() {
+            let (head, tail) = z.split_at_mut(N * b + N);
+            let zb = &mut head[N * b..];
+            let coupling = (pb != ROOT).then(|| (low, &mut tail[N * pb as usize - N * b - N..]));
+            forward_fixed::<N>(d, perm, zb, coupling);
+        }
+        for (b, (w, &pb)) in self
+            .w
+            .chunks_exact(3 * N)
+            .zip(&self.parent)
+            .enumerate()
+            .rev()
+        {
+            if pb == ROOT {
+                continue;
+            }
+            let p = N * pb as usize;
+            let xp = [z[p], z[p + 1], z[p + 2]];
+            backward_fixed::<N>(w, xp, &mut z[N * b..N * b + N]);
+        }
     }
 }
 
