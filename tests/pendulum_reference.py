@@ -63,6 +63,11 @@ class MovingPivot:
     amplitude: float = 0.1
     frequency: float = 1.0
     theta0: float = np.pi / 6
+    # The pivot's shaking may start at t_start, rising over ramp_time as the C2 quintic of
+    # ``vinculo.sine`` (s = 10 u^3 - 15 u^4 + 6 u^5, u = (t - t_start)/ramp_time).
+    ramp_time: float = 0.0
+    t_start: float = 0.0
+    phase: float = 0.0
 
     @property
     def omega(self) -> float:
@@ -74,24 +79,58 @@ class MovingPivot:
         bob = system.add_particle(
             1.0,
             [np.sin(self.theta0), 0.0, -np.cos(self.theta0)],
-            velocity=[self.amplitude * self.omega, 0.0, 0.0],
+            velocity=[float(self._pivot_derivatives(0.0)[1]), 0.0, 0.0],
         )
-        law = vinculo.sine(self.amplitude, self.frequency)
+        law = vinculo.sine(
+            self.amplitude,
+            self.frequency,
+            phase=self.phase,
+            ramp_time=self.ramp_time,
+            t_start=self.t_start,
+        )
         system.add_distance_to_point(bob, (law, 0.0, 0.0), 1.0)
         return system, bob
 
+    def _ramp(self, t):
+        """The ramp s and its first two time derivatives."""
+        t = np.asarray(t, dtype=float)
+        if self.ramp_time <= 0.0:
+            one = np.ones_like(t)
+            return one, 0.0 * one, 0.0 * one
+        u = np.clip((t - self.t_start) / self.ramp_time, 0.0, 1.0)
+        d = self.ramp_time
+        return (
+            u**3 * (10.0 - 15.0 * u + 6.0 * u**2),
+            30.0 * u**2 * (1.0 - u) ** 2 / d,
+            60.0 * u * (1.0 - 3.0 * u + 2.0 * u**2) / d**2,
+        )
+
+    def _pivot_derivatives(self, t):
+        """x_p, x_p', x_p'' at t."""
+        t = np.asarray(t, dtype=float)
+        w = self.omega
+        arg = w * (t - self.t_start) + self.phase
+        g = np.array([np.sin(arg), w * np.cos(arg), -(w**2) * np.sin(arg)])
+        s = self._ramp(t)
+        a = self.amplitude
+        return (
+            a * s[0] * g[0],
+            a * (s[1] * g[0] + s[0] * g[1]),
+            a * (s[2] * g[0] + 2.0 * s[1] * g[1] + s[0] * g[2]),
+        )
+
     def pivot(self, t):
-        return self.amplitude * np.sin(self.omega * np.asarray(t))
+        return self._pivot_derivatives(t)[0]
 
     def pivot_acceleration(self, t: float) -> float:
-        return -self.amplitude * self.omega**2 * np.sin(self.omega * t)
+        return float(self._pivot_derivatives(t)[2])
 
     def bob_states(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(len(times), 3) reference positions and velocities of the bob."""
         times = np.asarray(times, dtype=float)
         theta, rate = angle_history(self.theta0, times, self.pivot_acceleration)
         zero = np.zeros_like(theta)
-        pivot_rate = self.amplitude * self.omega * np.cos(self.omega * times)
+        pivot_rate = self._pivot_derivatives(times)[1]
         positions = np.stack([self.pivot(times) + np.sin(theta), zero, -np.cos(theta)], axis=1)
         velocities = np.stack(
             [pivot_rate + np.cos(theta) * rate, zero, np.sin(theta) * rate], axis=1

@@ -7,9 +7,9 @@ steps used here.
 
 import numpy as np
 import pytest
-from pendulum_reference import MovingPivot, angle_reference
 
 import vinculo
+from pendulum_reference import MovingPivot, angle_reference
 from vinculo import demos
 
 # (scheme keywords, expected order of the positions, label). Orders: formulation.md for the

@@ -21,6 +21,7 @@
 //! (which the controller's growth limit ensures). The second order survives (checked by
 //! `tests/test_adaptive.py`, where the error falls with the tolerance like a second-order scheme's).
 
+use crate::assembly::NONE;
 use crate::dense_output::StepEnds;
 use crate::error::Error;
 use crate::initial::{scaled_velocity_violation, scaled_violation, singular_error};
@@ -77,6 +78,30 @@ fn take_step(
     }
 }
 
+/// Replaces the accelerations `a` by their part tangent to the constraints, with the
+/// factorisation of the step's last Newton matrix `[M/m_ref + K, -s G^T; s G, 0]` (K = O(h^2)):
+/// solving it with the right-hand side `[M a / m_ref; 0]` gives x with G x = 0 and
+/// (M/m_ref + K) x = M a / m_ref + s G^T mu, the M-orthogonal projection of a onto the tangent
+/// space up to O(h^2). What is left out is the acceleration the multipliers impose normal to the
+/// constraints (see `integrators::error_estimate` for why the estimate needs it gone).
+fn tangential(ws: &mut StepWorkspace, a: &mut [Vec3], rhs: &mut [f64]) {
+    rhs.fill(0.0);
+    let mass_ref = ws.mass_ref;
+    for (i, &d) in ws.layout.dof.iter().enumerate() {
+        if d != NONE {
+            for k in 0..3 {
+                rhs[d + k] = ws.inertia[i] / mass_ref * a[i][k];
+            }
+        }
+    }
+    ws.solver.solve_in_place(rhs);
+    for (i, &d) in ws.layout.dof.iter().enumerate() {
+        for k in 0..3 {
+            a[i][k] = if d != NONE { rhs[d + k] } else { 0.0 };
+        }
+    }
+}
+
 /// Stores a state with its violations and the statistics of the step that produced it.
 fn store(
     sol: &mut Solution,
@@ -112,8 +137,11 @@ pub(crate) fn march(
     let n = q.len();
     let free: Vec<bool> = system.particles().iter().map(|p| !p.fixed).collect();
     let constants = ErrorConstants::of(&scheme);
+    // Built at the first attempt, once a factorisation can project the initial accelerations.
     let mut history = AccelerationHistory::new(t0, &acc);
-    let mut controller = PiController::new(scheme.order() + 1, control.hold);
+    let mut projection = vec![0.0; ws.layout.unknowns()];
+    let mut initial = acc.clone();
+    let mut controller = PiController::new(scheme.order(), control.hold);
 
     // Requested output times: the initial row stays only when t_start is one of them.
     let outputs: &[f64] = options.output_times.as_deref().unwrap_or(&[]);
@@ -134,6 +162,7 @@ pub(crate) fn march(
     let mut alpha_saved = alpha_state.clone();
     let (mut q_new, mut v_new, mut lambda_new) = (q.clone(), v.clone(), lambda.clone());
     let (mut a_sample, mut e_q, mut e_v) = (acc.clone(), acc.clone(), acc.clone());
+    let mut full = acc.clone();
     let (mut q_out, mut v_out, mut lambda_out) = (q.clone(), v.clone(), lambda.clone());
 
     let mut t = t0;
@@ -208,7 +237,7 @@ pub(crate) fn march(
             }
         };
 
-        // The step's acceleration sample and its error.
+        // The step's acceleration sample (kept whole for the next predictor) and its error.
         match scheme {
             Scheme::GeneralizedTrapezoidal { .. } => {
                 for i in 0..n {
@@ -221,11 +250,18 @@ pub(crate) fn march(
                 a_sample.copy_from_slice(&alpha_state.acceleration);
             }
         }
+        full.copy_from_slice(&a_sample);
+        tangential(ws, &mut a_sample, &mut projection);
+        if step == 0 {
+            initial.copy_from_slice(&acc);
+            tangential(ws, &mut initial, &mut projection);
+            history = AccelerationHistory::new(t0, &initial);
+        }
         let tau = t + sample_offset(&scheme, h_try);
         history.estimate(&constants, t, h_try, tau, &a_sample, &mut e_q, &mut e_v);
         let err = run
             .weights
-            .norm(&free, &e_q, &e_v, &q, &ws.state.q, &v, &ws.state.v);
+            .norm(h_try, &free, &e_q, &e_v, &q, &ws.state.q, &v, &ws.state.v);
         if err.is_nan() || err > 1.0 {
             sol.steps_rejected += 1;
             if matches!(scheme, Scheme::GeneralizedAlpha { .. }) {
@@ -251,8 +287,8 @@ pub(crate) fn march(
         }
 
         // Accepted.
-        history.push(tau, &a_sample);
-        acc.copy_from_slice(&a_sample);
+        history.push(tau, &a_sample, h_try);
+        acc.copy_from_slice(&full);
         q_new.copy_from_slice(&ws.state.q);
         v_new.copy_from_slice(&ws.state.v);
         lambda_new.copy_from_slice(&ws.state.lambda);

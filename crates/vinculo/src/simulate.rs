@@ -212,13 +212,15 @@ fn check_output_times(o: &SimulationOptions, times: &[f64]) -> Result<()> {
                 .into(),
         });
     }
+    if o.step_control == StepControl::Fixed {
+        return bad(
+            0,
+            "output times need error-controlled steps (adaptive); with fixed steps every step \
+             (or every save_every-th) is stored"
+                .into(),
+        );
+    }
     for k in 0..times.len() {
-        if o.step_control == StepControl::Fixed {
-            return bad(
-                k,
-                "output times need error-controlled steps (adaptive); with fixed steps every step (or every save_every-th) is stored".into(),
-            );
-        }
         if !(times[k] >= o.t_start && times[k] <= o.t_end) {
             return bad(
                 k,
@@ -232,7 +234,8 @@ fn check_output_times(o: &SimulationOptions, times: &[f64]) -> Result<()> {
             return bad(
                 k,
                 format!(
-                    "output times must be strictly increasing: t_eval[{}] = {}; sort them and drop repeats",
+                    "output times must be strictly increasing: t_eval[{}] = {}; sort them and \
+                     drop repeats",
                     k - 1,
                     times[k - 1]
                 ),
@@ -365,6 +368,7 @@ pub fn simulate_with_observer(
             control,
             newton,
             weights: ErrorWeights {
+                time_scale: length / speed,
                 atol_q: control.atol,
                 atol_v: control.atol * speed / length,
                 rtol: control.rtol,

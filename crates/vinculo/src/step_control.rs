@@ -13,11 +13,18 @@
 //! atol_v = atol U / L, with the length scale L of the model ([`crate::model::System::length_scale`])
 //! and the speed scale U the run already uses for its initial velocity check (the largest initial
 //! speed, or sqrt(|g| L)): an error of atol in positions and one of atol_v in velocities displace
-//! the motion by the same amount over the time L/U it takes to cross the model. A step is
-//! accepted when err <= 1.
+//! the motion by the same amount over the time T = L/U it takes to cross the model.
 //!
-//! **Controller.** The local error of a scheme of order p shrinks as h^k, k = p + 1. After an
-//! accepted step the next one is
+//! **Error per unit step.** A step of size h is accepted when err T / h <= 1 (err <= 1 for steps
+//! longer than T): the error a step adds is measured against the tolerance per time T, not per
+//! step. The errors of the N = (t_end - t_start)/h steps of a run add up; with the error per step
+//! at the tolerance the run's error would be about N times it, and grow as the tolerance shrinks
+//! (N grows as tol^(-1/(p+1)) for a scheme of order p). Per unit step, the run's error is about
+//! (t_end - t_start)/T times the tolerance (before the motion's own amplification of errors),
+//! proportional to the tolerance: halving the tolerance halves the error.
+//!
+//! **Controller.** The scaled error err T / h of a scheme of order p shrinks as h^k, k = p (the
+//! local error as h^(p+1)). After an accepted step the next one is
 //!
 //! ```text
 //! h_new = h * clamp( (rho / err_n)^(0.7/k) * (err_{n-1} / rho)^(0.4/k), 1/5, 5 ),  rho = safety^k
@@ -134,9 +141,12 @@ impl AdaptiveOptions {
     }
 }
 
-/// The weights of the error norm: absolute tolerances of positions and velocities, and rtol.
+/// The weights of the error norm: absolute tolerances of positions and velocities, rtol, and
+/// the time scale of the error per unit step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ErrorWeights {
+    /// Time scale T = L/U (s): the error of a step of size h < T counts T/h times.
+    pub time_scale: f64,
     /// Absolute tolerance of positions (m).
     pub atol_q: f64,
     /// Absolute tolerance of velocities (m/s).
@@ -146,11 +156,12 @@ pub struct ErrorWeights {
 }
 
 impl ErrorWeights {
-    /// The weighted RMS norm of (e_q, e_v) over the particles marked `free` (module
-    /// documentation), with the states at both ends of the step.
+    /// The weighted RMS norm of (e_q, e_v) of a step of size `h` over the particles marked
+    /// `free`, per unit step (module documentation), with the states at both ends of the step.
     #[allow(clippy::too_many_arguments)]
     pub fn norm(
         &self,
+        h: f64,
         free: &[bool],
         e_q: &[Vec3],
         e_v: &[Vec3],
@@ -172,7 +183,7 @@ impl ErrorWeights {
         if count == 0 {
             0.0
         } else {
-            (sum / count as f64).sqrt()
+            (sum / count as f64).sqrt() * (self.time_scale / h).max(1.0)
         }
     }
 }
@@ -180,7 +191,7 @@ impl ErrorWeights {
 /// The PI step-size controller (module documentation).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PiController {
-    /// Order of the local error (scheme order + 1).
+    /// Power of h in the scaled error (the scheme order, module documentation).
     k: f64,
     /// Error norm of the last accepted step (1 before the first).
     previous: f64,
@@ -193,7 +204,7 @@ pub struct PiController {
 const ERROR_FLOOR: f64 = 1e-10;
 
 impl PiController {
-    /// A controller for local errors of order `k` (h^k).
+    /// A controller for scaled errors that shrink as h^k.
     pub fn new(k: usize, hold: f64) -> PiController {
         PiController {
             k: k as f64,
@@ -282,10 +293,12 @@ mod tests {
         assert_eq!(control.accepted(0.1, 0.5), 0.1);
     }
 
-    /// The RMS norm of errors equal to their weights is 1; fixed particles do not count.
+    /// The RMS norm of errors equal to their weights is 1 for steps longer than the time scale;
+    /// fixed particles do not count.
     #[test]
     fn weighted_norm() {
         let weights = ErrorWeights {
+            time_scale: 0.5,
             atol_q: 1e-3,
             atol_v: 1e-2,
             rtol: 0.1,
@@ -295,8 +308,11 @@ mod tests {
         // Weights of the free particle: q: 0.101, 0.001, 0.001; v: 0.01, 0.21, 0.01.
         let e_q = [[0.101, -0.001, 0.001], [9.0; 3]];
         let e_v = [[0.01, 0.21, -0.01], [9.0; 3]];
-        let err = weights.norm(&[true, false], &e_q, &e_v, &q, &q, &v, &v);
+        let err = weights.norm(1.0, &[true, false], &e_q, &e_v, &q, &q, &v, &v);
         assert!((err - 1.0).abs() < 1e-12, "{err}");
+        // Per unit step: a step of a tenth of the time scale counts ten times.
+        let err = weights.norm(0.05, &[true, false], &e_q, &e_v, &q, &q, &v, &v);
+        assert!((err - 10.0).abs() < 1e-11, "{err}");
     }
 
     /// Every bad option is refused with its name.

@@ -47,21 +47,43 @@
 //! For Newmark schemes this is the estimate of Zienkiewicz and Xie, e_q = (beta - 1/6) h^2
 //! (a_{n+1} - a_n): here A, A' and A'' come from the history of accelerations instead.
 //!
-//! **Where A, A', A'' come from.** Each accepted step leaves one acceleration sample at a known
-//! time tau: the trapezoidal rules the mean acceleration (v_{n+1} - v_n)/h = a(q_a, v_a, t_a), which
-//! is A(t_n + alpha h) + O(h^2); generalised-alpha the true acceleration qdd_{n+1} at t_n + h; the
-//! run starts with the consistent accelerations at t_0. With the new sample and the last two
-//! accepted ones, divided differences give A'' (from three samples; 0 while only two exist) and
-//! A' at the midpoint tau_bar of the two newest, and Taylor steps move A' and A to t_n:
+//! **Where A, A', A'' come from.** Each accepted step leaves one raw acceleration sample at a
+//! known time tau: the trapezoidal rules the mean acceleration (v_{n+1} - v_n)/h = a(q_a, v_a, t_a),
+//! which is A(t_n + alpha h) + O(h^2); generalised-alpha the true acceleration qdd_{n+1} at
+//! t_n + h; the run starts with the consistent accelerations at t_0.
+//!
+//! The raw samples are smoothed before they are differenced: each is averaged with the previous
+//! one, weighted by their steps, S = (h_n a_n + h_{n-1} a_{n-1})/(h_n + h_{n-1}) at the likewise
+//! weighted time (still A + O(h^2) there). The reason is the undamped parasitic solution of the
+//! index-3 trapezoidal rule (and of generalised-alpha at rho_inf = 1): velocities off by
+//! (-1)^n eps, which every change of step size excites and nothing damps, put (-1)^n 2 eps/h into
+//! the mean accelerations. Differenced twice it would give an h^3 A'' term of about eps whatever
+//! the step, and the controller would shrink the step without end. The average of two
+//! consecutive mean accelerations is (v_{n+1} - v_{n-1})/(h_n + h_{n-1}), from which the
+//! oscillation cancels exactly for any steps. (The oscillation does not grow; the estimate
+//! measures what each step adds.)
+//!
+//! The samples are also cut to their part tangent to the constraints before they enter the
+//! history (the run loop does it with the step's factorised Newton matrix, one extra solve): the
+//! part normal to the constraints is what the multipliers impose, and in an index-3 solve it
+//! depends on the step itself (backward Euler's velocities are chords, off the velocity
+//! constraints by O(h); the trapezoidal multipliers ring), so it jumps whenever the step size
+//! changes and would make the estimate, and the step, collapse. The positions' local error normal
+//! to the constraints is nil anyway (they hold at every step end); the tangential part follows
+//! the motion along the constraints, which is what errors propagate in.
+//!
+//! With the new smoothed sample and the last two, divided differences give A'' (from three
+//! samples; 0 while only two exist) and A' at the midpoint tau_bar of the two newest, and Taylor
+//! steps move A' and A to t_n:
 //!
 //! ```text
-//! d1 = (A_new - A_1)/(tau_new - tau_1),    d2 = 2 (d1 - (A_1 - A_2)/(tau_1 - tau_2))/(tau_new - tau_2)
-//! A'(t_n) = d1 - (tau_bar - t_n) d2,         A(t_n) = A_new - s A'(t_n) - s^2/2 d2,  s = tau_new - t_n
+//! d1 = (S_new - S_1)/(tau_new - tau_1),    d2 = 2 (d1 - (S_1 - S_2)/(tau_1 - tau_2))/(tau_new - tau_2)
+//! A'(t_n) = d1 - (tau_bar - t_n) d2,         A(t_n) = S_new - s A'(t_n) - s^2/2 d2,  s = tau_new - t_n
 //! ```
 //!
-//! In constrained directions the true position error is nil (the constraints hold at the step end)
-//! while the estimate counts the constraint accelerations too: it errs on the safe side there,
-//! most for backward Euler whose c_q2 h^2 A includes the centripetal accelerations.
+//! Limits: a law whose third derivative jumps (the end of a C2 ramp) shows up in the samples only
+//! as the step that crosses it is taken, and a long step across it can be accepted with too
+//! small an estimate; h_max bounds that. The velocity part uses the linear-force h^3 constant.
 
 use super::Scheme;
 use crate::math::Vec3;
@@ -113,35 +135,56 @@ pub fn sample_offset(scheme: &Scheme, h: f64) -> f64 {
     }
 }
 
-/// The last two accepted acceleration samples (times and values), newest first.
+/// The acceleration samples of the accepted steps, smoothed (module documentation).
 #[derive(Debug, Clone)]
 pub struct AccelerationHistory {
+    /// The last accepted raw sample: time, values and weight (its step; 0 for the start).
+    raw: (f64, Vec<Vec3>, f64),
+    /// The last two smoothed samples (time, values), newest first.
     newest: (f64, Vec<Vec3>),
     older: Option<(f64, Vec<Vec3>)>,
 }
 
 impl AccelerationHistory {
-    /// A history holding one sample: the accelerations `a` at time `tau`.
+    /// A history holding one sample: the accelerations `a` at time `tau` (the consistent
+    /// accelerations of the initial state, which need no smoothing).
     pub fn new(tau: f64, a: &[Vec3]) -> AccelerationHistory {
         AccelerationHistory {
+            raw: (tau, a.to_vec(), 0.0),
             newest: (tau, a.to_vec()),
             older: None,
         }
     }
 
-    /// Adds the sample of an accepted step (time `tau`, after the newest), dropping the oldest.
-    pub fn push(&mut self, tau: f64, a: &[Vec3]) {
+    /// The smoothed sample's time and the weights of the new raw sample (of a step `h`) and of
+    /// the last one.
+    fn smoothing(&self, tau: f64, h: f64) -> (f64, f64, f64) {
+        let w_raw = self.raw.2;
+        let (w_new, w_old) = (h / (h + w_raw), w_raw / (h + w_raw));
+        (w_new * tau + w_old * self.raw.0, w_new, w_old)
+    }
+
+    /// Adds the raw sample `a` at `tau` of an accepted step of size `h` (after the newest).
+    pub fn push(&mut self, tau: f64, a: &[Vec3], h: f64) {
+        let (tau_s, w_new, w_old) = self.smoothing(tau, h);
         let mut buffer = match self.older.take() {
             Some((_, buffer)) => buffer,
             None => vec![[0.0; 3]; a.len()],
         };
-        buffer.copy_from_slice(a);
-        let previous = std::mem::replace(&mut self.newest, (tau, buffer));
+        for (b, (a, r)) in buffer.iter_mut().zip(a.iter().zip(&self.raw.1)) {
+            for k in 0..3 {
+                b[k] = w_new * a[k] + w_old * r[k];
+            }
+        }
+        let previous = std::mem::replace(&mut self.newest, (tau_s, buffer));
         self.older = Some(previous);
+        self.raw.0 = tau;
+        self.raw.1.copy_from_slice(a);
+        self.raw.2 = h;
     }
 
     /// Writes the estimated local errors of positions and velocities of a step of size `h` from
-    /// `t_n` whose acceleration sample is `a_new` at `tau_new` (see the module documentation).
+    /// `t_n` whose raw acceleration sample is `a_new` at `tau_new` (module documentation).
     #[allow(clippy::too_many_arguments)]
     pub fn estimate(
         &self,
@@ -153,23 +196,25 @@ impl AccelerationHistory {
         e_q: &mut [Vec3],
         e_v: &mut [Vec3],
     ) {
+        let (tau_s, w_new, w_old) = self.smoothing(tau_new, h);
         let (tau_1, a_1) = (&self.newest.0, &self.newest.1);
-        let span = tau_new - tau_1;
-        let tau_bar = 0.5 * (tau_new + tau_1);
-        let s = tau_new - t_n;
+        let span = tau_s - tau_1;
+        let tau_bar = 0.5 * (tau_s + tau_1);
+        let s = tau_s - t_n;
         let (h2, h3) = (h * h, h * h * h);
         for i in 0..a_new.len() {
             for k in 0..3 {
-                let d1 = (a_new[i][k] - a_1[i][k]) / span;
+                let a_s = w_new * a_new[i][k] + w_old * self.raw.1[i][k];
+                let d1 = (a_s - a_1[i][k]) / span;
                 let d2 = match &self.older {
                     Some((tau_2, a_2)) => {
                         let d1_old = (a_1[i][k] - a_2[i][k]) / (tau_1 - tau_2);
-                        2.0 * (d1 - d1_old) / (tau_new - tau_2)
+                        2.0 * (d1 - d1_old) / (tau_s - tau_2)
                     }
                     None => 0.0,
                 };
                 let jerk = d1 - (tau_bar - t_n) * d2;
-                let acceleration = a_new[i][k] - s * jerk - 0.5 * s * s * d2;
+                let acceleration = a_s - s * jerk - 0.5 * s * s * d2;
                 e_q[i][k] = constants.q2 * h2 * acceleration + constants.q3 * h3 * jerk;
                 e_v[i][k] = constants.v2 * h2 * jerk + constants.v3 * h3 * d2;
             }
@@ -241,8 +286,12 @@ mod tests {
         // The samples a uniform run of step h would have left, from the exact motion.
         let offset = sample_offset(&scheme, h);
         let tau_1 = t_n - h + offset;
-        let mut history = AccelerationHistory::new(tau_1 - h, &state(exact(tau_1 - h)[2]));
-        history.push(tau_1, &state(exact(tau_1)[2]));
+        let mut history =
+            AccelerationHistory::new(tau_1 - 3.0 * h, &state(exact(tau_1 - 3.0 * h)[2]));
+        for j in (0..3).rev() {
+            let tau = tau_1 - j as f64 * h;
+            history.push(tau, &state(exact(tau)[2]), h);
+        }
         let a_new = match scheme {
             Scheme::GeneralizedTrapezoidal { alpha } => {
                 GeneralizedTrapezoidal { alpha }
