@@ -121,12 +121,14 @@ def simulate(
         adaptive: choose the step sizes by a local error estimate (on positions and velocities,
             not multipliers) and a PI controller so that each step meets ``rtol`` and ``atol``;
             ``dt`` is then the first step. False: fixed steps of ``dt`` (halved where Newton fails).
-            The estimate's weighted RMS norm over the free coordinates must be <= 1, with the
-            weights ``atol + rtol |q|`` for positions and ``atol U / L + rtol |v|`` for velocities
-            (``L = system.length_scale()``, ``U`` the speed scale of ``initial_tolerance``). A
-            rejected step is retried smaller (``Solution.steps_rejected`` counts them). The
-            tolerances bound the error of each step; the error at the end of a run also depends
-            on how the motion propagates it (for a pendulum, a few times the tolerance).
+            The estimate's weighted RMS norm over the free coordinates, with the weights
+            ``atol + rtol |q|`` for positions and ``atol U / L + rtol |v|`` for velocities
+            (``L = system.length_scale()``, ``U`` the speed scale of ``initial_tolerance``), times
+            ``T / h`` (error per unit step, ``T = L / U``) must be <= 1. A rejected step is retried
+            smaller (``Solution.steps_rejected`` counts them). The error of a run is then about
+            proportional to the tolerance (a few times it on a swinging pendulum). With
+            ``jacobian_reuse`` keep ``tolerance`` far below ``rtol``: modified Newton's error
+            near its tolerance looks like a step error at small steps.
         rtol: relative tolerance of adaptive steps, in (0, 1).
         atol: absolute tolerance of adaptive steps, in m (positions).
         h_min: smallest adaptive step, in s: a run that would need a smaller one stops with
