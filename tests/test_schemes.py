@@ -1,17 +1,16 @@
 """Every time-integration scheme against references computed independently with scipy.
 
-The references integrate the pendulum's angle ODE (minimal coordinates, no constraint) with
-scipy's DOP853 at rtol = atol = 1e-12, far below the schemes' errors at the steps used here.
+The references (``pendulum_reference``) integrate the pendulum's angle ODE (minimal coordinates,
+no constraint) with scipy's DOP853 at rtol = atol = 1e-12, far below the schemes' errors at the
+steps used here.
 """
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
 
 import vinculo
+from pendulum_reference import MovingPivot, angle_reference
 from vinculo import demos
-
-GRAVITY = demos.GRAVITY
 
 # (scheme keywords, expected order of the positions, label). Orders: formulation.md for the
 # generalised trapezoidal rule (alpha = 1/2: 2, alpha = 1: 1); Arnold and Brüls (2007), Multibody
@@ -23,20 +22,6 @@ SCHEMES = [
     ({"scheme": "generalized-alpha", "rho_inf": 0.5}, 2.0, "generalised-alpha rho 0.5"),
     ({"scheme": "generalized-alpha", "rho_inf": 1.0}, 2.0, "generalised-alpha rho 1"),
 ]
-
-
-def angle_reference(theta0: float, t_end: float, pivot_acceleration=None) -> float:
-    """Angle from the downward vertical at ``t_end`` of a 1 m pendulum released at rest relative
-    to its pivot: theta'' = -(g/L) sin theta - (x_p''(t)/L) cos theta, where x_p is the pivot's
-    horizontal position (the Lagrangian in minimal coordinates, with L = 1 m)."""
-
-    def rhs(t, y):
-        acc = pivot_acceleration(t) if pivot_acceleration is not None else 0.0
-        return [y[1], -GRAVITY * np.sin(y[0]) - acc * np.cos(y[0])]
-
-    result = solve_ivp(rhs, (0.0, t_end), [theta0, 0.0], method="DOP853", rtol=1e-12, atol=1e-12)
-    assert result.success
-    return float(result.y[0, -1])
 
 
 def bob_error(kwargs: dict, dt: float, t_end: float, reference: np.ndarray) -> float:
@@ -62,19 +47,12 @@ def test_observed_order_against_the_angle_ode(kwargs, order, label):
 
 
 def moving_pivot_error(kwargs: dict, dt: float) -> float:
-    """Bob position error at t = 1 s of a 1 m pendulum whose pivot moves as
-    x_p = 0.1 sin(2 pi t) m (a prescribed point of ``add_distance_to_point``), released at
-    30 degrees with the pivot's velocity (at rest relative to it: a consistent start)."""
-    amplitude, omega, theta0, t_end = 0.1, 2.0 * np.pi, np.pi / 6, 1.0
-    system = vinculo.System(gravity=(0.0, 0.0, -GRAVITY))
-    bob = system.add_particle(
-        1.0, [np.sin(theta0), 0.0, -np.cos(theta0)], velocity=[amplitude * omega, 0.0, 0.0]
-    )
-    system.add_distance_to_point(bob, (vinculo.sine(amplitude, 1.0), 0.0, 0.0), 1.0)
-    solution = vinculo.simulate(system, t_end, dt, **kwargs)
-    theta = angle_reference(theta0, t_end, lambda t: -amplitude * omega**2 * np.sin(omega * t))
-    pivot = amplitude * np.sin(omega * t_end)
-    reference = np.array([pivot + np.sin(theta), 0.0, -np.cos(theta)])
+    """Bob position error at t = 1 s of the pendulum whose pivot moves as x_p = 0.1 sin(2 pi t) m,
+    released at 30 degrees at rest relative to its pivot (``MovingPivot``'s defaults)."""
+    case = MovingPivot()
+    system, bob = case.build()
+    solution = vinculo.simulate(system, 1.0, dt, **kwargs)
+    reference = case.bob_states(np.array([1.0]))[0][-1]
     return float(np.max(np.abs(solution.particle(bob)[-1] - reference)))
 
 

@@ -23,6 +23,7 @@ from vinculo.errors import (
     NegativeTensionError,
     RedundantConstraintsError,
     SchedulerError,
+    StepSizeTooSmallError,
     UnknownHandleError,
     VinculoError,
 )
@@ -48,6 +49,7 @@ __all__ = [
     "RedundantConstraintsError",
     "SchedulerError",
     "Solution",
+    "StepSizeTooSmallError",
     "System",
     "UnknownHandleError",
     "VinculoError",

@@ -22,6 +22,7 @@ __all__ = [
     "NegativeTensionError",
     "RedundantConstraintsError",
     "SchedulerError",
+    "StepSizeTooSmallError",
     "UnknownHandleError",
     "VinculoError",
 ]
@@ -171,6 +172,25 @@ class ConvergenceError(VinculoError, RuntimeError):
     iterations: int | None = None
     equation: str | None = None
     solution: Any = None
+
+
+class StepSizeTooSmallError(ConvergenceError):
+    """Error-controlled steps would have to be smaller than ``h_min``.
+
+    Raised by :func:`vinculo.simulate` with ``adaptive=True`` when the step that meets ``rtol`` and
+    ``atol`` is below ``h_min``: loosen the tolerances, lower ``h_min``, or look for a
+    discontinuity in the model's laws. ``solution`` holds every state computed before.
+
+    Attributes:
+        time: the time at the start of the step that could not be completed (s).
+        step_size: the step the controller proposed (s).
+        h_min: the smallest step allowed (s).
+        error_norm: the weighted error norm of the last attempt (1 meets the tolerances).
+        solution: the partial :class:`vinculo.Solution`.
+    """
+
+    h_min: float | None = None
+    error_norm: float | None = None
 
 
 class InternalError(VinculoError):

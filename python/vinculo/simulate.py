@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import IO, Any
+
+import numpy as np
 
 from vinculo import _core, errors
 from vinculo._core import System
@@ -67,6 +69,12 @@ def simulate(
     save_every: int = 1,
     progress: bool | ProgressCallback = False,
     jacobian_reuse: bool = False,
+    adaptive: bool = False,
+    rtol: float = 1e-6,
+    atol: float = 1e-6,
+    h_min: float = 1e-10,
+    h_max: float | None = None,
+    t_eval: Sequence[float] | np.ndarray | None = None,
 ) -> Solution:
     """Integrate a constrained system from ``t_start`` to ``t_end``.
 
@@ -110,6 +118,27 @@ def simulate(
             factorisations. Each step stops with an error near ``tolerance`` (full Newton stops
             far below it), which enters the velocities divided by ``dt``: with small steps lower
             the tolerance. False: full Newton (a new matrix every iteration).
+        adaptive: choose the step sizes by a local error estimate (on positions and velocities,
+            not multipliers) and a PI controller so that each step meets ``rtol`` and ``atol``;
+            ``dt`` is then the first step. False: fixed steps of ``dt`` (halved where Newton fails).
+            The estimate's weighted RMS norm over the free coordinates, with the weights
+            ``atol + rtol |q|`` for positions and ``atol U / L + rtol |v|`` for velocities
+            (``L = system.length_scale()``, ``U`` the speed scale of ``initial_tolerance``), times
+            ``T / h`` (error per unit step, ``T = L / U``) must be <= 1. A rejected step is retried
+            smaller (``Solution.steps_rejected`` counts them). The error of a run is then about
+            proportional to the tolerance (a few times it on a swinging pendulum). With
+            ``jacobian_reuse`` keep ``tolerance`` far below ``rtol``: modified Newton's error
+            near its tolerance looks like a step error at small steps.
+        rtol: relative tolerance of adaptive steps, in (0, 1).
+        atol: absolute tolerance of adaptive steps, in m (positions).
+        h_min: smallest adaptive step, in s: a run that would need a smaller one stops with
+            :class:`StepSizeTooSmallError`.
+        h_max: largest adaptive step, in s (default: no limit).
+        t_eval: times at which to return the state with ``adaptive=True`` (strictly increasing,
+            within ``[t_start, t_end]``), interpolated inside the step that contains each (cubic
+            Hermite positions, its derivative for velocities, linear multipliers) without forcing
+            the steps onto them. Default: the state after every accepted step (every
+            ``save_every``-th).
 
     Returns:
         The :class:`Solution`.
@@ -122,6 +151,8 @@ def simulate(
             ``initial_tolerance`` (see ``System.project_initial_state``).
         ConvergenceError: a step failed even at the smallest step size; its ``solution`` attribute
             holds every step completed before.
+        StepSizeTooSmallError: (a ConvergenceError) adaptive steps would have to be smaller than
+            ``h_min`` to meet the tolerances; ``solution`` holds every state computed before.
     """
     if not isinstance(scheme, str):
         raise errors.InvalidInputError(
@@ -130,6 +161,16 @@ def simulate(
             name="scheme",
             value=scheme,
         )
+    times = None
+    if t_eval is not None:
+        times = np.asarray(t_eval, dtype=np.float64)
+        if times.ndim != 1:
+            raise errors.InvalidInputError(
+                f"t_eval must be a 1-D sequence of times, got an array of shape {times.shape}",
+                name="t_eval",
+                value=t_eval,
+            )
+        times = [float(x) for x in times]
     bar: ProgressBar | None = None
     callback: ProgressCallback | None
     if progress is True:
@@ -161,6 +202,12 @@ def simulate(
             jacobian_reuse=bool(jacobian_reuse),
             scheme=scheme,
             rho_inf=rho_inf,
+            adaptive=bool(adaptive),
+            rtol=rtol,
+            atol=atol,
+            h_min=h_min,
+            h_max=h_max,
+            t_eval=times,
         )
     finally:
         if bar is not None:

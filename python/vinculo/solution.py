@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -38,8 +38,11 @@ class Solution:
     """Everything one call of :func:`vinculo.simulate` computed.
 
     Row 0 of every array is the initial state (0 Newton iterations, step size 0, multipliers from
-    the consistent initial accelerations); row ``k`` is the state after step ``k``. The arrays are
-    read-only.
+    the consistent initial accelerations); row ``k`` is the state after step ``k``. With
+    ``simulate(..., adaptive=True, t_eval=...)`` the rows are the requested times instead
+    (interpolated inside the steps that contain them; the initial state is a row only when
+    ``t_start`` is requested), and the per-row statistics are those of the containing step. The
+    arrays are read-only.
 
     Attributes:
         times: (s,) times of the stored states, in s.
@@ -68,6 +71,11 @@ class Solution:
         factorisations: number of Newton iteration matrices factorised over the run (one per
             Newton iteration in full Newton, fewer with ``jacobian_reuse=True``).
         scheme: the time discretisation: 'trapezoidal', 'backward-euler' or 'generalized-alpha'.
+        steps_taken: steps attempted, including those rejected and retried.
+        steps_rejected: attempts rejected (Newton failed, or the error estimate of an
+            error-controlled step exceeded the tolerance).
+        accepted_step_sizes: size of every accepted step, in s, whether its state was stored or
+            not (its length is :attr:`steps_accepted`).
     """
 
     times: np.ndarray
@@ -85,6 +93,9 @@ class Solution:
     linear_solver: str = ""
     factorisations: int = 0
     scheme: str = ""
+    steps_taken: int = 0
+    steps_rejected: int = 0
+    accepted_step_sizes: np.ndarray = field(default_factory=lambda: _frozen([], np.float64))
 
     @classmethod
     def from_core(cls, data: dict[str, Any], system: System) -> Solution:
@@ -109,6 +120,9 @@ class Solution:
             linear_solver=str(data.get("linear_solver", "")),
             factorisations=int(data.get("factorisations", 0)),
             scheme=str(data.get("scheme", "")),
+            steps_taken=int(data.get("steps_taken", 0)),
+            steps_rejected=int(data.get("steps_rejected", 0)),
+            accepted_step_sizes=_frozen(data.get("accepted_step_sizes", []), np.float64),
         )
 
     @property
@@ -124,8 +138,14 @@ class Solution:
 
     @property
     def num_steps(self) -> int:
-        """Number of completed steps (the stored states less the initial one)."""
+        """Number of stored states less the initial one (the completed steps when every step is
+        stored; see :attr:`steps_accepted` otherwise)."""
         return max(len(self.times) - 1, 0)
+
+    @property
+    def steps_accepted(self) -> int:
+        """Number of accepted steps (stored or not)."""
+        return len(self.accepted_step_sizes)
 
     def particle(self, particle: ParticleId) -> np.ndarray:
         """Trajectory of one particle.
@@ -274,7 +294,9 @@ class Solution:
                 f"Newton iterations per step: mean {np.mean(iterations):.2f}, "
                 f"max {int(np.max(iterations))}"
             )
-            lines.append(f"min step size: {np.min(self.step_sizes[1:]):.6g} s")
+            sizes = self.accepted_step_sizes
+            sizes = sizes if len(sizes) else self.step_sizes[1:]
+            lines.append(f"min step size: {np.min(sizes):.6g} s")
         if self.linear_solver:
             lines.append(f"linear solver: {self.linear_solver}")
         return "\n".join(lines)

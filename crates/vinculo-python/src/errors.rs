@@ -73,6 +73,12 @@ pub fn details<'py>(py: Python<'py>, e: &Error) -> PyResult<Bound<'py, PyDict>> 
             d.set_item("time", t)?;
             d.set_item("equation", equation)?;
         }
+        Error::StepSizeTooSmall { t, h, h_min, error } => {
+            d.set_item("time", t)?;
+            d.set_item("step_size", h)?;
+            d.set_item("h_min", h_min)?;
+            d.set_item("error_norm", error)?;
+        }
         Error::Interrupted { t } => d.set_item("time", t)?,
         Error::RedundantConstraints {
             constraint,

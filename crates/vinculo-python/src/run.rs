@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::time::{Duration, Instant};
 use vinculo::integrators::{NewtonOptions, Scheme};
-use vinculo::{simulate_with_observer, Observer, SimulationOptions};
+use vinculo::{simulate_with_observer, AdaptiveOptions, Observer, SimulationOptions, StepControl};
 
 /// Calls the Python progress callback and checks for Ctrl-C about twice a second.
 struct Progress {
@@ -81,7 +81,8 @@ fn scheme_by_name(name: &str, alpha: Option<f64>, rho_inf: Option<f64>) -> PyRes
 #[pyfunction]
 #[pyo3(signature = (system, t_end, dt, alpha=None, t_start=0.0, tolerance=1e-10, max_iterations=25,
                     max_halvings=4, initial_tolerance=1e-8, save_every=1, progress=None,
-                    jacobian_reuse=false, scheme="trapezoidal", rho_inf=None))]
+                    jacobian_reuse=false, scheme="trapezoidal", rho_inf=None, adaptive=false,
+                    rtol=1e-6, atol=1e-6, h_min=1e-10, h_max=None, t_eval=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
@@ -99,6 +100,12 @@ pub fn simulate<'py>(
     jacobian_reuse: bool,
     scheme: &str,
     rho_inf: Option<f64>,
+    adaptive: bool,
+    rtol: f64,
+    atol: f64,
+    h_min: f64,
+    h_max: Option<f64>,
+    t_eval: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let count = |name: &str, v: i64, min: i64| -> PyResult<usize> {
         if v < min {
@@ -120,6 +127,18 @@ pub fn simulate<'py>(
         max_halvings: count("max_halvings", max_halvings, 0)?,
         initial_tolerance,
         save_every: count("save_every", save_every, 1)?,
+        step_control: if adaptive {
+            StepControl::Adaptive(AdaptiveOptions {
+                rtol,
+                atol,
+                h_min,
+                h_max: h_max.unwrap_or(f64::INFINITY),
+                ..Default::default()
+            })
+        } else {
+            StepControl::Fixed
+        },
+        output_times: t_eval,
         ..Default::default()
     };
     let model = &system.inner;
@@ -183,6 +202,10 @@ pub fn simulate<'py>(
     )?;
     out.set_item("steps_taken", sol.steps_taken)?;
     out.set_item("steps_rejected", sol.steps_rejected)?;
+    out.set_item(
+        "accepted_step_sizes",
+        Array1::from(sol.accepted_step_sizes.clone()).into_pyarray(py),
+    )?;
     out.set_item("factorisations", sol.factorisations)?;
     out.set_item("linear_solver", sol.linear_solver)?;
     out.set_item("scheme", sol.scheme.name())?;

@@ -139,6 +139,18 @@ pub enum Error {
         /// The tension it would need (N, negative).
         tension: f64,
     },
+    /// Error-controlled steps: meeting rtol/atol would take a step below the smallest allowed.
+    #[error("at t = {t:.6} s the step needed to meet rtol/atol would be {h:.3e} s (error norm {error:.3e} at the last step tried), below h_min = {h_min:.3e} s: loosen rtol/atol, lower h_min, or look for a discontinuity in the model's laws")]
+    StepSizeTooSmall {
+        /// Time at the start of the step that could not be completed.
+        t: f64,
+        /// The step the controller proposed.
+        h: f64,
+        /// The smallest step allowed.
+        h_min: f64,
+        /// Weighted error norm of the last attempt (1 meets the tolerances).
+        error: f64,
+    },
     /// The run was stopped by its observer (for instance a keyboard interrupt).
     #[error("run interrupted at t = {t:.6} s")]
     Interrupted {
@@ -160,6 +172,7 @@ impl Error {
             Error::InconsistentInitialState { .. } => "InconsistentInitialStateError",
             Error::RedundantConstraints { .. } => "RedundantConstraintsError",
             Error::NegativeTension { .. } => "NegativeTensionError",
+            Error::StepSizeTooSmall { .. } => "StepSizeTooSmallError",
             Error::ProjectionFailed { .. }
             | Error::NewtonFailed { .. }
             | Error::SingularMatrix { .. }

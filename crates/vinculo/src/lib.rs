@@ -32,8 +32,10 @@
 // Index loops over 3-vector components and local blocks mirror the derivations in the doc comments.
 #![allow(clippy::needless_range_loop)]
 
+mod adaptive;
 pub mod assembly;
 pub mod constraints;
+pub mod dense_output;
 pub mod error;
 pub mod forces;
 pub mod initial;
@@ -44,8 +46,10 @@ pub mod math;
 pub mod model;
 pub mod simulate;
 pub mod solution;
+pub mod step_control;
 
 pub use error::{Error, Result};
 pub use linear::SparseSolver;
 pub use simulate::{simulate, simulate_with_observer, Observer, SimulationOptions};
 pub use solution::{Solution, StepStats};
+pub use step_control::{AdaptiveOptions, StepControl};

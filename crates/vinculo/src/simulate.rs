@@ -14,6 +14,7 @@ use crate::linear::SparseSolver;
 use crate::math::Vec3;
 use crate::model::System;
 use crate::solution::{Solution, StepStats};
+use crate::step_control::{ErrorWeights, StepControl};
 
 /// Options of a run. Tolerances are relative to the model's length scale
 /// ([`System::length_scale`]).
@@ -51,6 +52,13 @@ pub struct SimulationOptions {
     /// the rest of a step are serial. The residual is the same bit for bit; the Jacobian equals
     /// the serial one to round-off (its entries are summed in another order).
     pub parallel_from: usize,
+    /// Fixed steps (the default) or error-controlled ones ([`StepControl::Adaptive`], where
+    /// `dt` is the first step).
+    pub step_control: StepControl,
+    /// Times at which to store the state (strictly increasing, in [t_start, t_end]; error-controlled
+    /// steps only), interpolated inside the steps that contain them (Python: `t_eval`). `None`:
+    /// store the end of every step (every `save_every`-th).
+    pub output_times: Option<Vec<f64>>,
 }
 
 impl Default for SimulationOptions {
@@ -68,6 +76,8 @@ impl Default for SimulationOptions {
             sparse_solver: SparseSolver::Auto,
             max_output_bytes: 8.0 * (1u64 << 30) as f64,
             parallel_from: PARALLEL_FROM,
+            step_control: StepControl::Fixed,
+            output_times: None,
         }
     }
 }
@@ -154,6 +164,12 @@ fn check_options(system: &System, o: &SimulationOptions) -> Result<()> {
     if o.save_every == 0 {
         return Err(bad("save_every", 0.0, "must be >= 1"));
     }
+    if let StepControl::Adaptive(control) = &o.step_control {
+        control.check(o.dt)?;
+    }
+    if let Some(times) = &o.output_times {
+        check_output_times(o, times)?;
+    }
     let constraints = system
         .constraints()
         .iter()
@@ -178,8 +194,64 @@ fn check_options(system: &System, o: &SimulationOptions) -> Result<()> {
     Ok(())
 }
 
+/// Requested output times: error-controlled steps only, finite, strictly increasing, within the
+/// run.
+fn check_output_times(o: &SimulationOptions, times: &[f64]) -> Result<()> {
+    let bad = |k: usize, expected: String| {
+        Err(Error::InvalidParameter {
+            name: format!("output time t_eval[{k}]"),
+            value: times[k],
+            expected,
+        })
+    };
+    if times.is_empty() {
+        return Err(Error::InvalidParameter {
+            name: "t_eval".into(),
+            value: 0.0,
+            expected: "no output time given: give at least one, or none (None) for every step"
+                .into(),
+        });
+    }
+    if o.step_control == StepControl::Fixed {
+        return bad(
+            0,
+            "output times need error-controlled steps (adaptive); with fixed steps every step \
+             (or every save_every-th) is stored"
+                .into(),
+        );
+    }
+    for k in 0..times.len() {
+        if !(times[k] >= o.t_start && times[k] <= o.t_end) {
+            return bad(
+                k,
+                format!(
+                    "must lie in [t_start, t_end] = [{}, {}]",
+                    o.t_start, o.t_end
+                ),
+            );
+        }
+        if k > 0 && times[k] <= times[k - 1] {
+            return bad(
+                k,
+                format!(
+                    "output times must be strictly increasing: t_eval[{}] = {}; sort them and \
+                     drop repeats",
+                    k - 1,
+                    times[k - 1]
+                ),
+            );
+        }
+    }
+    Ok(())
+}
+
 /// The first tension-only constraint whose tension is below `floor` (N), as an error.
-fn negative_tension(system: &System, lambda: &[f64], t: f64, floor: f64) -> Option<Error> {
+pub(crate) fn negative_tension(
+    system: &System,
+    lambda: &[f64],
+    t: f64,
+    floor: f64,
+) -> Option<Error> {
     system.tension_only().iter().find_map(|&c| {
         let tension = system.tension(c, lambda[c])?;
         (tension < floor).then(|| Error::NegativeTension {
@@ -289,6 +361,29 @@ pub fn simulate_with_observer(
         sol.status = Err(e);
         return Ok(sol);
     }
+    if let StepControl::Adaptive(control) = options.step_control {
+        let run = crate::adaptive::AdaptiveRun {
+            system,
+            options,
+            control,
+            newton,
+            weights: ErrorWeights {
+                time_scale: length / speed,
+                atol_q: control.atol,
+                atol_v: control.atol * speed / length,
+                rtol: control.rtol,
+            },
+            tension_floor,
+        };
+        let start = crate::adaptive::StartState {
+            q,
+            v,
+            acceleration: acc,
+            lambda,
+        };
+        crate::adaptive::march(&run, &mut ws, &mut sol, start, observer);
+        return Ok(sol);
+    }
 
     // Times are kept on an exact grid: every step is dt / 2^j, an integer number of the smallest
     // allowed step, so t = t_start + units * unit never accumulates round-off. The last step is
@@ -363,6 +458,7 @@ pub fn simulate_with_observer(
                     t0 + units as f64 * unit
                 };
                 step += 1;
+                sol.accepted_step_sizes.push(h_try);
                 let slack = negative_tension(system, &lambda, t, tension_floor);
                 if step % options.save_every == 0 || last || slack.is_some() {
                     let stats = StepStats {

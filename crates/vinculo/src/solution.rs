@@ -3,7 +3,8 @@
 use crate::error::Error;
 use crate::integrators::Scheme;
 
-/// Statistics of one stored step.
+/// Statistics of one stored step (for a state interpolated at a requested output time: of the
+/// step that contains that time).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct StepStats {
     /// Newton iterations of the step (0 for the initial state).
@@ -42,8 +43,11 @@ pub struct Solution {
     pub stats: Vec<StepStats>,
     /// Steps taken (stored or not), including retries with smaller steps.
     pub steps_taken: usize,
-    /// Steps rejected because Newton failed (then retried with half the step).
+    /// Steps rejected because Newton failed (then retried with a smaller step) or, with
+    /// error-controlled steps, because their error estimate exceeded the tolerance.
     pub steps_rejected: usize,
+    /// Size of every accepted step, in order (whether its state was stored or not).
+    pub accepted_step_sizes: Vec<f64>,
     /// Factorisations of Newton iteration matrices (one per iteration in full Newton; fewer with
     /// [`NewtonOptions::jacobian_reuse`](crate::integrators::NewtonOptions::jacobian_reuse)).
     pub factorisations: usize,
@@ -71,6 +75,7 @@ impl Solution {
             stats: Vec::new(),
             steps_taken: 0,
             steps_rejected: 0,
+            accepted_step_sizes: Vec::new(),
             factorisations: 0,
             scheme: Scheme::default(),
             linear_solver,
@@ -106,6 +111,18 @@ impl Solution {
             self.velocities[b + 1],
             self.velocities[b + 2],
         ]
+    }
+
+    /// Keeps the first `len` stored states only.
+    pub(crate) fn truncate(&mut self, len: usize) {
+        let (n, m) = (self.particles, self.constraints);
+        self.times.truncate(len);
+        self.positions.truncate(len * n * 3);
+        self.velocities.truncate(len * n * 3);
+        self.multipliers.truncate(len * m);
+        self.constraint_residual.truncate(len);
+        self.velocity_violation.truncate(len);
+        self.stats.truncate(len);
     }
 
     /// Stores a state with its position- and velocity-level violations and statistics.

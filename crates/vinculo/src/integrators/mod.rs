@@ -1,10 +1,12 @@
 //! Time integration: the generalised trapezoidal rule (paper eq. 24), the generalised-alpha
 //! scheme of Arnold and Brüls, and the Newton loop they share.
 
+pub mod error_estimate;
 mod generalized_alpha;
 pub mod newton;
 mod trapezoidal;
 
+pub use error_estimate::{AccelerationHistory, ErrorConstants};
 pub use generalized_alpha::{AlphaCoefficients, AlphaState, GeneralizedAlpha};
 
 pub use newton::{
