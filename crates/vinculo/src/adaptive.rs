@@ -155,10 +155,7 @@ pub(crate) fn march(
         }
     }
 
-    let mut alpha_state = AlphaState {
-        acceleration: acc.clone(),
-        algorithmic: acc.clone(),
-    };
+    let mut alpha_state = AlphaState::new(&acc);
     let mut alpha_saved = alpha_state.clone();
     let (mut q_new, mut v_new, mut lambda_new) = (q.clone(), v.clone(), lambda.clone());
     let (mut a_sample, mut e_q, mut e_v) = (acc.clone(), acc.clone(), acc.clone());

@@ -306,10 +306,8 @@ mod tests {
                 let kappa = 0.5 * (1.0 - k.alpha_f) - (1.0 - k.alpha_m) * (0.5 + delta);
                 // The algorithmic acceleration of the exact motion (module documentation).
                 let a = e[2] + delta * h * e[3] + kappa * h * h * e[4];
-                let mut alpha_state = AlphaState {
-                    acceleration: state(e[2]),
-                    algorithmic: state(a),
-                };
+                let mut alpha_state = AlphaState::new(&state(a));
+                alpha_state.acceleration = state(e[2]);
                 ga.step(
                     &system,
                     &mut ws,
