@@ -1,4 +1,5 @@
-"""Every time-integration scheme against references computed independently with scipy.
+"""Every time-integration scheme, on the index-3 and on the stabilised index-2 (GGL)
+formulation, against references computed independently with scipy.
 
 The references integrate the pendulum's angle ODE (minimal coordinates, no constraint) with
 scipy's DOP853 at rtol = atol = 1e-12, far below the schemes' errors at the steps used here.
@@ -16,12 +17,18 @@ GRAVITY = demos.GRAVITY
 # (scheme keywords, expected order of the positions, label). Orders: formulation.md for the
 # generalised trapezoidal rule (alpha = 1/2: 2, alpha = 1: 1); Arnold and Brüls (2007), Multibody
 # System Dynamics 18:185-202, for generalised-alpha (2 for every rho_inf in [0, 1]).
-SCHEMES = [
+INDEX3 = [
     ({"scheme": "trapezoidal"}, 2.0, "trapezoidal"),
     ({"scheme": "backward-euler"}, 1.0, "backward Euler"),
     ({"scheme": "generalized-alpha", "rho_inf": 0.0}, 2.0, "generalised-alpha rho 0"),
     ({"scheme": "generalized-alpha", "rho_inf": 0.5}, 2.0, "generalised-alpha rho 0.5"),
     ({"scheme": "generalized-alpha", "rho_inf": 1.0}, 2.0, "generalised-alpha rho 1"),
+]
+# The same time rules on the GGL formulation: the velocity constraints added with a second
+# multiplier change the discrete equations, not the order of the rule (Gear, Gupta and Leimkuhler
+# 1985 for the trapezoidal rule and BDF; Arnold and Brüls 2007 for generalised-alpha).
+SCHEMES = INDEX3 + [
+    ({**kwargs, "formulation": "ggl"}, order, f"{label} GGL") for kwargs, order, label in INDEX3
 ]
 
 
@@ -61,16 +68,27 @@ def test_observed_order_against_the_angle_ode(kwargs, order, label):
     assert observed == pytest.approx(order, abs=0.2), f"{label}: errors {errors}"
 
 
-def moving_pivot_error(kwargs: dict, dt: float) -> float:
-    """Bob position error at t = 1 s of a 1 m pendulum whose pivot moves as
-    x_p = 0.1 sin(2 pi t) m (a prescribed point of ``add_distance_to_point``), released at
-    30 degrees with the pivot's velocity (at rest relative to it: a consistent start)."""
-    amplitude, omega, theta0, t_end = 0.1, 2.0 * np.pi, np.pi / 6, 1.0
+PIVOT_AMPLITUDE, PIVOT_OMEGA, PIVOT_THETA0 = 0.1, 2.0 * np.pi, np.pi / 6
+
+
+def moving_pivot_pendulum():
+    """A 1 m pendulum whose pivot moves as x_p = 0.1 sin(2 pi t) m (a prescribed point of
+    ``add_distance_to_point``), released at 30 degrees with the pivot's velocity (at rest
+    relative to it: a consistent start). Returns (system, bob)."""
+    amplitude, omega, theta0 = PIVOT_AMPLITUDE, PIVOT_OMEGA, PIVOT_THETA0
     system = vinculo.System(gravity=(0.0, 0.0, -GRAVITY))
     bob = system.add_particle(
         1.0, [np.sin(theta0), 0.0, -np.cos(theta0)], velocity=[amplitude * omega, 0.0, 0.0]
     )
     system.add_distance_to_point(bob, (vinculo.sine(amplitude, 1.0), 0.0, 0.0), 1.0)
+    return system, bob
+
+
+def moving_pivot_error(kwargs: dict, dt: float) -> float:
+    """Bob position error at t = 1 s of the moving-pivot pendulum against the DOP853 solution of
+    its angle ODE."""
+    amplitude, omega, theta0, t_end = PIVOT_AMPLITUDE, PIVOT_OMEGA, PIVOT_THETA0, 1.0
+    system, bob = moving_pivot_pendulum()
     solution = vinculo.simulate(system, t_end, dt, **kwargs)
     theta = angle_reference(theta0, t_end, lambda t: -amplitude * omega**2 * np.sin(omega * t))
     pivot = amplitude * np.sin(omega * t_end)
@@ -108,6 +126,31 @@ def test_solution_records_the_scheme(kwargs, order, label):
     model = demos.build_pendulum()
     solution = vinculo.simulate(model.system, 0.01, 1e-3, **kwargs)
     assert solution.scheme == kwargs["scheme"]
+    assert solution.formulation == kwargs.get("formulation", "index-3")
+
+
+def test_unknown_formulation_is_named():
+    model = demos.build_pendulum()
+    with pytest.raises(vinculo.InvalidInputError, match="index-2") as info:
+        vinculo.simulate(model.system, 0.01, 1e-3, formulation="index-2")
+    assert info.value.name == "formulation"
+    with pytest.raises(vinculo.InvalidInputError, match="formulation"):
+        vinculo.simulate(model.system, 0.01, 1e-3, formulation=2)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(("kwargs", "order", "label"), INDEX3, ids=[s[2] for s in INDEX3])
+def test_ggl_holds_the_velocity_constraints_at_every_step(kwargs, order, label):
+    # The moving pivot makes Phi_t non-zero. GGL solves G v + Phi_t = 0 at every step: with full
+    # Newton its residual ends at round-off, below 1e-12 of the speed scale sqrt(g L) = 3.1 m/s
+    # (velocity_violation is max_k |s_k (G v + Phi_t)|, in m/s). The index-3 formulation leaves a
+    # violation of the size of the scheme's velocity error, many orders of magnitude larger.
+    system, _ = moving_pivot_pendulum()
+    speed = np.sqrt(GRAVITY * 1.0)
+    ggl = vinculo.simulate(system, 1.0, 2e-3, formulation="ggl", **kwargs)
+    index3 = vinculo.simulate(system, 1.0, 2e-3, **kwargs)
+    assert np.max(ggl.velocity_violation) < 1e-12 * speed, label
+    assert np.max(ggl.position_violation) < 1e-12, label
+    assert np.max(index3.velocity_violation) > 1e3 * np.max(ggl.velocity_violation), label
 
 
 # Generalised-alpha with rho_inf = 1 is left out: it has no numerical damping, and in this run it

@@ -141,7 +141,7 @@ def simulate(system: System, t_end: float, dt: float, alpha: float | None = None
              initial_tolerance: float = 1e-8, save_every: int = 1,
              progress: Callable[[float, float], None] | None = None,
              jacobian_reuse: bool = False, scheme: str = "trapezoidal",
-             rho_inf: float | None = None) -> dict:
+             rho_inf: float | None = None, formulation: str = "index-3") -> dict:
     """Integrate; returns a dict of numpy arrays:
     times (s,), positions (s, n, 3), velocities (s, n, 3), multipliers (s, m),
     constraint_residual (s,) [max_k |s_k Phi_k| at each stored time, metres],
@@ -151,7 +151,7 @@ def simulate(system: System, t_end: float, dt: float, alpha: float | None = None
     initial accelerations; row n > 0 holds the multipliers of the step that ends at times[n], which
     act at t_{n-1} + alpha dt for the trapezoidal schemes, where they evaluate the dynamics, and
     at times[n] for generalized-alpha),
-    steps_taken, steps_rejected, factorisations (int), linear_solver, scheme (str), and
+    steps_taken, steps_rejected, factorisations (int), linear_solver, scheme, formulation (str), and
     'error': None, or a dict {'kind', 'message', 'time', 'step_size', 'residual', 'iterations',
     'equation'} when the run stopped early (the arrays then hold every step completed).
     progress(t, t_end) is called about twice a second of wall time.

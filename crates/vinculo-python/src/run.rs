@@ -7,7 +7,7 @@ use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::time::{Duration, Instant};
-use vinculo::integrators::{NewtonOptions, Scheme};
+use vinculo::integrators::{Formulation, NewtonOptions, Scheme};
 use vinculo::{simulate_with_observer, Observer, SimulationOptions};
 
 /// Calls the Python progress callback and checks for Ctrl-C about twice a second.
@@ -77,11 +77,25 @@ fn scheme_by_name(name: &str, alpha: Option<f64>, rho_inf: Option<f64>) -> PyRes
     }
 }
 
+/// The formulation a name selects.
+fn formulation_by_name(name: &str) -> PyResult<Formulation> {
+    match name {
+        "index-3" => Ok(Formulation::Index3),
+        "ggl" => Ok(Formulation::Ggl),
+        other => Err(invalid(
+            "formulation",
+            format!("'{other}'"),
+            "expected 'index-3' or 'ggl'",
+        )),
+    }
+}
+
 /// Integrates the system; see the type stubs (`_core.pyi`) for the returned dictionary.
 #[pyfunction]
 #[pyo3(signature = (system, t_end, dt, alpha=None, t_start=0.0, tolerance=1e-10, max_iterations=25,
                     max_halvings=4, initial_tolerance=1e-8, save_every=1, progress=None,
-                    jacobian_reuse=false, scheme="trapezoidal", rho_inf=None))]
+                    jacobian_reuse=false, scheme="trapezoidal", rho_inf=None,
+                    formulation="index-3"))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
@@ -99,6 +113,7 @@ pub fn simulate<'py>(
     jacobian_reuse: bool,
     scheme: &str,
     rho_inf: Option<f64>,
+    formulation: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let count = |name: &str, v: i64, min: i64| -> PyResult<usize> {
         if v < min {
@@ -112,6 +127,7 @@ pub fn simulate<'py>(
         t_end,
         dt,
         scheme: scheme_by_name(scheme, alpha, rho_inf)?,
+        formulation: formulation_by_name(formulation)?,
         newton: NewtonOptions {
             tolerance,
             max_iterations: count("max_iterations", max_iterations, 1)?,
@@ -186,6 +202,7 @@ pub fn simulate<'py>(
     out.set_item("factorisations", sol.factorisations)?;
     out.set_item("linear_solver", sol.linear_solver)?;
     out.set_item("scheme", sol.scheme.name())?;
+    out.set_item("formulation", sol.formulation.name())?;
     match &sol.status {
         Ok(()) => out.set_item("error", py.None())?,
         Err(e) => {

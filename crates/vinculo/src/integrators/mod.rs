@@ -1,8 +1,11 @@
 //! Time integration: the generalised trapezoidal rule (paper eq. 24), the generalised-alpha
-//! scheme of Arnold and Brüls, and the Newton loop they share.
+//! scheme of Arnold and Brüls, and the Newton loop they share; each on the index-3 DAE or on the
+//! stabilised index-2 (GGL) formulation ([`Formulation`]).
 
 mod generalized_alpha;
 pub mod newton;
+mod stabilized;
+mod stabilized_layout;
 mod trapezoidal;
 
 pub use generalized_alpha::{AlphaCoefficients, AlphaState, GeneralizedAlpha};
@@ -10,6 +13,8 @@ pub use generalized_alpha::{AlphaCoefficients, AlphaState, GeneralizedAlpha};
 pub use newton::{
     IterationMatrix, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport,
 };
+pub use stabilized::{phi_qt, Formulation, StabilizedProblem, StabilizedWorkspace};
+pub use stabilized_layout::StabilizedLayout;
 pub use trapezoidal::{GeneralizedTrapezoidal, StepProblem, StepWorkspace};
 
 /// The time discretisation of a run, chosen by name.
