@@ -281,9 +281,8 @@ impl StabilizedLayout {
         let (n3, m) = (3 * self.free, self.constraints);
         if i < n3 {
             i
-        } else if i < 2 * n3 {
-            i - n3
         } else if i < 2 * n3 + m {
+            // Dynamic rows of the particles, then the position rows of the constraints.
             i - n3
         } else {
             i - n3 - m
@@ -298,9 +297,9 @@ mod tests {
 
     /// Every slot is in the pattern (a missing entry panics in `Pattern::slot`), and the pattern
     /// has exactly the structural entries counted by hand for a pendulum (1 free particle, one
-    /// distance to a fixed anchor): 9 (K,q, the identity and the mu Hessian) + 3 (K,v diagonal)
-    /// + 9 (D,v) + 9 (D,q, the lambda Hessian) + 3 each for (K,mu), (D,lambda), (Phi,q),
-    /// (Psi,q), (Psi,v): 45.
+    /// distance to a fixed anchor): 9 in (K,q) for the identity and the mu Hessian, 3 on the
+    /// (K,v) diagonal, 9 in (D,v), 9 in (D,q) for the lambda Hessian, and 3 each in (K,mu),
+    /// (D,lambda), (Phi,q), (Psi,q) and (Psi,v): 45 in all.
     #[test]
     fn pendulum_pattern_has_the_expected_entries() {
         let mut s = System::new([0.0, 0.0, -9.81]);
