@@ -13,7 +13,7 @@ pub use generalized_alpha::{AlphaCoefficients, AlphaState, GeneralizedAlpha};
 pub use newton::{
     IterationMatrix, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport,
 };
-pub use stabilized::{phi_qt, Formulation, StabilizedProblem, StabilizedWorkspace};
+pub use stabilized::{phi_qt, Formulation, StabilizedWorkspace};
 pub use stabilized_layout::StabilizedLayout;
 pub use trapezoidal::{GeneralizedTrapezoidal, StepProblem, StepWorkspace};
 
