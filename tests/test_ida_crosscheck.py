@@ -110,7 +110,7 @@ def test_multipliers_match_ida():
 def test_ida_agrees_with_the_minimal_coordinate_reference():
     # The index-1 setup itself against the angle ODE of test_schemes (DOP853 at 1e-12): the two
     # independent references agree to 1e-8 m at t = 1 s.
-    from test_schemes import angle_reference
+    from pendulum_reference import angle_reference
 
     x, z, _ = ida_solution(np.array([0.0, T_END]))
     theta = angle_reference(THETA0, T_END, lambda t: pivot(t)[2])

@@ -141,8 +141,9 @@ def simulate(system: System, t_end: float, dt: float, alpha: float | None = None
              initial_tolerance: float = 1e-8, save_every: int = 1,
              progress: Callable[[float, float], None] | None = None,
              jacobian_reuse: bool = False, scheme: str = "trapezoidal",
-             rho_inf: float | None = None, adaptive: bool = False, rtol: float = 1e-6,
-             atol: float = 1e-6, h_min: float = 1e-10, h_max: float | None = None,
+             rho_inf: float | None = None, formulation: str = "index-3",
+             adaptive: bool = False, rtol: float = 1e-6, atol: float = 1e-6,
+             h_min: float = 1e-10, h_max: float | None = None,
              t_eval: list[float] | None = None) -> dict:
     """Integrate; returns a dict of numpy arrays:
     times (s,), positions (s, n, 3), velocities (s, n, 3), multipliers (s, m),
@@ -156,7 +157,7 @@ def simulate(system: System, t_end: float, dt: float, alpha: float | None = None
     (with adaptive=True and t_eval: one row per requested time, interpolated in its step,
     with that step's statistics),
     accepted_step_sizes (every accepted step, in s),
-    steps_taken, steps_rejected, factorisations (int), linear_solver, scheme (str), and
+    steps_taken, steps_rejected, factorisations (int), linear_solver, scheme, formulation (str), and
     'error': None, or a dict {'kind', 'message', 'time', 'step_size', 'residual', 'iterations',
     'equation'} when the run stopped early (the arrays then hold every step completed).
     progress(t, t_end) is called about twice a second of wall time.

@@ -61,6 +61,7 @@ def simulate(
     *,
     scheme: str = "trapezoidal",
     rho_inf: float | None = None,
+    formulation: str = "index-3",
     t_start: float = 0.0,
     tolerance: float = 1e-10,
     max_iterations: int = 25,
@@ -80,7 +81,8 @@ def simulate(
 
     The equations ``M v' + F(q, v, t) - Phi_q^T lambda = 0``, ``v = q'``, ``Phi(q, t) = 0`` are
     discretised by the scheme named by ``scheme`` and solved step by step with Newton's method, the
-    position constraints holding at the end of every step. A step that does not converge is
+    position constraints (with ``formulation='ggl'`` also the velocity constraints) holding at the
+    end of every step. A step that does not converge is
     retried with half the step size, up to ``max_halvings`` times.
 
     Arguments:
@@ -97,6 +99,12 @@ def simulate(
         rho_inf: spectral radius at infinite frequency of 'generalized-alpha', in [0, 1]
             (default 0.9): 1 adds no numerical damping, 0 removes the highest frequencies in one
             step; the low frequencies are barely damped in every case.
+        formulation: 'index-3' (default: position constraints only, the velocities satisfy
+            ``Phi_q v + Phi_t = 0`` to the scheme's accuracy) or 'ggl' (the stabilised index-2
+            formulation of Gear, Gupta and Leimkuhler: the velocity constraints are added with a
+            second multiplier on the kinematics, ``q' = v + Phi_q^T mu``, so both levels hold at
+            every step to the Newton tolerance; same orders, same meaning of the multipliers,
+            about twice the unknowns and the general sparse LU instead of the tree elimination).
         t_start: initial time, in s.
         tolerance: Newton stops when the scaled residual and the last increment (both lengths, see
             formulation.md) are below ``tolerance * system.length_scale()``.
@@ -145,8 +153,8 @@ def simulate(
 
     Raises:
         InvalidInputError: a bad argument (``dt <= 0``, ``t_end < t_start``, an unknown
-            ``scheme``, ``alpha`` outside [1/2, 1], ``rho_inf`` outside [0, 1], a parameter of
-            another scheme, a non-positive tolerance, ...).
+            ``scheme`` or ``formulation``, ``alpha`` outside [1/2, 1], ``rho_inf`` outside [0, 1],
+            a parameter of another scheme, a non-positive tolerance, ...).
         InconsistentInitialStateError: the initial state violates a constraint by more than
             ``initial_tolerance`` (see ``System.project_initial_state``).
         ConvergenceError: a step failed even at the smallest step size; its ``solution`` attribute
@@ -171,6 +179,12 @@ def simulate(
                 value=t_eval,
             )
         times = [float(x) for x in times]
+    if not isinstance(formulation, str):
+        raise errors.InvalidInputError(
+            f"formulation must be a name ('index-3' or 'ggl'), got {formulation!r}",
+            name="formulation",
+            value=formulation,
+        )
     bar: ProgressBar | None = None
     callback: ProgressCallback | None
     if progress is True:
@@ -208,6 +222,7 @@ def simulate(
             h_min=h_min,
             h_max=h_max,
             t_eval=times,
+            formulation=formulation,
         )
     finally:
         if bar is not None:

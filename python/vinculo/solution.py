@@ -54,9 +54,10 @@ class Solution:
             constraint's scale, see ``System.constraint_scales``): the position-level
             violation, at the Newton tolerance or below (also :attr:`position_violation`).
         velocity_violation: (s,) ``max_k |s_k (Phi_q v + Phi_t)|`` at each stored time, in m/s:
-            the velocity-level violation. The schemes enforce the position constraints only
-            (index 3), so the velocities drift off the velocity constraints by an amount that
-            shrinks with the step: a measure of the run's accuracy.
+            the velocity-level violation. With ``formulation='index-3'`` the schemes enforce the
+            position constraints only, so the velocities drift off the velocity constraints by an
+            amount that shrinks with the step: a measure of the run's accuracy. With
+            ``formulation='ggl'`` both levels hold at every step, to the Newton tolerance.
         newton_iterations: (s,) Newton iterations of each step.
         step_sizes: (s,) size of each step, in s (smaller than ``dt`` where steps were halved).
         residual_norms: (s,) final residual norm of each step's Newton solve.
@@ -67,7 +68,7 @@ class Solution:
         system: the :class:`vinculo.System` that was simulated.
         linear_solver: the linear solver the run used: 'dense LU' (small systems),
             'tree elimination' (tree-shaped constraint graphs: chains, ropes, branched strings)
-            or 'sparse LU' (graphs with loops).
+            or 'sparse LU' (graphs with loops; and every GGL run above the dense size).
         factorisations: number of Newton iteration matrices factorised over the run (one per
             Newton iteration in full Newton, fewer with ``jacobian_reuse=True``).
         scheme: the time discretisation: 'trapezoidal', 'backward-euler' or 'generalized-alpha'.
@@ -76,6 +77,7 @@ class Solution:
             error-controlled step exceeded the tolerance).
         accepted_step_sizes: size of every accepted step, in s, whether its state was stored or
             not (its length is :attr:`steps_accepted`).
+        formulation: the equations discretised: 'index-3' or 'ggl'.
     """
 
     times: np.ndarray
@@ -96,6 +98,7 @@ class Solution:
     steps_taken: int = 0
     steps_rejected: int = 0
     accepted_step_sizes: np.ndarray = field(default_factory=lambda: _frozen([], np.float64))
+    formulation: str = ""
 
     @classmethod
     def from_core(cls, data: dict[str, Any], system: System) -> Solution:
@@ -123,6 +126,7 @@ class Solution:
             steps_taken=int(data.get("steps_taken", 0)),
             steps_rejected=int(data.get("steps_rejected", 0)),
             accepted_step_sizes=_frozen(data.get("accepted_step_sizes", []), np.float64),
+            formulation=str(data.get("formulation", "")),
         )
 
     @property

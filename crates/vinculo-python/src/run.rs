@@ -7,7 +7,7 @@ use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::time::{Duration, Instant};
-use vinculo::integrators::{NewtonOptions, Scheme};
+use vinculo::integrators::{Formulation, NewtonOptions, Scheme};
 use vinculo::{simulate_with_observer, AdaptiveOptions, Observer, SimulationOptions, StepControl};
 
 /// Calls the Python progress callback and checks for Ctrl-C about twice a second.
@@ -77,12 +77,26 @@ fn scheme_by_name(name: &str, alpha: Option<f64>, rho_inf: Option<f64>) -> PyRes
     }
 }
 
+/// The formulation a name selects.
+fn formulation_by_name(name: &str) -> PyResult<Formulation> {
+    match name {
+        "index-3" => Ok(Formulation::Index3),
+        "ggl" => Ok(Formulation::Ggl),
+        other => Err(invalid(
+            "formulation",
+            format!("'{other}'"),
+            "expected 'index-3' or 'ggl'",
+        )),
+    }
+}
+
 /// Integrates the system; see the type stubs (`_core.pyi`) for the returned dictionary.
 #[pyfunction]
 #[pyo3(signature = (system, t_end, dt, alpha=None, t_start=0.0, tolerance=1e-10, max_iterations=25,
                     max_halvings=4, initial_tolerance=1e-8, save_every=1, progress=None,
-                    jacobian_reuse=false, scheme="trapezoidal", rho_inf=None, adaptive=false,
-                    rtol=1e-6, atol=1e-6, h_min=1e-10, h_max=None, t_eval=None))]
+                    jacobian_reuse=false, scheme="trapezoidal", rho_inf=None,
+                    formulation="index-3", adaptive=false, rtol=1e-6, atol=1e-6, h_min=1e-10,
+                    h_max=None, t_eval=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
@@ -100,6 +114,7 @@ pub fn simulate<'py>(
     jacobian_reuse: bool,
     scheme: &str,
     rho_inf: Option<f64>,
+    formulation: &str,
     adaptive: bool,
     rtol: f64,
     atol: f64,
@@ -119,6 +134,7 @@ pub fn simulate<'py>(
         t_end,
         dt,
         scheme: scheme_by_name(scheme, alpha, rho_inf)?,
+        formulation: formulation_by_name(formulation)?,
         newton: NewtonOptions {
             tolerance,
             max_iterations: count("max_iterations", max_iterations, 1)?,
@@ -209,6 +225,7 @@ pub fn simulate<'py>(
     out.set_item("factorisations", sol.factorisations)?;
     out.set_item("linear_solver", sol.linear_solver)?;
     out.set_item("scheme", sol.scheme.name())?;
+    out.set_item("formulation", sol.formulation.name())?;
     match &sol.status {
         Ok(()) => out.set_item("error", py.None())?,
         Err(e) => {

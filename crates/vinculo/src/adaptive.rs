@@ -24,11 +24,11 @@
 use crate::assembly::NONE;
 use crate::dense_output::StepEnds;
 use crate::error::Error;
-use crate::initial::{scaled_velocity_violation, scaled_violation, singular_error};
+use crate::initial::{factor_saddle, scaled_velocity_violation, scaled_violation, singular_error};
 use crate::integrators::error_estimate::sample_offset;
 use crate::integrators::{
     AccelerationHistory, AlphaState, ErrorConstants, GeneralizedAlpha, GeneralizedTrapezoidal,
-    NewtonFailure, NewtonOptions, NewtonReport, Scheme, StepWorkspace,
+    NewtonFailure, NewtonOptions, NewtonReport, Scheme, StabilizedWorkspace, StepWorkspace,
 };
 use crate::math::Vec3;
 use crate::model::System;
@@ -55,12 +55,14 @@ pub(crate) struct StartState {
     pub lambda: Vec<f64>,
 }
 
-/// One step of the scheme from (t, q, v); `alpha_state` is generalised-alpha's extra state.
+/// One step of the scheme from (t, q, v), on the GGL formulation when `stabilized` is given;
+/// `alpha_state` is generalised-alpha's extra state.
 #[allow(clippy::too_many_arguments)]
 fn take_step(
     scheme: Scheme,
     system: &System,
     ws: &mut StepWorkspace,
+    stabilized: Option<&mut StabilizedWorkspace>,
     t: f64,
     q: &[Vec3],
     v: &[Vec3],
@@ -68,11 +70,12 @@ fn take_step(
     h: f64,
     newton: &NewtonOptions,
 ) -> Result<NewtonReport, NewtonFailure> {
-    match scheme {
-        Scheme::GeneralizedTrapezoidal { alpha } => {
+    match (stabilized, scheme) {
+        (Some(ggl), _) => ggl.step(system, ws, scheme, t, q, v, alpha_state, h, newton),
+        (None, Scheme::GeneralizedTrapezoidal { alpha }) => {
             GeneralizedTrapezoidal { alpha }.step(system, ws, t, q, v, h, newton)
         }
-        Scheme::GeneralizedAlpha { rho_inf } => {
+        (None, Scheme::GeneralizedAlpha { rho_inf }) => {
             GeneralizedAlpha { rho_inf }.step(system, ws, t, q, v, alpha_state, h, newton)
         }
     }
@@ -120,6 +123,7 @@ fn store(
 pub(crate) fn march(
     run: &AdaptiveRun,
     ws: &mut StepWorkspace,
+    mut stabilized: Option<&mut StabilizedWorkspace>,
     sol: &mut Solution,
     start: StartState,
     observer: &mut dyn Observer,
@@ -160,6 +164,7 @@ pub(crate) fn march(
     let (mut q_new, mut v_new, mut lambda_new) = (q.clone(), v.clone(), lambda.clone());
     let (mut a_sample, mut e_q, mut e_v) = (acc.clone(), acc.clone(), acc.clone());
     let mut full = acc.clone();
+    let mut q_end = q.clone();
     let (mut q_out, mut v_out, mut lambda_out) = (q.clone(), v.clone(), lambda.clone());
 
     let mut t = t0;
@@ -193,6 +198,7 @@ pub(crate) fn march(
             scheme,
             system,
             ws,
+            stabilized.as_deref_mut(),
             t,
             &q,
             &v,
@@ -248,6 +254,15 @@ pub(crate) fn march(
             }
         }
         full.copy_from_slice(&a_sample);
+        if stabilized.is_some() {
+            // The GGL step factorised its own matrix: the projection needs the index-3
+            // workspace's [M/m_ref, -s G^T; s G, 0] at the step's end.
+            q_end.copy_from_slice(&ws.state.q);
+            if let Err(e) = factor_saddle(system, ws, &q_end, t + h_try) {
+                sol.status = Err(e);
+                return;
+            }
+        }
         tangential(ws, &mut a_sample, &mut projection);
         if step == 0 {
             initial.copy_from_slice(&acc);

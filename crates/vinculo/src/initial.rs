@@ -53,13 +53,24 @@ pub(crate) fn singular_error(system: &System, layout: &Layout, t: f64, s: Singul
 }
 
 /// Solves the saddle system at (q, t) for the right-hand side in `ws.r`, leaving the solution there.
-fn solve_saddle(system: &System, ws: &mut StepWorkspace, q: &[Vec3], t: f64) -> Result<()> {
+/// Fills [M/m_ref, -s G^T; s G, 0] at (q, t) and factorises it in `ws.solver`. The caller says
+/// what the solver held before (see [`IterationMatrix::invalidate`](crate::integrators::IterationMatrix::invalidate)).
+pub(crate) fn factor_saddle(
+    system: &System,
+    ws: &mut StepWorkspace,
+    q: &[Vec3],
+    t: f64,
+) -> Result<()> {
     fill_saddle(system, ws, q, t);
-    // The solver no longer holds a step's iteration matrix.
-    ws.matrix.invalidate();
     ws.solver
         .factor(&ws.values)
-        .map_err(|s| singular_error(system, &ws.layout, t, s))?;
+        .map_err(|s| singular_error(system, &ws.layout, t, s))
+}
+
+fn solve_saddle(system: &System, ws: &mut StepWorkspace, q: &[Vec3], t: f64) -> Result<()> {
+    // The solver no longer holds a step's iteration matrix.
+    ws.matrix.invalidate();
+    factor_saddle(system, ws, q, t)?;
     ws.solver.solve_in_place(&mut ws.r);
     if ws.r.iter().any(|x| !x.is_finite()) {
         return Err(Error::SingularMatrix {

@@ -12,7 +12,8 @@
 //! Point masses ([`model::System`]) are linked by constraints ([`constraints::Constraint`]) enforced
 //! with Lagrange multipliers and loaded by forces ([`forces::Force`]). The generalised trapezoidal
 //! rule ([`integrators::GeneralizedTrapezoidal`]) or the generalised-alpha scheme
-//! ([`integrators::GeneralizedAlpha`]), chosen by [`integrators::Scheme`], turns each step into a
+//! ([`integrators::GeneralizedAlpha`]), chosen by [`integrators::Scheme`], on this system or on its
+//! stabilised index-2 form ([`integrators::Formulation`]), turns each step into a
 //! nonlinear system that a Newton loop ([`integrators::newton`], full or modified) solves with the
 //! analytic Jacobian, assembled into a sparsity pattern computed once ([`assembly`]) and
 //! factorised by faer ([`linear`]).

@@ -7,8 +7,8 @@ use crate::initial::{
     consistent_accelerations, scaled_velocity_violation, scaled_violation, singular_error,
 };
 use crate::integrators::{
-    AlphaState, GeneralizedAlpha, GeneralizedTrapezoidal, NewtonFailure, NewtonOptions, Scheme,
-    StepWorkspace,
+    AlphaState, Formulation, GeneralizedAlpha, GeneralizedTrapezoidal, NewtonFailure,
+    NewtonOptions, Scheme, StabilizedWorkspace, StepWorkspace,
 };
 use crate::linear::SparseSolver;
 use crate::math::Vec3;
@@ -28,6 +28,11 @@ pub struct SimulationOptions {
     pub dt: f64,
     /// The time discretisation (default: the trapezoidal rule, alpha = 1/2).
     pub scheme: Scheme,
+    /// The equations discretised (default: the index-3 DAE). [`Formulation::Ggl`] adds the
+    /// velocity constraints with a second multiplier (see `integrators/stabilized.rs`); its
+    /// steps solve with the dense LU (up to `dense_limit` unknowns) or the general sparse LU,
+    /// and assemble serially whatever `parallel_from` says.
+    pub formulation: Formulation,
     /// Newton options (tolerance relative to the length scale).
     pub newton: NewtonOptions,
     /// How many times a failing step may be halved before the run stops.
@@ -68,6 +73,7 @@ impl Default for SimulationOptions {
             t_end: 1.0,
             dt: 1e-3,
             scheme: Scheme::default(),
+            formulation: Formulation::default(),
             newton: NewtonOptions::default(),
             max_halvings: 4,
             initial_tolerance: 1e-8,
@@ -319,8 +325,17 @@ pub fn simulate_with_observer(
         tolerance: options.newton.tolerance * length,
         ..options.newton
     };
-    let mut sol = Solution::new(q.len(), system.constraints().len(), ws.solver.name());
+    // The GGL steps have their own unknowns and solver; the index-3 workspace still serves the
+    // consistent start and carries the step's state in and out.
+    let mut stabilized = (options.formulation == Formulation::Ggl)
+        .then(|| StabilizedWorkspace::new(system, options.dense_limit));
+    let solver_name = match &stabilized {
+        Some(g) => g.solver.name(),
+        None => ws.solver.name(),
+    };
+    let mut sol = Solution::new(q.len(), system.constraints().len(), solver_name);
     sol.scheme = scheme;
+    sol.formulation = options.formulation;
     let start = consistent_accelerations(system, &mut ws, &q, &v, t0).map_err(|e| match e {
         // Name the culprits when the matrix is singular because constraints are redundant.
         Error::SingularMatrix { .. } => find_redundant(system, &q, t0, None).unwrap_or(e),
@@ -381,7 +396,14 @@ pub fn simulate_with_observer(
             acceleration: acc,
             lambda,
         };
-        crate::adaptive::march(&run, &mut ws, &mut sol, start, observer);
+        crate::adaptive::march(
+            &run,
+            &mut ws,
+            stabilized.as_mut(),
+            &mut sol,
+            start,
+            observer,
+        );
         return Ok(sol);
     }
 
@@ -416,11 +438,22 @@ pub fn simulate_with_observer(
         // Modified Newton starting from a matrix of an earlier step gets one more attempt with a
         // fresh matrix before the step counts as failed.
         let stale = newton.jacobian_reuse && ws.matrix.holds(scheme.matrix_key(h_try));
-        let attempt = match scheme {
-            Scheme::GeneralizedTrapezoidal { alpha } => {
+        let attempt = match (stabilized.as_mut(), scheme) {
+            (Some(ggl), _) => ggl.step(
+                system,
+                &mut ws,
+                scheme,
+                t,
+                &q,
+                &v,
+                &mut alpha_state,
+                h_try,
+                &newton,
+            ),
+            (None, Scheme::GeneralizedTrapezoidal { alpha }) => {
                 GeneralizedTrapezoidal { alpha }.step(system, &mut ws, t, &q, &v, h_try, &newton)
             }
-            Scheme::GeneralizedAlpha { rho_inf } => GeneralizedAlpha { rho_inf }.step(
+            (None, Scheme::GeneralizedAlpha { rho_inf }) => GeneralizedAlpha { rho_inf }.step(
                 system,
                 &mut ws,
                 t,

@@ -1,7 +1,7 @@
 //! What a run returns: stored states, multipliers, constraint health and per-step statistics.
 
 use crate::error::Error;
-use crate::integrators::Scheme;
+use crate::integrators::{Formulation, Scheme};
 
 /// Statistics of one stored step (for a state interpolated at a requested output time: of the
 /// step that contains that time).
@@ -36,8 +36,9 @@ pub struct Solution {
     /// max_k |s_k Phi_k| at each stored time (a length, m): the position-level violation.
     pub constraint_residual: Vec<f64>,
     /// max_k |s_k (Phi_q v + Phi_t)| at each stored time (a speed, m/s): the velocity-level
-    /// violation. The index-3 schemes enforce only the positions, so this is not zero but
-    /// shrinks with the step (see [`crate::initial::scaled_velocity_violation`]).
+    /// violation. The index-3 formulation enforces only the positions, so this is not zero but
+    /// shrinks with the step (see [`crate::initial::scaled_velocity_violation`]); the GGL
+    /// formulation enforces it at every step, to the Newton tolerance.
     pub velocity_violation: Vec<f64>,
     /// Per stored step.
     pub stats: Vec<StepStats>,
@@ -53,7 +54,9 @@ pub struct Solution {
     pub factorisations: usize,
     /// The time discretisation used ([`Scheme::name`] names it).
     pub scheme: Scheme,
-    /// Name of the linear solver used.
+    /// The equations discretised ([`Formulation::name`] names them).
+    pub formulation: Formulation,
+    /// Name of the linear solver used for the steps.
     pub linear_solver: &'static str,
     /// `Ok` when the run reached its end; otherwise the error that stopped it (the arrays hold
     /// everything computed before).
@@ -78,6 +81,7 @@ impl Solution {
             accepted_step_sizes: Vec::new(),
             factorisations: 0,
             scheme: Scheme::default(),
+            formulation: Formulation::default(),
             linear_solver,
             status: Ok(()),
         }

@@ -1,12 +1,19 @@
 //! A run that cannot converge stops with a typed error naming time, residual and equation, and
-//! keeps every state computed before.
+//! keeps every state computed before, on both formulations (GGL names the particle or constraint
+//! whose kinematic, dynamic, position or velocity row failed).
 
-use vinculo::integrators::NewtonOptions;
+use vinculo::integrators::{Formulation, NewtonOptions};
 use vinculo::model::System;
 use vinculo::{simulate, Error, SimulationOptions};
 
 #[test]
 fn newton_failure_reports_and_keeps_the_partial_run() {
+    for formulation in [Formulation::Index3, Formulation::Ggl] {
+        fails_and_keeps_the_partial_run(formulation);
+    }
+}
+
+fn fails_and_keeps_the_partial_run(formulation: Formulation) {
     let mut s = System::new([0.0, 0.0, -9.81]);
     let pivot = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
     let bob = s
@@ -23,6 +30,7 @@ fn newton_failure_reports_and_keeps_the_partial_run() {
             ..Default::default()
         },
         max_halvings: 2,
+        formulation,
         ..Default::default()
     };
     let sol = simulate(&s, &options).unwrap();
@@ -43,7 +51,7 @@ fn newton_failure_reports_and_keeps_the_partial_run() {
             // Everything up to the failing step is kept.
             assert!((sol.times.last().unwrap() - t).abs() < 1e-12);
         }
-        other => panic!("expected NewtonFailed, got {other:?}"),
+        other => panic!("{formulation:?}: expected NewtonFailed, got {other:?}"),
     }
     assert!(sol.steps_rejected >= 3);
 }

@@ -1,9 +1,12 @@
 //! Time integration: the generalised trapezoidal rule (paper eq. 24), the generalised-alpha
-//! scheme of Arnold and Brüls, and the Newton loop they share.
+//! scheme of Arnold and Brüls, and the Newton loop they share; each on the index-3 DAE or on the
+//! stabilised index-2 (GGL) formulation ([`Formulation`]).
 
 pub mod error_estimate;
 mod generalized_alpha;
 pub mod newton;
+mod stabilized;
+mod stabilized_layout;
 mod trapezoidal;
 
 pub use error_estimate::{AccelerationHistory, ErrorConstants};
@@ -12,6 +15,8 @@ pub use generalized_alpha::{AlphaCoefficients, AlphaState, GeneralizedAlpha};
 pub use newton::{
     IterationMatrix, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport,
 };
+pub use stabilized::{phi_qt, Formulation, StabilizedWorkspace};
+pub use stabilized_layout::StabilizedLayout;
 pub use trapezoidal::{GeneralizedTrapezoidal, StepProblem, StepWorkspace};
 
 /// The time discretisation of a run, chosen by name.
