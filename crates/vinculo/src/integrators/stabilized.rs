@@ -549,10 +549,9 @@ mod tests {
             for dense_limit in [0, 1000] {
                 let mut ws = StepWorkspace::with_solver(&s, 0, SparseSolver::SparseLu);
                 let mut ggl = StabilizedWorkspace::new(&s, dense_limit);
-                let alpha = AlphaState {
-                    acceleration: q_n.iter().map(|x| [x[1], -x[0], 0.3]).collect(),
-                    algorithmic: q_n.iter().map(|x| [0.2, x[2], -x[0]]).collect(),
-                };
+                let algorithmic: Vec<Vec3> = q_n.iter().map(|x| [0.2, x[2], -x[0]]).collect();
+                let mut alpha = AlphaState::new(&algorithmic);
+                alpha.acceleration = q_n.iter().map(|x| [x[1], -x[0], 0.3]).collect();
                 let h = 0.01;
                 let rule = ggl.prepare(scheme, ws.mass_ref, 0.3, &q_n, &v_n, &alpha, h);
                 perturbed_iterate(&mut ws, &q_n);
