@@ -44,6 +44,7 @@ pub mod math;
 pub mod model;
 pub mod simulate;
 pub mod solution;
+pub mod user;
 
 pub use error::{Error, Result};
 pub use linear::SparseSolver;
