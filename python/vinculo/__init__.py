@@ -14,7 +14,7 @@ Example:
 
 from importlib.metadata import PackageNotFoundError, version
 
-from vinculo._core import ConstraintId, ForceId, Law, ParticleId, System
+from vinculo._core import ConstraintId, ForceId, Law, ParticleId, System, UserGroup
 from vinculo.errors import (
     ConvergenceError,
     InconsistentInitialStateError,
@@ -24,6 +24,8 @@ from vinculo.errors import (
     RedundantConstraintsError,
     SchedulerError,
     UnknownHandleError,
+    UserFunctionError,
+    UserFunctionOutputError,
     VinculoError,
 )
 from vinculo.laws import constant, polynomial, sine, tabulated
@@ -50,6 +52,9 @@ __all__ = [
     "Solution",
     "System",
     "UnknownHandleError",
+    "UserFunctionError",
+    "UserFunctionOutputError",
+    "UserGroup",
     "VinculoError",
     "__version__",
     "constant",

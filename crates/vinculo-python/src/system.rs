@@ -65,6 +65,8 @@ type Frame = Vec<[f64; 3]>;
 #[pyclass(name = "System", module = "vinculo._core")]
 pub struct PySystem {
     pub inner: System,
+    /// The first exception raised by a user function (for the run to chain).
+    pub user_errors: crate::user_physics::PendingError,
 }
 
 fn vec3(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<[f64; 3]> {
@@ -149,6 +151,7 @@ impl PySystem {
         };
         Ok(PySystem {
             inner: System::try_new(g).map_err(to_py)?,
+            user_errors: Default::default(),
         })
     }
 
@@ -401,6 +404,71 @@ impl PySystem {
         };
         let id = self.inner.add_morison(p, spec).map_err(to_py)?;
         Ok(PyForceId { index: id.0 })
+    }
+
+    /// A group of forces computed by one Python function for all its elements at once; see
+    /// `vinculo.System.add_force_group` in the stubs for the contract.
+    #[pyo3(signature = (particles, force, jacobian=None, name=None))]
+    fn add_force_group(
+        &mut self,
+        particles: &Bound<'_, PyAny>,
+        force: &Bound<'_, PyAny>,
+        jacobian: Option<&Bound<'_, PyAny>>,
+        name: Option<String>,
+    ) -> PyResult<crate::user_physics::PyUserGroup> {
+        use crate::user_physics as up;
+        let (elements, arity) = up::elements(particles)?;
+        let force = up::callable("force", Some(force))?
+            .ok_or_else(|| invalid("force", "None", "expected a function force(t, q, v)"))?;
+        let jacobian = up::callable("jacobian", jacobian)?;
+        let functions =
+            up::force_functions(elements.len(), arity, self.user_errors.clone(), force, jacobian);
+        let group = self
+            .inner
+            .add_user_force_group(elements, arity, Box::new(functions), name)
+            .map_err(to_py)?;
+        Ok(up::PyUserGroup::force(group))
+    }
+
+    /// A group of constraint equations (one per element) computed by Python functions for all
+    /// its elements at once; see `vinculo.System.add_constraint_group` in the stubs.
+    #[pyo3(signature = (particles, phi, gradient=None, hessian=None, phi_t=None, gamma=None, scale=None, name=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_constraint_group(
+        &mut self,
+        particles: &Bound<'_, PyAny>,
+        phi: &Bound<'_, PyAny>,
+        gradient: Option<&Bound<'_, PyAny>>,
+        hessian: Option<&Bound<'_, PyAny>>,
+        phi_t: Option<&Bound<'_, PyAny>>,
+        gamma: Option<&Bound<'_, PyAny>>,
+        scale: Option<f64>,
+        name: Option<String>,
+    ) -> PyResult<crate::user_physics::PyUserGroup> {
+        use crate::user_physics as up;
+        let (elements, arity) = up::elements(particles)?;
+        let phi = up::callable("phi", Some(phi))?
+            .ok_or_else(|| invalid("phi", "None", "expected a function phi(t, q)"))?;
+        let functions = [
+            Some(phi),
+            up::callable("gradient", gradient)?,
+            up::callable("hessian", hessian)?,
+            up::callable("phi_t", phi_t)?,
+            up::callable("gamma", gamma)?,
+        ];
+        let functions =
+            up::constraint_functions(elements.len(), arity, self.user_errors.clone(), functions);
+        let (group, first) = self
+            .inner
+            .add_user_constraint_group(
+                elements,
+                arity,
+                Box::new(functions),
+                scale.unwrap_or(1.0),
+                name,
+            )
+            .map_err(to_py)?;
+        Ok(up::PyUserGroup::constraint(group, first))
     }
 
     /// Declares a distance constraint a string: a run stops with NegativeTensionError when it

@@ -163,6 +163,27 @@ impl UserConstraints {
         3 * self.arity
     }
 
+    /// Evaluates `call` over the group at the inputs `q` (and `v` for gamma), k x a x 3, outside
+    /// a run, with a fresh cache and without counting; by finite differences when
+    /// `finite_differences` is set (or the function is not supplied). For checking user
+    /// derivatives against the finite differences.
+    pub fn evaluate(
+        &self,
+        call: ConstraintCall,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        finite_differences: bool,
+    ) -> crate::Result<Vec<f64>> {
+        let mut st = GroupState::new();
+        let v = if call == ConstraintCall::Gamma { v } else { &[] };
+        self.compute(&mut st, call, t, q, v, finite_differences)
+            .ok_or_else(|| {
+                let (name, t, f) = st.failure.clone().expect("a failure");
+                f.into_error(&self.name, name, t)
+            })
+    }
+
     /// One call of a user function over the group.
     fn user(
         &self,
@@ -208,8 +229,10 @@ impl UserConstraints {
         t: f64,
         q: &[f64],
         v: &[f64],
+        finite_differences: bool,
     ) -> Option<Vec<f64>> {
-        if call == ConstraintCall::Phi || self.functions.supplies(call) {
+        let supplied = self.functions.supplies(call) && !finite_differences;
+        if call == ConstraintCall::Phi || supplied {
             return self.user(st, call, t, q, v);
         }
         let n = self.width();
@@ -313,7 +336,7 @@ impl UserConstraints {
             q,
             v,
             t,
-            |st, qg, vg| self.compute(st, call, t, qg, vg),
+            |st, qg, vg| self.compute(st, call, t, qg, vg, false),
             read,
         )
     }

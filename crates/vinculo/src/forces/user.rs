@@ -113,6 +113,36 @@ impl UserForces {
         Some(f.into_error(&self.name, call, t))
     }
 
+    /// Evaluates the group at the inputs `q`, `v` (k x a x 3) outside a run, with a fresh cache
+    /// and without counting: the forces (k x a x 3), df/dq and df/dv (k x 3a x 3a each), the
+    /// Jacobian by finite differences when `finite_differences` is set (or no Jacobian is
+    /// supplied). For checking a user Jacobian against the finite differences.
+    pub fn evaluate(
+        &self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        finite_differences: bool,
+    ) -> crate::Result<[Vec<f64>; 3]> {
+        let mut st = GroupState::new();
+        let failed = |st: &GroupState<2>| {
+            let (call, t, f) = st.failure.clone().expect("a failure");
+            f.into_error(&self.name, call, t)
+        };
+        let f = self.call_force(&mut st, t, q, v).ok_or_else(|| failed(&st))?;
+        st.memos[FORCE].store(t, q.to_vec(), v.to_vec(), f.clone());
+        let both = self
+            .call_jacobian(&mut st, t, q, v, finite_differences)
+            .ok_or_else(|| failed(&st))?;
+        let nn = self.width() * self.width();
+        let (mut dq, mut dv) = (Vec::new(), Vec::new());
+        for e in both.chunks(2 * nn) {
+            dq.extend_from_slice(&e[..nn]);
+            dv.extend_from_slice(&e[nn..]);
+        }
+        Ok([f, dq, dv])
+    }
+
     /// Number of coordinates of one element, 3a.
     fn width(&self) -> usize {
         3 * self.arity
@@ -132,12 +162,13 @@ impl UserForces {
         t: f64,
         q: &[f64],
         v: &[f64],
+        finite_differences: bool,
     ) -> Option<Vec<f64>> {
         let n = self.width();
         let k = self.elements.len();
         let mut dq = vec![0.0; k * n * n];
         let mut dv = vec![0.0; k * n * n];
-        if self.functions.has_jacobian() {
+        if self.functions.has_jacobian() && !finite_differences {
             let ok = st.call(JACOBIAN, "jacobian", t, || {
                 self.functions.jacobian(t, q, v, &mut dq, &mut dv)
             });
@@ -248,7 +279,7 @@ impl UserForce {
             q,
             Some(v),
             t,
-            |st, qg, vg| g.call_jacobian(st, t, qg, vg),
+            |st, qg, vg| g.call_jacobian(st, t, qg, vg, false),
             |local| {
                 for (half, out) in [(0, dq), (1, dv)] {
                     for p in 0..arity {
