@@ -74,12 +74,8 @@ pub fn details<'py>(py: Python<'py>, e: &Error) -> PyResult<Bound<'py, PyDict>> 
             d.set_item("equation", equation)?;
         }
         Error::Interrupted { t } => d.set_item("time", t)?,
-        Error::UserFunction {
-            group, call, t, ..
-        }
-        | Error::UserFunctionOutput {
-            group, call, t, ..
-        } => {
+        Error::UserFunction { group, call, t, .. }
+        | Error::UserFunctionOutput { group, call, t, .. } => {
             d.set_item("group", group)?;
             d.set_item("call", call)?;
             d.set_item("time", t)?;

@@ -139,17 +139,15 @@ pub fn simulate<'py>(
     if let Some(e) = observer.error.take() {
         return Err(e);
     }
-    let sol = result
-        .map_err(crate::errors::internal)?
-        .map_err(|e| {
-            let user = matches!(e, vinculo::Error::UserFunction { .. });
-            let err = to_py(e);
-            let cause = pending.lock().unwrap_or_else(|p| p.into_inner()).take();
-            if let (true, Some(cause)) = (user, cause) {
-                err.set_cause(py, Some(cause));
-            }
-            err
-        })?;
+    let sol = result.map_err(crate::errors::internal)?.map_err(|e| {
+        let user = matches!(e, vinculo::Error::UserFunction { .. });
+        let err = to_py(e);
+        let cause = pending.lock().unwrap_or_else(|p| p.into_inner()).take();
+        if let (true, Some(cause)) = (user, cause) {
+            err.set_cause(py, Some(cause));
+        }
+        err
+    })?;
 
     let (s, n, m) = (sol.len(), sol.particles, sol.constraints);
     let out = PyDict::new(py);

@@ -406,8 +406,19 @@ impl PySystem {
         Ok(PyForceId { index: id.0 })
     }
 
-    /// A group of forces computed by one Python function for all its elements at once; see
-    /// `vinculo.System.add_force_group` in the stubs for the contract.
+    /// Forces computed by one Python function for a whole group of elements at once.
+    ///
+    /// `particles`: (k,) integer array (one particle per element) or (k, 2) (pairs) of
+    /// particle indices. `force(t, q, v)` gets the elements' positions and velocities, (k, 3)
+    /// or (k, 2, 3), and returns the forces on those particles in the same shape; element i's
+    /// result may depend only on t and row i. It is called once per residual evaluation.
+    /// `jacobian(t, q, v)` returns (df_dq, df_dv), each (k, 3a, 3a) (a = 1 or 2; row 3p + l:
+    /// component l of the force on particle p, column 3r + m: coordinate m of particle r);
+    /// None: forward differences over the group (6a force calls per Jacobian). Returns a
+    /// `UserGroup` (calls and seconds of the last run). During a run, an exception stops it with
+    /// `UserFunctionError` (the exception chained), a wrong shape or NaN with
+    /// `UserFunctionOutputError`. Bad particles or a non-callable raise `InvalidInputError`,
+    /// an index out of range `UnknownHandleError`.
     #[pyo3(signature = (particles, force, jacobian=None, name=None))]
     fn add_force_group(
         &mut self,
@@ -421,8 +432,13 @@ impl PySystem {
         let force = up::callable("force", Some(force))?
             .ok_or_else(|| invalid("force", "None", "expected a function force(t, q, v)"))?;
         let jacobian = up::callable("jacobian", jacobian)?;
-        let functions =
-            up::force_functions(elements.len(), arity, self.user_errors.clone(), force, jacobian);
+        let functions = up::force_functions(
+            elements.len(),
+            arity,
+            self.user_errors.clone(),
+            force,
+            jacobian,
+        );
         let group = self
             .inner
             .add_user_force_group(elements, arity, Box::new(functions), name)
@@ -430,8 +446,16 @@ impl PySystem {
         Ok(up::PyUserGroup::force(group))
     }
 
-    /// A group of constraint equations (one per element) computed by Python functions for all
-    /// its elements at once; see `vinculo.System.add_constraint_group` in the stubs.
+    /// Constraint equations Phi_i(q, t) = 0, one per element, computed by Python functions for
+    /// a whole group of elements at once.
+    ///
+    /// `particles` as for `add_force_group`. `phi(t, q)` returns the k residuals. Optional
+    /// (finite differences over the group when None): `gradient(t, q)` (k, a, 3),
+    /// `hessian(t, q)` (k, 3a, 3a), `phi_t(t, q)` (k,), `gamma(t, q, v)` (k,), gamma being
+    /// Phi'' - Phi_q q''. `scale`: s such that s Phi is a length (default 1). The group's
+    /// equations are `UserGroup.constraint_indices` (columns of Solution.multipliers). Errors as
+    /// for `add_force_group`; a scale that is not finite and positive, or an element touching
+    /// only fixed particles, raises `InvalidInputError`.
     #[pyo3(signature = (particles, phi, gradient=None, hessian=None, phi_t=None, gamma=None, scale=None, name=None))]
     #[allow(clippy::too_many_arguments)]
     fn add_constraint_group(

@@ -91,7 +91,7 @@ impl Calling {
                         kw.set_item("dtype", "float64")?;
                         asarray.call((obj,), Some(&kw))
                     });
-                match converted.and_then(|a| Ok(a.extract::<PyReadonlyArrayDyn<'_, f64>>()?)) {
+                match converted.and_then(|a| a.extract::<PyReadonlyArrayDyn<'_, f64>>()) {
                     Ok(a) => a,
                     Err(_) => {
                         let kind = obj
@@ -491,7 +491,9 @@ impl PyUserGroup {
                     Ok(pair.into_pyobject(py)?.into_any())
                 }
             }
-            (Group::Constraint(g, _), name) if ConstraintCall::ALL.iter().any(|c| c.name() == name) => {
+            (Group::Constraint(g, _), name)
+                if ConstraintCall::ALL.iter().any(|c| c.name() == name) =>
+            {
                 let which = *ConstraintCall::ALL
                     .iter()
                     .find(|c| c.name() == name)

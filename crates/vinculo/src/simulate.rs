@@ -259,12 +259,14 @@ pub fn simulate_with_observer(
         Error::SingularMatrix { .. } => find_redundant(system, &q, t0, None).unwrap_or(e),
         e => e,
     });
+    // A failed user function is the cause of whatever else went wrong at the start.
+    let start = match (start, system.user_failure()) {
+        (_, Some(e)) => Err(e),
+        (start, None) => start,
+    };
     let (mut acc, mut lambda) = match start {
-        Ok(x) if system.user_failure().is_none() => x,
-        result => {
-            let e = system
-                .user_failure()
-                .unwrap_or_else(|| result.err().expect("failed start"));
+        Ok(x) => x,
+        Err(e) => {
             sol.push(
                 t0,
                 &q,

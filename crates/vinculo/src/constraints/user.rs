@@ -176,7 +176,11 @@ impl UserConstraints {
         finite_differences: bool,
     ) -> crate::Result<Vec<f64>> {
         let mut st = GroupState::new();
-        let v = if call == ConstraintCall::Gamma { v } else { &[] };
+        let v = if call == ConstraintCall::Gamma {
+            v
+        } else {
+            &[]
+        };
         self.compute(&mut st, call, t, q, v, finite_differences)
             .ok_or_else(|| {
                 let (name, t, f) = st.failure.clone().expect("a failure");

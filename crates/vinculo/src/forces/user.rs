@@ -129,7 +129,9 @@ impl UserForces {
             let (call, t, f) = st.failure.clone().expect("a failure");
             f.into_error(&self.name, call, t)
         };
-        let f = self.call_force(&mut st, t, q, v).ok_or_else(|| failed(&st))?;
+        let f = self
+            .call_force(&mut st, t, q, v)
+            .ok_or_else(|| failed(&st))?;
         st.memos[FORCE].store(t, q.to_vec(), v.to_vec(), f.clone());
         let both = self
             .call_jacobian(&mut st, t, q, v, finite_differences)
