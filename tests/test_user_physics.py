@@ -444,3 +444,22 @@ def test_benchmark_smoke_run_agrees_with_the_built_in_drag():
         assert row.force_calls > 0 and row.force_per_call > 0.0
     assert rows[1].jacobian_calls > 0 and rows[2].jacobian_calls == 0
     assert any("Python, finite diff." in line for line in lines)
+
+
+def test_a_run_stopped_by_a_user_function_is_saved_with_its_status(tmp_path):
+    # Solution I/O with user groups: the partial solution of a failed run goes to a NetCDF file
+    # with its arrays exactly and the failure's facts; user equations are of kind 'other'.
+    pytest.importorskip("xarray")
+    from vinculo.io import load_netcdf, save_netcdf
+
+    drag = {"force": failing_after(30, RuntimeError("sensor offline"))}
+    system, _ = chain(3, drag=drag, links=distance_functions(LINK))
+    with pytest.raises(vinculo.UserFunctionError) as info:
+        vinculo.simulate(system, 1.0, 5e-3)
+    partial = info.value.solution
+    data = load_netcdf(save_netcdf(partial, tmp_path / "failed.nc"))
+    assert data.attrs["status"] == "failed"
+    assert "sensor offline" in data.attrs["error_message"]
+    assert np.array_equal(data["positions"].values, partial.positions)
+    assert np.array_equal(data["multipliers"].values, partial.multipliers)
+    assert list(data["constraint_kinds"].values) == ["other"] * 3

@@ -60,6 +60,13 @@ class UserGroup:
     """Wall time in each function during the last run, the crossing (GIL, array copies, shape
     checks) included."""
     def __len__(self) -> int: ...
+    def evaluate(self, call: str, t: float, q: npt.ArrayLike, v: npt.ArrayLike | None = None,
+                 finite_differences: bool = False) -> Any:
+        """Function ``call`` of the group at (t, q, v) as the core evaluates it (counts and caches
+        untouched): "force" -> forces; "jacobian" -> (df_dq, df_dv); "phi", "gradient",
+        "hessian", "phi_t", "gamma" -> that term. ``finite_differences=True``: the core's
+        finite-difference value instead of the user function (compare the two to check a
+        derivative)."""
 
 class System:
     def __init__(self, gravity: Sequence[float] = (0.0, 0.0, 0.0)) -> None: ...

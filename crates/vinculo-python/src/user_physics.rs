@@ -353,7 +353,13 @@ impl PyUserGroup {
         }
     }
 
-    fn counts(&self) -> Vec<(&'static str, vinculo::user::CallCount)> {
+    /// The call counts. Read without the GIL: a run holds a group's lock while it waits for the
+    /// GIL to call the group's function.
+    fn counts(&self, py: Python<'_>) -> Vec<(&'static str, vinculo::user::CallCount)> {
+        py.detach(|| self.counts_now())
+    }
+
+    fn counts_now(&self) -> Vec<(&'static str, vinculo::user::CallCount)> {
         match &self.group {
             Group::Force(g) => {
                 let c = g.counts();
@@ -424,7 +430,7 @@ impl PyUserGroup {
     #[getter]
     fn calls<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for (name, c) in self.counts() {
+        for (name, c) in self.counts(py) {
             d.set_item(name, c.calls)?;
         }
         Ok(d)
@@ -435,7 +441,7 @@ impl PyUserGroup {
     #[getter]
     fn seconds<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for (name, c) in self.counts() {
+        for (name, c) in self.counts(py) {
             d.set_item(name, c.seconds)?;
         }
         Ok(d)

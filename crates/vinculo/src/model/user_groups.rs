@@ -3,6 +3,9 @@
 //! Each element of a group becomes one force element ([`Force::User`]) or one constraint
 //! equation ([`Constraint::User`]), numbered after the elements already in the system, so the
 //! assembly, the schemes and the analyses see them as they see the built-in kinds.
+//!
+//! A group is shared (`Arc`): a clone of the system shares its groups' functions, caches and
+//! call counts, so runs of clones must not overlap in time if their counts are to be read.
 
 use super::System;
 use crate::constraints::{Constraint, ConstraintGroup, UserConstraint, UserConstraints};
