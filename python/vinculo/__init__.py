@@ -14,7 +14,7 @@ Example:
 
 from importlib.metadata import PackageNotFoundError, version
 
-from vinculo._core import ConstraintId, ForceId, Law, ParticleId, System
+from vinculo._core import ConstraintId, ForceId, Law, ParticleId, System, UserGroup
 from vinculo.errors import (
     ConvergenceError,
     InconsistentInitialStateError,
@@ -25,6 +25,8 @@ from vinculo.errors import (
     SchedulerError,
     StepSizeTooSmallError,
     UnknownHandleError,
+    UserFunctionError,
+    UserFunctionOutputError,
     VinculoError,
 )
 from vinculo.laws import constant, polynomial, sine, tabulated
@@ -52,6 +54,9 @@ __all__ = [
     "StepSizeTooSmallError",
     "System",
     "UnknownHandleError",
+    "UserFunctionError",
+    "UserFunctionOutputError",
+    "UserGroup",
     "VinculoError",
     "__version__",
     "constant",

@@ -43,6 +43,31 @@ class ConstraintId:
 class ForceId:
     index: int
 
+class UserGroup:
+    """A group of user-defined forces or constraints (``System.add_force_group`` /
+    ``System.add_constraint_group``)."""
+    name: str
+    kind: str
+    """"force" or "constraint"."""
+    arity: int
+    constraint_indices: list[int]
+    """Equations of a constraint group (columns of ``Solution.multipliers``)."""
+    calls: dict[str, int]
+    """Calls of each function during the last run: "force", "jacobian"; or "phi", "gradient",
+    "hessian", "phi_t", "gamma". Finite-difference evaluations count as calls of the function
+    they evaluate."""
+    seconds: dict[str, float]
+    """Wall time in each function during the last run, the crossing (GIL, array copies, shape
+    checks) included."""
+    def __len__(self) -> int: ...
+    def evaluate(self, call: str, t: float, q: npt.ArrayLike, v: npt.ArrayLike | None = None,
+                 finite_differences: bool = False) -> Any:
+        """Function ``call`` of the group at (t, q, v) as the core evaluates it (counts and caches
+        untouched): "force" -> forces; "jacobian" -> (df_dq, df_dv); "phi", "gradient",
+        "hessian", "phi_t", "gamma" -> that term. ``finite_differences=True``: the core's
+        finite-difference value instead of the user function (compare the two to check a
+        derivative)."""
+
 class System:
     def __init__(self, gravity: Sequence[float] = (0.0, 0.0, 0.0)) -> None: ...
     def add_particle(self, mass: float, position: Sequence[float],
@@ -64,6 +89,77 @@ class System:
         """f = -c v."""
     def add_quadratic_drag(self, particle: ParticleId, coefficient: float) -> ForceId:
         """f = -c |v| v."""
+    def add_force_group(
+        self,
+        particles: npt.ArrayLike,
+        force: Callable[[float, np.ndarray, np.ndarray], npt.ArrayLike],
+        jacobian: Callable[[float, np.ndarray, np.ndarray], tuple[npt.ArrayLike, npt.ArrayLike]]
+        | None = None,
+        name: str | None = None,
+    ) -> "UserGroup":
+        """Forces computed by one Python function for a whole group of elements at once.
+
+        ``particles`` is a (k,) integer array (one particle per element, arity 1) or (k, 2)
+        (two per element, arity 2) of particle indices (``ParticleId.index``). Once per
+        evaluation point (each Newton residual) the core calls ``force(t, q, v)`` with the
+        positions and velocities of every element's particles, arrays of shape (k, 3) for arity 1
+        or (k, 2, 3) for arity 2, and expects the forces on those particles (N) in the same
+        shape. Element i's result must depend only on ``t`` and row i of ``q`` and ``v``.
+
+        ``jacobian(t, q, v)`` returns ``(df_dq, df_dv)``, each (k, 3a, 3a) with a the arity:
+        entry [i, 3p + l, 3r + m] is d(component l of the force on particle p) / d(coordinate m
+        of particle r) of element i. Without it the core uses forward differences over the whole
+        group (each coordinate of every element perturbed at once by
+        h = sqrt(eps) max(|x|, s), s the largest |x| in the group): 6a extra ``force`` calls per
+        Jacobian, accurate to ~1e-8 relative, which changes Newton's rate, not the solution.
+
+        Returns the group, whose ``calls`` and ``seconds`` report the calls of the last run.
+        A function that raises stops the run with ``UserFunctionError`` (the partial solution
+        kept, the function's exception as ``__cause__``); a result of the wrong shape or with NaN
+        stops it with ``UserFunctionOutputError``. Models with user groups assemble serially.
+
+        Raises:
+            InvalidInputError: ``particles`` not a (k,) or (k, 2) integer array, a pair with
+                the same particle twice, a function that is not callable.
+            UnknownHandleError: a particle index out of range.
+        """
+    def add_constraint_group(
+        self,
+        particles: npt.ArrayLike,
+        phi: Callable[[float, np.ndarray], npt.ArrayLike],
+        gradient: Callable[[float, np.ndarray], npt.ArrayLike] | None = None,
+        hessian: Callable[[float, np.ndarray], npt.ArrayLike] | None = None,
+        phi_t: Callable[[float, np.ndarray], npt.ArrayLike] | None = None,
+        gamma: Callable[[float, np.ndarray, np.ndarray], npt.ArrayLike] | None = None,
+        scale: float | None = None,
+        name: str | None = None,
+    ) -> "UserGroup":
+        """Constraint equations Phi_i(q, t) = 0, one per element, computed by Python functions
+        for a whole group of elements at once.
+
+        ``particles`` as for :meth:`add_force_group`; q (and v) are (k, 3) or (k, 2, 3).
+        ``phi(t, q)`` returns the k residuals. Optional, each replaced by finite differences
+        over the group when missing:
+
+        - ``gradient(t, q)``: dPhi/dq, (k, a, 3) ((k, 3) is accepted for arity 1);
+          fallback: central differences of ``phi`` (6a calls, ~4e-11 relative);
+        - ``hessian(t, q)``: d2Phi/dq2, (k, 3a, 3a); fallback: forward differences of
+          ``gradient`` (3a calls), or second differences of ``phi`` without a gradient (~1e-5;
+          it only enters Newton's matrix);
+        - ``phi_t(t, q)``: dPhi/dt, (k,); fallback: central difference in t (2 calls);
+        - ``gamma(t, q, v)``: Phi'' - Phi_q q'', (k,); fallback: second difference of ``phi``
+          along (q + s v, t + s) (2 calls).
+
+        ``scale`` is s such that s Phi is a length (1 by default; 1/(2L) for L^2 - |d|^2): it
+        scales the equation's row and multiplier in the linear solves and the constraint-health
+        measures. The multipliers of the group are the columns ``group.constraint_indices`` of
+        ``Solution.multipliers``.
+
+        Raises:
+            InvalidInputError: bad ``particles``, a non-callable function, a scale that is not
+                finite and positive, an element touching only fixed particles.
+            UnknownHandleError: a particle index out of range.
+        """
     def add_rigid_body(
         self,
         mass: float,

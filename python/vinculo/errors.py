@@ -24,6 +24,8 @@ __all__ = [
     "SchedulerError",
     "StepSizeTooSmallError",
     "UnknownHandleError",
+    "UserFunctionError",
+    "UserFunctionOutputError",
     "VinculoError",
 ]
 
@@ -191,6 +193,35 @@ class StepSizeTooSmallError(ConvergenceError):
 
     h_min: float | None = None
     error_norm: float | None = None
+class UserFunctionError(VinculoError, RuntimeError):
+    """A Python function of a user force or constraint group raised an exception.
+
+    Raised by :func:`vinculo.simulate`: the run stops at the failing call and ``solution`` holds
+    every step completed before. The function's own exception, with its traceback, is chained as
+    ``__cause__``.
+
+    Attributes:
+        group: the group's name.
+        call: the failing function ("force", "jacobian", "phi", "gradient", "hessian", "phi_t"
+            or "gamma").
+        time: the time of the call (s).
+        solution: the partial :class:`vinculo.Solution` (None when the run stopped before its
+            first step).
+    """
+
+    group: str | None = None
+    call: str | None = None
+    time: float | None = None
+    solution: Any = None
+
+
+class UserFunctionOutputError(UserFunctionError, ValueError):
+    """A Python function of a user group returned an unusable result.
+
+    The message names the group, the function, the shape returned and the one expected (or the
+    first element with NaN or infinity) and says what to return. Same attributes as
+    :class:`UserFunctionError`.
+    """
 
 
 class InternalError(VinculoError):

@@ -161,6 +161,9 @@ def simulate(
             holds every step completed before.
         StepSizeTooSmallError: (a ConvergenceError) adaptive steps would have to be smaller than
             ``h_min`` to meet the tolerances; ``solution`` holds every state computed before.
+        UserFunctionError: a function of a user force or constraint group raised (its exception
+            is the ``__cause__``; ``solution`` holds the steps completed before).
+        UserFunctionOutputError: such a function returned a wrong shape or a non-finite value.
     """
     if not isinstance(scheme, str):
         raise errors.InvalidInputError(
@@ -227,9 +230,12 @@ def simulate(
     finally:
         if bar is not None:
             bar.close()
+    # A user function's own exception (with its traceback), chained as the cause; it is not
+    # part of the solution (which is saved to files).
+    cause = data["error"].pop("cause", None) if data.get("error") is not None else None
     solution = Solution.from_core(data, system)
     if solution.error is not None:
-        raise _convergence_error(solution.error, solution)
+        raise _convergence_error(solution.error, solution) from cause
     return solution
 
 

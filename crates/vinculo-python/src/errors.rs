@@ -80,6 +80,12 @@ pub fn details<'py>(py: Python<'py>, e: &Error) -> PyResult<Bound<'py, PyDict>> 
             d.set_item("error_norm", error)?;
         }
         Error::Interrupted { t } => d.set_item("time", t)?,
+        Error::UserFunction { group, call, t, .. }
+        | Error::UserFunctionOutput { group, call, t, .. } => {
+            d.set_item("group", group)?;
+            d.set_item("call", call)?;
+            d.set_item("time", t)?;
+        }
         Error::RedundantConstraints {
             constraint,
             index,

@@ -5,6 +5,7 @@ mod errors;
 mod laws;
 mod run;
 mod system;
+mod user_physics;
 
 use pyo3::prelude::*;
 
@@ -15,6 +16,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<system::PyParticleId>()?;
     m.add_class::<system::PyConstraintId>()?;
     m.add_class::<system::PyForceId>()?;
+    m.add_class::<user_physics::PyUserGroup>()?;
     m.add_function(wrap_pyfunction!(run::simulate, m)?)?;
     Ok(())
 }

@@ -158,6 +158,9 @@ pub fn simulate<'py>(
         ..Default::default()
     };
     let model = &system.inner;
+    // The exception of a user function of an earlier run is no longer of interest.
+    let pending = system.user_errors.clone();
+    pending.lock().unwrap_or_else(|p| p.into_inner()).take();
     let mut observer = Progress {
         callback: progress,
         last: Instant::now(),
@@ -171,7 +174,15 @@ pub fn simulate<'py>(
     if let Some(e) = observer.error.take() {
         return Err(e);
     }
-    let sol = result.map_err(crate::errors::internal)?.map_err(to_py)?;
+    let sol = result.map_err(crate::errors::internal)?.map_err(|e| {
+        let user = matches!(e, vinculo::Error::UserFunction { .. });
+        let err = to_py(e);
+        let cause = pending.lock().unwrap_or_else(|p| p.into_inner()).take();
+        if let (true, Some(cause)) = (user, cause) {
+            err.set_cause(py, Some(cause));
+        }
+        err
+    })?;
 
     let (s, n, m) = (sol.len(), sol.particles, sol.constraints);
     let out = PyDict::new(py);
@@ -232,6 +243,13 @@ pub fn simulate<'py>(
             let d = details(py, e)?;
             d.set_item("kind", e.kind())?;
             d.set_item("message", e.to_string())?;
+            // The user's own exception (with its traceback), to be raised as the cause.
+            if let vinculo::Error::UserFunction { .. } = e {
+                let cause = pending.lock().unwrap_or_else(|p| p.into_inner()).take();
+                if let Some(cause) = cause {
+                    d.set_item("cause", cause.into_value(py))?;
+                }
+            }
             out.set_item("error", d)?;
         }
     }

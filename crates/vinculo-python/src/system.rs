@@ -65,6 +65,8 @@ type Frame = Vec<[f64; 3]>;
 #[pyclass(name = "System", module = "vinculo._core")]
 pub struct PySystem {
     pub inner: System,
+    /// The first exception raised by a user function (for the run to chain).
+    pub user_errors: crate::user_physics::PendingError,
 }
 
 fn vec3(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<[f64; 3]> {
@@ -149,6 +151,7 @@ impl PySystem {
         };
         Ok(PySystem {
             inner: System::try_new(g).map_err(to_py)?,
+            user_errors: Default::default(),
         })
     }
 
@@ -401,6 +404,95 @@ impl PySystem {
         };
         let id = self.inner.add_morison(p, spec).map_err(to_py)?;
         Ok(PyForceId { index: id.0 })
+    }
+
+    /// Forces computed by one Python function for a whole group of elements at once.
+    ///
+    /// `particles`: (k,) integer array (one particle per element) or (k, 2) (pairs) of
+    /// particle indices. `force(t, q, v)` gets the elements' positions and velocities, (k, 3)
+    /// or (k, 2, 3), and returns the forces on those particles in the same shape; element i's
+    /// result may depend only on t and row i. It is called once per residual evaluation.
+    /// `jacobian(t, q, v)` returns (df_dq, df_dv), each (k, 3a, 3a) (a = 1 or 2; row 3p + l:
+    /// component l of the force on particle p, column 3r + m: coordinate m of particle r);
+    /// None: forward differences over the group (6a force calls per Jacobian). Returns a
+    /// `UserGroup` (calls and seconds of the last run). During a run, an exception stops it with
+    /// `UserFunctionError` (the exception chained), a wrong shape or NaN with
+    /// `UserFunctionOutputError`. Bad particles or a non-callable raise `InvalidInputError`,
+    /// an index out of range `UnknownHandleError`.
+    #[pyo3(signature = (particles, force, jacobian=None, name=None))]
+    fn add_force_group(
+        &mut self,
+        particles: &Bound<'_, PyAny>,
+        force: &Bound<'_, PyAny>,
+        jacobian: Option<&Bound<'_, PyAny>>,
+        name: Option<String>,
+    ) -> PyResult<crate::user_physics::PyUserGroup> {
+        use crate::user_physics as up;
+        let (elements, arity) = up::elements(particles)?;
+        let force = up::callable("force", Some(force))?
+            .ok_or_else(|| invalid("force", "None", "expected a function force(t, q, v)"))?;
+        let jacobian = up::callable("jacobian", jacobian)?;
+        let functions = up::force_functions(
+            elements.len(),
+            arity,
+            self.user_errors.clone(),
+            force,
+            jacobian,
+        );
+        let group = self
+            .inner
+            .add_user_force_group(elements, arity, Box::new(functions), name)
+            .map_err(to_py)?;
+        Ok(up::PyUserGroup::force(group))
+    }
+
+    /// Constraint equations Phi_i(q, t) = 0, one per element, computed by Python functions for
+    /// a whole group of elements at once.
+    ///
+    /// `particles` as for `add_force_group`. `phi(t, q)` returns the k residuals. Optional
+    /// (finite differences over the group when None): `gradient(t, q)` (k, a, 3),
+    /// `hessian(t, q)` (k, 3a, 3a), `phi_t(t, q)` (k,), `gamma(t, q, v)` (k,), gamma being
+    /// Phi'' - Phi_q q''. `scale`: s such that s Phi is a length (default 1). The group's
+    /// equations are `UserGroup.constraint_indices` (columns of Solution.multipliers). Errors as
+    /// for `add_force_group`; a scale that is not finite and positive, or an element touching
+    /// only fixed particles, raises `InvalidInputError`.
+    #[pyo3(signature = (particles, phi, gradient=None, hessian=None, phi_t=None, gamma=None, scale=None, name=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_constraint_group(
+        &mut self,
+        particles: &Bound<'_, PyAny>,
+        phi: &Bound<'_, PyAny>,
+        gradient: Option<&Bound<'_, PyAny>>,
+        hessian: Option<&Bound<'_, PyAny>>,
+        phi_t: Option<&Bound<'_, PyAny>>,
+        gamma: Option<&Bound<'_, PyAny>>,
+        scale: Option<f64>,
+        name: Option<String>,
+    ) -> PyResult<crate::user_physics::PyUserGroup> {
+        use crate::user_physics as up;
+        let (elements, arity) = up::elements(particles)?;
+        let phi = up::callable("phi", Some(phi))?
+            .ok_or_else(|| invalid("phi", "None", "expected a function phi(t, q)"))?;
+        let functions = [
+            Some(phi),
+            up::callable("gradient", gradient)?,
+            up::callable("hessian", hessian)?,
+            up::callable("phi_t", phi_t)?,
+            up::callable("gamma", gamma)?,
+        ];
+        let functions =
+            up::constraint_functions(elements.len(), arity, self.user_errors.clone(), functions);
+        let (group, first) = self
+            .inner
+            .add_user_constraint_group(
+                elements,
+                arity,
+                Box::new(functions),
+                scale.unwrap_or(1.0),
+                name,
+            )
+            .map_err(to_py)?;
+        Ok(up::PyUserGroup::constraint(group, first))
     }
 
     /// Declares a distance constraint a string: a run stops with NegativeTensionError when it

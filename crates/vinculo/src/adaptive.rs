@@ -208,6 +208,11 @@ pub(crate) fn march(
         );
         sol.factorisations = ws.matrix.factorisations;
         fresh_retry = false;
+        // A failed user function stops the run at once (NaN terms would only fail again).
+        if let Some(e) = system.user_failure() {
+            sol.status = Err(e);
+            return;
+        }
         let report = match attempt {
             Ok(report) => report,
             Err(_) if stale => {

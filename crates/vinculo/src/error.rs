@@ -151,6 +151,31 @@ pub enum Error {
         /// Weighted error norm of the last attempt (1 meets the tolerances).
         error: f64,
     },
+    /// A user function of a force or constraint group failed (raised an error).
+    #[error("user function {call}() of group '{group}' failed at t = {t:.6} s: {message}")]
+    UserFunction {
+        /// The group's name.
+        group: String,
+        /// The function ("force", "jacobian", "phi", "gradient", "hessian", "phi_t", "gamma").
+        call: String,
+        /// Time of the failing call.
+        t: f64,
+        /// What the function reported.
+        message: String,
+    },
+    /// A user function of a force or constraint group returned an unusable output.
+    #[error("user function {call}() of group '{group}' {problem} at t = {t:.6} s; return a finite float array of the documented shape (see System.add_force_group / add_constraint_group)")]
+    UserFunctionOutput {
+        /// The group's name.
+        group: String,
+        /// The function.
+        call: String,
+        /// Time of the call.
+        t: f64,
+        /// What is wrong with the output (the shape returned and the one expected, or the
+        /// first element with a non-finite value).
+        problem: String,
+    },
     /// The run was stopped by its observer (for instance a keyboard interrupt).
     #[error("run interrupted at t = {t:.6} s")]
     Interrupted {
@@ -173,6 +198,8 @@ impl Error {
             Error::RedundantConstraints { .. } => "RedundantConstraintsError",
             Error::NegativeTension { .. } => "NegativeTensionError",
             Error::StepSizeTooSmall { .. } => "StepSizeTooSmallError",
+            Error::UserFunction { .. } => "UserFunctionError",
+            Error::UserFunctionOutput { .. } => "UserFunctionOutputError",
             Error::ProjectionFailed { .. }
             | Error::NewtonFailed { .. }
             | Error::SingularMatrix { .. }

@@ -18,6 +18,11 @@
 //! analytic Jacobian, assembled into a sparsity pattern computed once ([`assembly`]) and
 //! factorised by faer ([`linear`]).
 //!
+//! Forces and constraints that the built-in kinds do not cover can be supplied as groups whose
+//! terms one user function computes for all their elements at once ([`user`],
+//! [`forces::ForceGroup`], [`constraints::ConstraintGroup`]); the Python bindings implement
+//! them with Python callables.
+//!
 //! The entry point is [`simulate`], which returns a [`Solution`].
 //!
 //! ```
@@ -48,6 +53,7 @@ pub mod model;
 pub mod simulate;
 pub mod solution;
 pub mod step_control;
+pub mod user;
 
 pub use error::{Error, Result};
 pub use linear::SparseSolver;

@@ -285,6 +285,8 @@ pub fn simulate_with_observer(
     observer: &mut dyn Observer,
 ) -> Result<Solution> {
     check_options(system, options)?;
+    // User groups start the run with empty caches and counters.
+    system.reset_user_groups();
     let length = system.length_scale();
     let t0 = options.t_start;
     let mut q = system.initial_positions();
@@ -299,6 +301,9 @@ pub fn simulate_with_observer(
     let speed = if speed > 0.0 { speed } else { length };
     let (worst, k) = scaled_violation(system, &q, t0);
     let velocity_worst = scaled_velocity_violation(system, &q, &v, t0);
+    if let Some(e) = system.user_failure() {
+        return Err(e);
+    }
     let checks = [
         ("positions", "Phi", (worst, k), length),
         ("velocities", "Phi_q v + Phi_t", velocity_worst, speed),
@@ -341,6 +346,11 @@ pub fn simulate_with_observer(
         Error::SingularMatrix { .. } => find_redundant(system, &q, t0, None).unwrap_or(e),
         e => e,
     });
+    // A failed user function is the cause of whatever else went wrong at the start.
+    let start = match (start, system.user_failure()) {
+        (_, Some(e)) => Err(e),
+        (start, None) => start,
+    };
     let (mut acc, mut lambda) = match start {
         Ok(x) => x,
         Err(e) => {
@@ -466,6 +476,11 @@ pub fn simulate_with_observer(
         };
         sol.factorisations = ws.matrix.factorisations;
         fresh_retry = false;
+        // A failed user function stops the run at once (NaN terms would only fail again).
+        if let Some(e) = system.user_failure() {
+            sol.status = Err(e);
+            break;
+        }
         match attempt {
             Ok(report) => {
                 match scheme {
@@ -542,6 +557,9 @@ pub fn simulate_with_observer(
                 break;
             }
         }
+    }
+    if let (Ok(()), Some(e)) = (&sol.status, system.user_failure()) {
+        sol.status = Err(e);
     }
     Ok(sol)
 }

@@ -13,18 +13,23 @@
 //! `q` and `v` are the positions and velocities of every particle of the system (fixed ones
 //! included). Each kind's doc comment derives its terms; tests check them against finite
 //! differences.
+//!
+//! [`Constraint::User`] equations belong to a group whose terms user functions compute for all
+//! its elements at once ([`user`]).
 
 mod distance;
 mod fixed_coordinate;
 mod plane;
 mod point_distance;
 mod redundancy;
+pub mod user;
 
 pub use distance::Distance;
 pub use fixed_coordinate::FixedCoordinate;
 pub use plane::Plane;
 pub use point_distance::PointDistance;
 pub use redundancy::{find_redundant, MAX_ENTRIES, RANK_TOLERANCE};
+pub use user::{ConstraintCall, ConstraintGroup, UserConstraint, UserConstraints};
 
 use crate::math::{Mat3, Vec3};
 
@@ -44,6 +49,8 @@ pub enum Constraint {
     Plane(Box<Plane>),
     /// One coordinate of a particle follows a prescribed law (constant by default).
     FixedCoordinate(FixedCoordinate),
+    /// One equation of a group computed by user functions.
+    User(UserConstraint),
 }
 
 macro_rules! dispatch {
@@ -53,6 +60,7 @@ macro_rules! dispatch {
             Constraint::PointDistance($c) => $e,
             Constraint::Plane($c) => $e,
             Constraint::FixedCoordinate($c) => $e,
+            Constraint::User($c) => $e,
         }
     };
 }
@@ -136,6 +144,7 @@ impl Constraint {
                 (a.max(e), b.min(f))
             }
             Constraint::FixedCoordinate(c) => c.value.domain(),
+            Constraint::User(_) => (f64::NEG_INFINITY, f64::INFINITY),
         }
     }
 
@@ -155,6 +164,10 @@ impl Constraint {
                     ["x", "y", "z"][c.axis]
                 )
             }
+            Constraint::User(c) => format!(
+                "user constraint '{}' element {} #{index} (particles {p:?})",
+                c.group.name, c.element
+            ),
         }
     }
 }

@@ -11,16 +11,21 @@
 //!
 //! Uniform gravity acts on every particle and lives in the [`System`](crate::model::System) itself.
 //! The residual of the dynamics uses F = -f (formulation.md), so the assembler subtracts these.
+//!
+//! [`Force::User`] elements belong to a group whose forces a user function computes for all its
+//! elements at once ([`user`]).
 
 mod applied;
 mod drag;
 mod morison;
 mod spring_damper;
+pub mod user;
 
 pub use applied::AppliedForce;
 pub use drag::{LinearDrag, QuadraticDrag};
 pub use morison::{Morison, MorisonSpec};
 pub use spring_damper::SpringDamper;
+pub use user::{ForceGroup, UserForce, UserForces};
 
 use crate::math::{Mat3, Vec3};
 
@@ -42,6 +47,8 @@ pub enum Force {
     QuadraticDrag(QuadraticDrag),
     /// Buoyancy, Froude-Krylov, added mass and drag of a fluid in rigid motion.
     Morison(Box<Morison>),
+    /// One element of a group computed by a user function.
+    User(UserForce),
 }
 
 macro_rules! dispatch {
@@ -52,6 +59,7 @@ macro_rules! dispatch {
             Force::LinearDrag($f) => $e,
             Force::QuadraticDrag($f) => $e,
             Force::Morison($f) => $e,
+            Force::User($f) => $e,
         }
     };
 }
@@ -124,6 +132,10 @@ impl Force {
             Force::LinearDrag(_) => format!("linear drag #{index} (particle {})", p[0]),
             Force::QuadraticDrag(_) => format!("quadratic drag #{index} (particle {})", p[0]),
             Force::Morison(_) => format!("fluid forces #{index} (particle {})", p[0]),
+            Force::User(f) => format!(
+                "user force '{}' element {} #{index} (particles {p:?})",
+                f.group.name, f.element
+            ),
         }
     }
 }

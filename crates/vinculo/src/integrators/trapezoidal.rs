@@ -148,10 +148,11 @@ impl StepWorkspace {
 
     /// Assembles residuals and Jacobians on rayon's thread pool when the model has at least
     /// `threshold` free particles, serially otherwise (`usize::MAX`: always serially). The
-    /// colouring this needs is computed here, once.
+    /// colouring this needs is computed here, once. Models with user force or constraint groups
+    /// always assemble serially (their elements read a shared cache, see [`crate::user`]).
     pub fn assemble_in_parallel_from(&mut self, system: &System, threshold: usize) {
-        self.parallel =
-            (self.layout.free >= threshold).then(|| ParallelAssembly::new(system, &self.layout));
+        self.parallel = (self.layout.free >= threshold && !system.has_user_groups())
+            .then(|| ParallelAssembly::new(system, &self.layout));
     }
 }
 

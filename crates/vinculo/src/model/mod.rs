@@ -4,6 +4,7 @@
 mod particle;
 mod rigid_body;
 mod system;
+pub mod user_groups;
 
 pub use particle::{ConstraintId, ForceId, Particle, ParticleId};
 pub use rigid_body::{RigidBody, RigidBodySpec};

@@ -18,9 +18,13 @@ pub struct System {
     id: u64,
     gravity: Vec3,
     particles: Vec<Particle>,
-    constraints: Vec<Constraint>,
-    forces: Vec<Force>,
+    pub(super) constraints: Vec<Constraint>,
+    pub(super) forces: Vec<Force>,
     tension_only: Vec<usize>,
+    /// Groups of user forces and constraints (their elements are also in `forces` and
+    /// `constraints`), see [`super::user_groups`].
+    pub(super) user_forces: Vec<std::sync::Arc<crate::forces::UserForces>>,
+    pub(super) user_constraints: Vec<std::sync::Arc<crate::constraints::UserConstraints>>,
 }
 
 impl System {
@@ -42,6 +46,8 @@ impl System {
             constraints: Vec::new(),
             forces: Vec::new(),
             tension_only: Vec::new(),
+            user_forces: Vec::new(),
+            user_constraints: Vec::new(),
         })
     }
 
@@ -93,7 +99,7 @@ impl System {
         })
     }
 
-    fn push_constraint(&mut self, c: Constraint) -> Result<ConstraintId> {
+    pub(super) fn push_constraint(&mut self, c: Constraint) -> Result<ConstraintId> {
         let index = self.constraints.len();
         if c.particles().iter().all(|&p| self.particles[p].fixed) {
             return Err(Error::ConstraintOnFixedParticles {

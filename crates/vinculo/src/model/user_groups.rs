@@ -1,0 +1,134 @@
+//! Adding groups of user-defined forces and constraints to a system, and their run-time state.
+//!
+//! Each element of a group becomes one force element ([`Force::User`]) or one constraint
+//! equation ([`Constraint::User`]), numbered after the elements already in the system, so the
+//! assembly, the schemes and the analyses see them as they see the built-in kinds.
+//!
+//! A group is shared (`Arc`): a clone of the system shares its groups' functions, caches and
+//! call counts, so runs of clones must not overlap in time if their counts are to be read.
+
+use super::System;
+use crate::constraints::{Constraint, ConstraintGroup, UserConstraint, UserConstraints};
+use crate::error::{positive, Error, Result};
+use crate::forces::{Force, ForceGroup, UserForce, UserForces};
+use std::sync::Arc;
+
+impl System {
+    /// Checks a group's elements: arity 1 or 2, at least one element, particle indices in
+    /// range, two different particles per element of arity 2.
+    fn check_elements(&self, what: &str, elements: &[[usize; 2]], arity: usize) -> Result<()> {
+        if !(arity == 1 || arity == 2) {
+            return Err(Error::InvalidParameter {
+                name: format!("arity of {what}"),
+                value: arity as f64,
+                expected: "must be 1 (one particle per element) or 2 (two particles)".into(),
+            });
+        }
+        if elements.is_empty() {
+            return Err(Error::InvalidParameter {
+                name: format!("number of elements of {what}"),
+                value: 0.0,
+                expected: "must be >= 1: give at least one particle (or pair)".into(),
+            });
+        }
+        let count = self.particles().len();
+        for e in elements {
+            for &p in &e[..arity] {
+                if p >= count {
+                    return Err(Error::UnknownParticle { index: p, count });
+                }
+            }
+            if arity == 2 && e[0] == e[1] {
+                return Err(Error::SameParticle {
+                    what: what.into(),
+                    particle: e[0],
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Adds a group of `elements.len()` force elements of `arity` particles each (the second
+    /// index is ignored for arity 1), computed by `functions` for the whole group at once.
+    /// `name` names it in messages (default "force group N").
+    pub fn add_user_force_group(
+        &mut self,
+        elements: Vec<[usize; 2]>,
+        arity: usize,
+        functions: Box<dyn ForceGroup>,
+        name: Option<String>,
+    ) -> Result<Arc<UserForces>> {
+        let name = name.unwrap_or_else(|| format!("force group {}", self.user_forces.len()));
+        self.check_elements(&format!("user force group '{name}'"), &elements, arity)?;
+        let group = Arc::new(UserForces::new(name, arity, elements, functions));
+        for e in 0..group.elements.len() {
+            self.forces
+                .push(Force::User(UserForce::new(group.clone(), e)));
+        }
+        self.user_forces.push(group.clone());
+        Ok(group)
+    }
+
+    /// Adds a group of constraint equations, one per element, computed by `functions` for the
+    /// whole group at once; `scale` is s such that s Phi is a length. Returns the group and the
+    /// index of its first equation (the others follow in element order).
+    pub fn add_user_constraint_group(
+        &mut self,
+        elements: Vec<[usize; 2]>,
+        arity: usize,
+        functions: Box<dyn ConstraintGroup>,
+        scale: f64,
+        name: Option<String>,
+    ) -> Result<(Arc<UserConstraints>, usize)> {
+        let name =
+            name.unwrap_or_else(|| format!("constraint group {}", self.user_constraints.len()));
+        let what = format!("user constraint group '{name}'");
+        self.check_elements(&what, &elements, arity)?;
+        let scale = positive(format!("scale of {what}"), scale)?;
+        for (e, parts) in elements.iter().enumerate() {
+            if parts[..arity].iter().all(|&p| self.particles()[p].fixed) {
+                return Err(Error::ConstraintOnFixedParticles {
+                    what: format!("element {e} of {what}"),
+                });
+            }
+        }
+        let first = self.constraints.len();
+        let group = Arc::new(UserConstraints::new(
+            name, arity, elements, scale, functions,
+        ));
+        for e in 0..group.elements.len() {
+            self.push_constraint(Constraint::User(UserConstraint::new(group.clone(), e)))?;
+        }
+        self.user_constraints.push(group.clone());
+        Ok((group, first))
+    }
+
+    /// True when the system has user force or constraint groups.
+    pub fn has_user_groups(&self) -> bool {
+        !(self.user_forces.is_empty() && self.user_constraints.is_empty())
+    }
+
+    /// The user force groups.
+    pub fn user_force_groups(&self) -> &[Arc<UserForces>] {
+        &self.user_forces
+    }
+
+    /// The user constraint groups.
+    pub fn user_constraint_groups(&self) -> &[Arc<UserConstraints>] {
+        &self.user_constraints
+    }
+
+    /// Clears the user groups' caches, call counts and failures (done at the start of a run).
+    pub fn reset_user_groups(&self) {
+        self.user_forces.iter().for_each(|g| g.reset());
+        self.user_constraints.iter().for_each(|g| g.reset());
+    }
+
+    /// The first failure of a user function since the last reset, as a run error.
+    pub fn user_failure(&self) -> Option<Error> {
+        self.user_forces
+            .iter()
+            .find_map(|g| g.failure())
+            .or_else(|| self.user_constraints.iter().find_map(|g| g.failure()))
+    }
+}
