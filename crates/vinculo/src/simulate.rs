@@ -414,6 +414,9 @@ pub fn simulate_with_observer(
             start,
             observer,
         );
+        if let (Ok(()), Some(e)) = (&sol.status, system.user_failure()) {
+            sol.status = Err(e);
+        }
         return Ok(sol);
     }
 
