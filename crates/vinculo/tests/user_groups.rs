@@ -200,7 +200,15 @@ fn user_spring_group_reproduces_the_built_in_spring_damper() {
             let steps = sol.stats.len() - 1;
             let counts = s.user_force_groups()[0].counts();
             let fd = if jacobian { 0 } else { 12 * iterations };
-            assert_eq!(counts[0].calls, 1 + iterations + steps + fd);
+            // A Newton iterate whose increment is below the positions' round-off is the previous
+            // evaluation point bit for bit and is served from the group's cache: at most one
+            // such repeat per step (its last iteration).
+            let evaluations = 1 + iterations + steps + fd;
+            let calls = counts[0].calls;
+            assert!(
+                calls <= evaluations && calls + steps >= evaluations,
+                "{scheme:?} jacobian {jacobian}: {calls} force calls for {evaluations} evaluations"
+            );
             assert_eq!(counts[1].calls, if jacobian { iterations } else { 0 });
         }
     }
