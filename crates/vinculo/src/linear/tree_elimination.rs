@@ -54,6 +54,8 @@ pub struct TreeElimination {
     z: Vec<f64>,
     /// The common size of every block, or 0 when the sizes differ.
     uniform: usize,
+    /// Per block: its diagonal block was gathered in the current factorisation.
+    gathered: Vec<bool>,
     factored: bool,
 }
 
@@ -272,6 +274,7 @@ impl TreeElimination {
         };
         Some(TreeElimination {
             uniform,
+            gathered: vec![false; blocks],
             diag: vec![0.0; diag_at[blocks]],
             low: vec![0.0; 3 * n],
             w: vec![0.0; 3 * n],
@@ -485,24 +488,37 @@ fn backward_fixed<const N: usize>(w: &[f64], xp: [f64; 3], zb: &mut [f64]) {
 impl LinearSolver for TreeElimination {
     fn factor(&mut self, values: &[f64]) -> Result<(), Singular> {
         self.factored = false;
-        gather(&mut self.diag, &self.diag_slots, values);
-        gather(&mut self.low, &self.low_slots, values);
-        gather(&mut self.w, &self.up_slots, values);
+        // The matrix's entries are gathered block by block as the elimination reaches them (a
+        // parent's diagonal block when its first child updates it), so that each block's numbers
+        // are used while they are in cache: on a 10^6-particle chain the three separate passes
+        // over 40 values per block cost as much as the elimination itself.
+        self.gathered.fill(false);
         for b in 0..self.blocks() {
             let (s, nb) = (self.start[b], self.start[b + 1] - self.start[b]);
             let (da, db) = (self.diag_at[b], self.diag_at[b + 1]);
+            if !self.gathered[b] {
+                gather(&mut self.diag[da..db], &self.diag_slots[da..db], values);
+            }
+            let (ls, le) = (3 * s, 3 * s + 3 * nb);
+            gather(&mut self.low[ls..le], &self.low_slots[ls..le], values);
+            gather(&mut self.w[ls..le], &self.up_slots[ls..le], values);
+            let pb = self.parent[b];
+            if pb != ROOT && !self.gathered[pb as usize] {
+                let (pa, pe) = (self.diag_at[pb as usize], self.diag_at[pb as usize + 1]);
+                gather(&mut self.diag[pa..pe], &self.diag_slots[pa..pe], values);
+                self.gathered[pb as usize] = true;
+            }
             let (own, rest) = self.diag.split_at_mut(db);
             let d = &mut own[da..];
             let perm = &mut self.perm[s..s + nb];
-            let pb = self.parent[b];
             let coupling = if pb == ROOT {
                 None
             } else {
                 let pb = pb as usize;
                 let np = self.start[pb + 1] - self.start[pb];
                 Some((
-                    &mut self.w[3 * s..3 * s + 3 * nb],
-                    &self.low[3 * s..3 * s + 3 * nb],
+                    &mut self.w[ls..le],
+                    &self.low[ls..le],
                     &mut rest[self.diag_at[pb] - db..],
                     np,
                 ))
