@@ -24,7 +24,7 @@
 use crate::assembly::NONE;
 use crate::dense_output::StepEnds;
 use crate::error::Error;
-use crate::initial::{factor_saddle, scaled_velocity_violation, scaled_violation, singular_error};
+use crate::initial::{factor_saddle, scaled_velocity_violation, scaled_violation};
 use crate::integrators::error_estimate::sample_offset;
 use crate::integrators::{
     AccelerationHistory, AlphaState, ErrorConstants, GeneralizedAlpha, GeneralizedTrapezoidal,
@@ -32,7 +32,7 @@ use crate::integrators::{
 };
 use crate::math::Vec3;
 use crate::model::System;
-use crate::simulate::{negative_tension, Observer, SimulationOptions};
+use crate::simulate::{negative_tension, step_failure, Observer, SimulationOptions};
 use crate::solution::{Solution, StepStats};
 use crate::step_control::{AdaptiveOptions, ErrorWeights, PiController};
 
@@ -227,20 +227,7 @@ pub(crate) fn march(
                     h = proposal.max(control.h_min);
                     continue;
                 }
-                sol.status = Err(match failure {
-                    NewtonFailure::NotConverged {
-                        iterations,
-                        residual,
-                        worst,
-                    } => Error::NewtonFailed {
-                        t,
-                        dt: h_try,
-                        iterations,
-                        residual,
-                        equation: ws.layout.equation_name(system, worst),
-                    },
-                    NewtonFailure::Singular(s) => singular_error(system, &ws.layout, t, s),
-                });
+                sol.status = Err(step_failure(system, &ws.layout, failure, t, h_try));
                 return;
             }
         };

@@ -1,6 +1,7 @@
 //! The entry point: validate, start consistently, march in time with step retries, keep
 //! everything computed even when a step fails.
 
+use crate::assembly::Layout;
 use crate::constraints::find_redundant;
 use crate::error::{Error, Result};
 use crate::initial::{
@@ -267,6 +268,31 @@ pub(crate) fn negative_tension(
             tension,
         })
     })
+}
+
+/// The error of a step from `t` of size `h` that failed at the smallest step allowed, naming the
+/// equation that dominated the residual or where the matrix was singular.
+pub(crate) fn step_failure(
+    system: &System,
+    layout: &Layout,
+    failure: NewtonFailure,
+    t: f64,
+    h: f64,
+) -> Error {
+    match failure {
+        NewtonFailure::NotConverged {
+            iterations,
+            residual,
+            worst,
+        } => Error::NewtonFailed {
+            t,
+            dt: h,
+            iterations,
+            residual,
+            equation: layout.equation_name(system, worst),
+        },
+        NewtonFailure::Singular(s) => singular_error(system, layout, t, s),
+    }
 }
 
 /// Integrates `system` from `options.t_start` to `options.t_end`.
@@ -543,20 +569,7 @@ pub fn simulate_with_observer(
                     level -= 1;
                     continue;
                 }
-                sol.status = Err(match failure {
-                    NewtonFailure::NotConverged {
-                        iterations,
-                        residual,
-                        worst,
-                    } => Error::NewtonFailed {
-                        t,
-                        dt: h_try,
-                        iterations,
-                        residual,
-                        equation: ws.layout.equation_name(system, worst),
-                    },
-                    NewtonFailure::Singular(s) => singular_error(system, &ws.layout, t, s),
-                });
+                sol.status = Err(step_failure(system, &ws.layout, failure, t, h_try));
                 break;
             }
         }

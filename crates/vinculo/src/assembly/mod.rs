@@ -53,16 +53,7 @@ impl Layout {
     /// Numbers the unknowns and computes the pattern and slots of `system`.
     /// Systems with at most `dense_limit` unknowns use dense storage.
     pub fn new(system: &System, dense_limit: usize) -> Layout {
-        let mut dof = Vec::with_capacity(system.particles().len());
-        let mut free = 0;
-        for p in system.particles() {
-            if p.fixed {
-                dof.push(NONE);
-            } else {
-                dof.push(3 * free);
-                free += 1;
-            }
-        }
+        let (dof, free) = number_particles(system);
         let m = system.constraints().len();
         let n = 3 * free + m;
         let lambda = |k: usize| 3 * free + k;
@@ -287,6 +278,22 @@ impl Layout {
             *l -= dx[m3 + c] * scales[c] / sigma;
         }
     }
+}
+
+/// The first unknown of each particle, 3 per free particle in order (NONE for fixed ones), and
+/// the number of free particles.
+pub fn number_particles(system: &System) -> (Vec<usize>, usize) {
+    let mut dof = Vec::with_capacity(system.particles().len());
+    let mut free = 0;
+    for p in system.particles() {
+        if p.fixed {
+            dof.push(NONE);
+        } else {
+            dof.push(3 * free);
+            free += 1;
+        }
+    }
+    (dof, free)
 }
 
 /// Adds `value` at `slot` unless the slot is absent.

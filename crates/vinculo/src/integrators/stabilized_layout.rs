@@ -29,7 +29,7 @@
 //! kinematics, which would bring G G^T and f_v G^T fill between neighbouring elements) keeps
 //! every block local.
 
-use crate::assembly::{Block, Pattern, Slot, NONE, NO_SLOT};
+use crate::assembly::{number_particles, Block, Pattern, Slot, NONE, NO_SLOT};
 use crate::model::System;
 
 /// Slots of a constraint's 3-vector row or column, per touched particle.
@@ -79,16 +79,7 @@ impl StabilizedLayout {
     /// Numbers the unknowns and computes the pattern and slots of `system`. Systems with at most
     /// `dense_limit` unknowns use dense storage.
     pub fn new(system: &System, dense_limit: usize) -> StabilizedLayout {
-        let mut dof = Vec::with_capacity(system.particles().len());
-        let mut free = 0;
-        for p in system.particles() {
-            if p.fixed {
-                dof.push(NONE);
-            } else {
-                dof.push(3 * free);
-                free += 1;
-            }
-        }
+        let (dof, free) = number_particles(system);
         let m = system.constraints().len();
         let n3 = 3 * free;
         let n = 2 * n3 + 2 * m;
