@@ -346,9 +346,9 @@ fn lu_in_place(a: &mut [f64], n: usize, perm: &mut [u32]) -> Result<(), usize> {
     Ok(())
 }
 
-/// Solves with the factors of `lu_in_place` for the n x m row-major right-hand side `x`.
-/// Branch-free (the row interchanges are applied as swaps, identity ones included), so that the
-/// copies for a fixed n unroll completely.
+/// Solves with the factors of `lu_in_place` for the n x m row-major right-hand side `x` (the
+/// factorisation's W = D^-1 A with m = 3, and the solve of blocks larger than 5). Zero entries
+/// of L are skipped: a KKT block's mass part gives many.
 #[inline(always)]
 fn lu_solve(a: &[f64], n: usize, perm: &[u32], x: &mut [f64], m: usize) {
     let (a, perm, x) = (&a[..n * n], &perm[..n], &mut x[..n * m]);
@@ -361,8 +361,10 @@ fn lu_solve(a: &[f64], n: usize, perm: &[u32], x: &mut [f64], m: usize) {
     for i in 1..n {
         for j in 0..i {
             let l = a[i * n + j];
-            for c in 0..m {
-                x[i * m + c] -= l * x[j * m + c];
+            if l != 0.0 {
+                for c in 0..m {
+                    x[i * m + c] -= l * x[j * m + c];
+                }
             }
         }
     }
