@@ -1,6 +1,8 @@
 //! Compressed sparse column pattern of the iteration matrix, or dense column-major storage for
 //! small systems; both give each (row, column) entry a fixed slot in a value array.
 
+use super::{Block, Slot, NONE, NO_SLOT};
+
 /// How the matrix's values are stored.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Storage {
@@ -27,7 +29,21 @@ pub struct Pattern {
 
 impl Pattern {
     /// Builds the pattern from (row, column) entries (duplicates allowed).
-    pub fn new(n: usize, mut entries: Vec<(usize, usize)>, dense: bool) -> Pattern {
+    ///
+    /// # Panics
+    /// If the matrix has more entries than 32-bit slots can address (about four billion, far
+    /// beyond any model that fits in memory).
+    pub fn new(n: usize, entries: Vec<(usize, usize)>, dense: bool) -> Pattern {
+        let pattern = Pattern::build(n, entries, dense);
+        assert!(
+            pattern.nnz() < NO_SLOT as usize,
+            "the iteration matrix has {} entries, more than 32-bit slots can address",
+            pattern.nnz()
+        );
+        pattern
+    }
+
+    fn build(n: usize, mut entries: Vec<(usize, usize)>, dense: bool) -> Pattern {
         if dense {
             return Pattern {
                 n,
@@ -77,6 +93,25 @@ impl Pattern {
     /// True once [`Pattern::release_structure`] was called.
     pub fn is_released(&self) -> bool {
         self.col_ptr.is_empty()
+    }
+    /// [`Pattern::slot`] as the layouts' 32-bit [`Slot`] ([`Pattern::new`] checks that every
+    /// slot fits).
+    pub fn slot32(&self, row: usize, col: usize) -> Slot {
+        self.slot(row, col) as Slot
+    }
+
+    /// Slots of the 3x3 block whose first row is `a` and first column `b`, row-major (all absent
+    /// when either is NONE, a fixed particle).
+    pub fn block_slots(&self, a: usize, b: usize) -> Block {
+        let mut s = [NO_SLOT; 9];
+        if a != NONE && b != NONE {
+            for r in 0..3 {
+                for c in 0..3 {
+                    s[3 * r + c] = self.slot32(a + r, b + c);
+                }
+            }
+        }
+        s
     }
 
     /// Slot of entry (row, col).

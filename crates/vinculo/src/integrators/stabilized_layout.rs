@@ -132,24 +132,8 @@ impl StabilizedLayout {
             }
         }
         let pattern = Pattern::new(n, entries, n <= dense_limit);
-        assert!(
-            pattern.nnz() < NO_SLOT as usize,
-            "the iteration matrix has {} entries, more than 32-bit slots can address",
-            pattern.nnz()
-        );
-        let slot = |row: usize, col: usize| pattern.slot(row, col) as Slot;
-
-        let block_slots = |a: usize, b: usize| -> Block {
-            let mut s = [NO_SLOT; 9];
-            if a != NONE && b != NONE {
-                for r in 0..3 {
-                    for c in 0..3 {
-                        s[3 * r + c] = slot(a + r, b + c);
-                    }
-                }
-            }
-            s
-        };
+        let slot = |row: usize, col: usize| pattern.slot32(row, col);
+        let block_slots = |a: usize, b: usize| pattern.block_slots(a, b);
         // Blocks between an element's particles: rows shifted by `row`, columns by `col`.
         let pair_blocks = |parts: &[usize], row: usize, col: usize| -> PairBlocks {
             let mut out = [[[NO_SLOT; 9]; 2]; 2];
