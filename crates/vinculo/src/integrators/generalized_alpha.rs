@@ -221,11 +221,40 @@ impl GeneralizedAlpha {
         h: f64,
         options: &NewtonOptions,
     ) -> Result<NewtonReport, NewtonFailure> {
+        let (mut problem, work) = self.problem(system, ws, state, t_n, q_n, v_n, h);
+        let known = problem.known;
+        let report = newton::solve(&mut problem, work, self.matrix_key(h), options)?;
+        let b = &mut ws.state;
+        for i in 0..b.q.len() {
+            let (a, v) = known.kinematics(&b.q[i], &state.predicted_q[i], &state.predicted_v[i]);
+            b.v[i] = v;
+            for x in 0..3 {
+                state.acceleration[i][x] = known.c_a * a[x] + known.c_m * state.algorithmic[i][x]
+                    - known.c_f * state.acceleration[i][x];
+            }
+            state.algorithmic[i] = a;
+        }
+        Ok(report)
+    }
+
+    /// The nonlinear problem of a step of size `h` from (t_n, q_n, v_n, state), with the
+    /// predictors computed into `state`, and the linear solver's share of the workspace.
+    #[allow(clippy::too_many_arguments)]
+    fn problem<'a>(
+        &self,
+        system: &'a System,
+        ws: &'a mut StepWorkspace,
+        state: &'a mut AlphaState,
+        t_n: f64,
+        q_n: &[Vec3],
+        v_n: &[Vec3],
+        h: f64,
+    ) -> (AlphaStepProblem<'a>, LinearWork<'a>) {
         let k = self.coefficients();
         let c = (1.0 - k.alpha_m) / ((1.0 - k.alpha_f) * k.beta * h * h);
-        let known = Predictors::new(&k, h);
         state.predict(&k, h, q_n, v_n);
-        let mut problem = AlphaStepProblem {
+        let state = &*state;
+        let problem = AlphaStepProblem {
             system,
             layout: &ws.layout,
             buffers: &mut ws.state,
@@ -239,7 +268,7 @@ impl GeneralizedAlpha {
             t_n,
             h,
             k,
-            known,
+            known: Predictors::new(&k, h),
             sigma: 1.0 / (c * ws.mass_ref),
         };
         let work = LinearWork {
@@ -248,18 +277,7 @@ impl GeneralizedAlpha {
             r: &mut ws.r,
             matrix: &mut ws.matrix,
         };
-        let report = newton::solve(&mut problem, work, self.matrix_key(h), options)?;
-        let b = &mut ws.state;
-        for i in 0..b.q.len() {
-            let (a, v) = known.kinematics(&b.q[i], &state.predicted_q[i], &state.predicted_v[i]);
-            b.v[i] = v;
-            for x in 0..3 {
-                state.acceleration[i][x] = known.c_a * a[x] + known.c_m * state.algorithmic[i][x]
-                    - known.c_f * state.acceleration[i][x];
-            }
-            state.algorithmic[i] = a;
-        }
-        Ok(report)
+        (problem, work)
     }
 }
 
@@ -470,32 +488,14 @@ mod tests {
                 let qdd_n: Vec<Vec3> = (0..q_n.len())
                     .map(|i| [-0.1, 0.4 * i as f64, 0.7])
                     .collect();
-                let scheme = GeneralizedAlpha { rho_inf };
-                let k = scheme.coefficients();
-                let h = 0.01;
-                let c = (1.0 - k.alpha_m) / ((1.0 - k.alpha_f) * k.beta * h * h);
                 let mut state = AlphaState::new(&a_n);
                 state.acceleration = qdd_n;
-                state.predict(&k, h, &q_n, &v_n);
                 perturbed_iterate(&mut ws, &q_n);
-                let mut problem = AlphaStepProblem {
-                    system: &s,
-                    layout: &ws.layout,
-                    buffers: &mut ws.state,
-                    scales: &ws.scales,
-                    inertia: &ws.inertia,
-                    parallel: None,
-                    p: &state.predicted_q,
-                    w: &state.predicted_v,
-                    a_n: &state.algorithmic,
-                    qdd_n: &state.acceleration,
-                    t_n: 0.3,
-                    h,
-                    k,
-                    known: Predictors::new(&k, h),
-                    sigma: 1.0 / (c * ws.mass_ref),
-                };
-                assert_jacobian_matches(&mut problem, &ws.layout);
+                let layout = ws.layout.clone();
+                let scheme = GeneralizedAlpha { rho_inf };
+                let (mut problem, _) =
+                    scheme.problem(&s, &mut ws, &mut state, 0.3, &q_n, &v_n, 0.01);
+                assert_jacobian_matches(&mut problem, &layout);
             }
         }
     }
@@ -512,37 +512,21 @@ mod tests {
             let qdd_n: Vec<Vec3> = (0..q_n.len())
                 .map(|i| [-0.1, 0.4, 0.7 / (1.0 + i as f64)])
                 .collect();
-            let k = GeneralizedAlpha { rho_inf: 0.6 }.coefficients();
-            let h = 0.01;
-            let c = (1.0 - k.alpha_m) / ((1.0 - k.alpha_f) * k.beta * h * h);
-            let mut state = AlphaState::new(&a_n);
-            state.acceleration = qdd_n;
-            state.predict(&k, h, &q_n, &v_n);
+            let mut start = AlphaState::new(&a_n);
+            start.acceleration = qdd_n;
             let assemble = |parallel: bool| {
                 let mut ws = StepWorkspace::new(&s, 48);
                 if parallel {
                     ws.assemble_in_parallel_from(&s, 0);
                 }
                 wiggled_iterate(&mut ws, &q_n);
-                let mut problem = AlphaStepProblem {
-                    system: &s,
-                    layout: &ws.layout,
-                    buffers: &mut ws.state,
-                    scales: &ws.scales,
-                    inertia: &ws.inertia,
-                    parallel: ws.parallel.as_mut(),
-                    p: &state.predicted_q,
-                    w: &state.predicted_v,
-                    a_n: &state.algorithmic,
-                    qdd_n: &state.acceleration,
-                    t_n: 0.3,
-                    h,
-                    k,
-                    known: Predictors::new(&k, h),
-                    sigma: 1.0 / (c * ws.mass_ref),
-                };
-                let mut r = vec![0.0; ws.layout.unknowns()];
-                let mut values = vec![0.0; ws.layout.pattern.nnz()];
+                let (unknowns, nnz) = (ws.layout.unknowns(), ws.layout.pattern.nnz());
+                let mut state = start.clone();
+                let scheme = GeneralizedAlpha { rho_inf: 0.6 };
+                let (mut problem, _) =
+                    scheme.problem(&s, &mut ws, &mut state, 0.3, &q_n, &v_n, 0.01);
+                let mut r = vec![0.0; unknowns];
+                let mut values = vec![0.0; nnz];
                 problem.residual(&mut r);
                 problem.jacobian(&mut values);
                 (r, values)
