@@ -101,6 +101,10 @@ def _add_buoy_parser(commands: Any) -> None:
                       "default: fit within the noise estimated from the record)")
     buoy.add_argument("--models", default="particle,two-dof,one-dof",
                       help="comma-separated models to run (default: all three)")
+    buoy.add_argument("--history-frequencies", metavar="F1,F2,...", default=None,
+                      help="frequencies (Hz) whose time histories to keep and plot, each run "
+                      "(added to the sweep when not on its grid; 'none' for none). Default: the "
+                      "paper's 0.8, 0.9 and 1.1 Hz that lie within the sweep's range")
     buoy.add_argument("--workers", type=int, default=None,
                       help="worker processes (default: one per CPU)")
     buoy.add_argument("--no-progress", action="store_true", help="do not draw a progress bar")
@@ -340,12 +344,57 @@ def _buoy(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
         parser.error(f"--output {str(output)!r} exists and is not a folder")
     if args.animate is not None:
         return _buoy_animation(args, parser, case, settings)
+    history = _history_frequencies(args.history_frequencies, parser)
     study = run_study(case, settings, models=models, workers=args.workers,
-                      progress=not args.no_progress, motions=motions)
-    paths = write_report(study, output, data)
-    print(summary(study), flush=True)
+                      progress=not args.no_progress, motions=motions,
+                      history_frequencies=history)
+    sources = _parameter_sources(args)
+    paths = write_report(study, output, data, sources)
+    print(summary(study, sources), flush=True)
     print(f"results: {len(paths)} files in {output}", flush=True)
     return 1 if study.failures() else 0
+
+
+def _history_frequencies(
+    text: str | None, parser: argparse.ArgumentParser
+) -> tuple[float, ...] | None:
+    """The frequencies of ``--history-frequencies`` (None when not given)."""
+    import math
+
+    if text is None:
+        return None
+    if text.strip().lower() == "none":
+        return ()
+    try:
+        values = tuple(float(v) for v in text.split(",") if v.strip())
+    except ValueError:
+        parser.error(f"--history-frequencies {text!r}: give frequencies in Hz separated by "
+                     f"commas, e.g. 0.8,0.9,1.1, or 'none'")
+    bad = [v for v in values if not (math.isfinite(v) and v > 0.0)]
+    if bad or not values:
+        parser.error(f"--history-frequencies {text!r}: every frequency must be a finite number "
+                     f"of Hz greater than 0")
+    return values
+
+
+def _parameter_sources(args: argparse.Namespace) -> dict[str, str]:
+    """Where each case and sweep parameter given by the user came from: the ``--case`` file or
+    an option (options override the file), for parameters.csv."""
+    from vinculo.buoy.case import _read_toml
+
+    sources: dict[str, str] = {}
+    if args.case is not None:
+        data = _read_toml(args.case)
+        for table, prefix in (("case", ""), ("sweep", "sweep.")):
+            for name in data.get(table, {}):
+                sources[prefix + name] = f"case file {args.case}"
+    for key, value in vars(args).items():
+        if value is None or "__" not in key:
+            continue
+        table, name = key.split("__", 1)
+        prefix = "" if table == "case" else "sweep."
+        sources[prefix + name] = f"option --{name.replace('_', '-')}"
+    return sources
 
 
 def _buoy_animation(

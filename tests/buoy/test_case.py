@@ -8,6 +8,7 @@ import pytest
 
 from vinculo.buoy.case import (
     ASSUMPTIONS,
+    PAPER_VALUES,
     BuoyCase,
     SweepSettings,
     load_case,
@@ -39,12 +40,21 @@ def test_pendulum_length_follows_the_attachment():
 
 
 def test_assumptions_name_existing_fields_with_reasons():
-    # Reference: the study does not give X0, the attachment point or a ramp (docs/buoy.md).
-    assert set(ASSUMPTIONS) == {"amplitude", "attachment", "ramp_periods"}
+    # Reference: the study does not give X0, the attachment point or a ramp (docs/buoy.md), nor
+    # a heavy string or a viscous force; everything else is the paper's table (docs/buoy.md,
+    # "Parameters (from the paper)"), so each field is one or the other, except the tank: its
+    # size is the paper's, its being closed (no sloshing) an assumption.
+    assert {"amplitude", "attachment", "ramp_periods"} <= set(ASSUMPTIONS)
     names = {field.name for field in dataclasses.fields(BuoyCase)}
-    assert set(ASSUMPTIONS) <= names
+    assert set(ASSUMPTIONS) | set(PAPER_VALUES) == names
+    assert not set(ASSUMPTIONS) & (set(PAPER_VALUES) - {"tank_size"})
     assert all(len(reason) > 20 for reason in ASSUMPTIONS.values())
     assert BuoyCase.ASSUMPTIONS is ASSUMPTIONS
+    paper = {"diameter": 0.1, "sphere_density": 366.69, "fluid_density": 1000.0,
+             "string_length": 0.16, "drag_coefficient": 0.22, "added_mass_coefficient": 0.52,
+             "gravity": 9.81, "tank_size": (0.38, 0.38, 0.40)}
+    assert PAPER_VALUES == paper
+    assert all(getattr(BuoyCase(), name) == value for name, value in paper.items())
 
 
 @pytest.mark.parametrize(

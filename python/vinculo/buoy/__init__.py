@@ -8,6 +8,7 @@
   from CSV and smoothed by a spline;
 - :mod:`vinculo.buoy.harmonic`: steady-state amplitude and phase by least squares over
   whole periods;
+- :mod:`vinculo.buoy.resonance`: each model's resonance, refined by fresh runs near the peak;
 - :mod:`vinculo.buoy.data`: reading measured amplitude and phase curves from CSV;
 - :mod:`vinculo.buoy.parameter_study`: any parameters over a grid, in parallel (local processes
   or a Dask cluster), resumable;
@@ -18,6 +19,8 @@ from vinculo.buoy.calibration import CALIBRATABLE, Calibration, calibrate
 from vinculo.buoy.case import (
     ASSUMPTIONS,
     ATTACHMENTS,
+    PAPER_VALUES,
+    VISCOUS_FORCES,
     BuoyCase,
     SweepSettings,
     load_case,
@@ -62,7 +65,9 @@ __all__ = [
     "COLUMNS",
     "MOTIONS",
     "MOTION_COLUMNS",
+    "PAPER_VALUES",
     "PHASE_CONVENTION",
+    "VISCOUS_FORCES",
     "BuoyCase",
     "Calibration",
     "HarmonicFit",

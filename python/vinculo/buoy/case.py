@@ -42,6 +42,8 @@ else:  # pragma: no cover - Python 3.10 reads TOML with the tomli backport
 __all__ = [
     "ASSUMPTIONS",
     "ATTACHMENTS",
+    "PAPER_VALUES",
+    "VISCOUS_FORCES",
     "BuoyCase",
     "SweepSettings",
     "load_case",
@@ -52,15 +54,43 @@ __all__ = [
 #: The two readings of where the string is tied to the sphere.
 ATTACHMENTS = ("bottom", "centre")
 
+#: The viscous forces the fluid model offers beyond Morison's: none (the study's model), or the
+#: Stokes-layer drag and added mass of a sphere oscillating in a viscous fluid
+#: (:meth:`BuoyCase.stokes_layer`).
+VISCOUS_FORCES = ("none", "stokes-layer")
+
+#: The values the study (the paper) gives, by field of :class:`BuoyCase`; a field's value is
+#: reported as the paper's only when it equals this.
+PAPER_VALUES: dict[str, Any] = {
+    "diameter": 0.1,
+    "sphere_density": 366.69,
+    "fluid_density": 1000.0,
+    "string_length": 0.16,
+    "drag_coefficient": 0.22,
+    "added_mass_coefficient": 0.52,
+    "gravity": 9.81,
+    "tank_size": (0.38, 0.38, 0.40),
+}
+
 #: Fields of :class:`BuoyCase` whose defaults are assumptions, not values from the study, each with
 #: the reason for the default.
 ASSUMPTIONS: dict[str, str] = {
-    "amplitude": "the table's displacement amplitude X0 is not reported; at 5 mm the string "
-    "swings at most about 13 deg (at resonance), where the linear picture still holds",
+    "amplitude": "the table's displacement amplitude X0 is not reported; 5 mm keeps the string's "
+    "swing moderate (parameters.csv gives the swing at the value used)",
     "attachment": "the study gives the string length but not where it is tied; 'bottom' (the "
     "sphere's lowest point) puts the centre 0.21 m above the anchor",
     "ramp_periods": "the study starts the table abruptly; a smooth C2 ramp over 10 periods avoids "
     "the strong start-up transient it reports (set 0 for the abrupt start)",
+    "string_beads": "the string is massless, as in the study's model (give beads and their mass "
+    "for a heavy string)",
+    "string_mass": "the string is massless, as in the study's model",
+    "viscous_force": "only Morison's drag and added mass, as in the study; 'stokes-layer' adds the "
+    "viscous boundary-layer force of an oscillating sphere (Stokes 1851)",
+    "kinematic_viscosity": "water at about 20 degC (1.0e-6 m^2/s); used only with viscous_force = "
+    "'stokes-layer'",
+    "tank_size": "the tank is closed and full, so the water moves with it as a rigid body (no "
+    "free surface, no sloshing); an open tank would slosh (first mode near 1.43 Hz for the "
+    "study's tank, inside the sweep)",
 }
 
 
@@ -102,8 +132,9 @@ def _non_negative(owner: str, name: str, value: float, unit: str) -> None:
 class BuoyCase:
     """Parameters of the buoy study: a sphere tethered to the floor of a shaken water tank.
 
-    The defaults are the study's values, except the fields listed in :data:`ASSUMPTIONS`
-    (``amplitude``, ``attachment``, ``ramp_periods``), which the study does not give.
+    The defaults are the study's values (:data:`PAPER_VALUES`), except the fields listed in
+    :data:`ASSUMPTIONS` (``amplitude``, ``attachment``, ``ramp_periods``, the massless string,
+    the fluid model's viscous option, and the closed tank), which the study does not give.
 
     Arguments:
         diameter: sphere diameter D, in m.
@@ -122,8 +153,14 @@ class BuoyCase:
         string_beads: number of small masses along the string (0: a massless string).
         string_mass: total mass of those beads, in kg (must be positive when there are beads, and
             0 when there are none).
-        tank_size: inner length, width and height of the tank, in m (informational: the fluid is
-            modelled as moving rigidly with the tank, whatever its size).
+        tank_size: inner length, width and height of the tank, in m. The fluid is modelled as
+            moving rigidly with the tank, whatever its size: the tank is taken as closed and full
+            (no free surface). The size gives the first sloshing frequency an open tank would
+            have (:meth:`sloshing_frequency`) and the walls of the animation.
+        viscous_force: ``"none"`` (Morison's drag and added mass only, the study's model) or
+            ``"stokes-layer"``: add the viscous force of the oscillatory boundary layer,
+            :meth:`stokes_layer`, on the sphere's motion relative to the fluid.
+        kinematic_viscosity: nu of the water, in m^2/s (only used by the Stokes-layer force).
 
     Raises:
         InvalidInputError: if a field is out of its domain (the message names the field and value).
@@ -142,6 +179,8 @@ class BuoyCase:
     string_beads: int = 0
     string_mass: float = 0.0
     tank_size: tuple[float, float, float] = (0.38, 0.38, 0.40)
+    viscous_force: str = "none"
+    kinematic_viscosity: float = 1.0e-6
 
     #: Fields whose defaults are assumptions (see the module's :data:`ASSUMPTIONS`).
     ASSUMPTIONS: ClassVar[dict[str, str]] = ASSUMPTIONS
@@ -155,6 +194,7 @@ class BuoyCase:
             ("string_length", "m"),
             ("gravity", "m/s^2"),
             ("amplitude", "m"),
+            ("kinematic_viscosity", "m^2/s"),
         ):
             _positive(owner, name, getattr(self, name), unit)
         for name, unit in (
@@ -170,6 +210,13 @@ class BuoyCase:
                 f"got {self.attachment!r}",
                 name="attachment",
                 value=self.attachment,
+            )
+        if self.viscous_force not in VISCOUS_FORCES:
+            raise InvalidInputError(
+                f"BuoyCase.viscous_force must be one of {', '.join(map(repr, VISCOUS_FORCES))}, "
+                f"got {self.viscous_force!r}",
+                name="viscous_force",
+                value=self.viscous_force,
             )
         if not _is_integer(self.string_beads) or self.string_beads < 0:
             raise InvalidInputError(
@@ -246,6 +293,78 @@ class BuoyCase:
             return self.string_length + self.radius
         return self.string_length
 
+    def sloshing_frequency(self, mode: int = 1) -> float:
+        """Natural frequency of an open tank's sloshing mode along the shaking, in Hz.
+
+        Linear water waves standing between two walls a length L apart in water of depth h
+        (the tank full: h = ``tank_size[2]``) have wavenumbers ``k = n pi / L`` and frequencies
+        ``f = sqrt(g k tanh(k h)) / (2 pi)`` (the dispersion relation of linear waves, e.g.
+        Ibrahim, *Liquid Sloshing Dynamics*, 2005, eq. 2.32; Lamb, *Hydrodynamics*, art. 257). The
+        study's model has no free surface (closed tank); this tells where that assumption would
+        fail for an open one: 1.431 Hz for the first mode of the study's tank.
+
+        Arguments:
+            mode: n >= 1, the number of half-waves along the tank's length.
+
+        Returns:
+            The frequency, in Hz.
+
+        Raises:
+            InvalidInputError: if ``mode`` is not a whole number >= 1.
+        """
+        if not _is_integer(mode) or mode < 1:
+            raise InvalidInputError(
+                f"mode must be a whole number >= 1 (half-waves along the tank), got {mode!r}",
+                name="mode",
+                value=mode,
+            )
+        length, _, depth = self.tank_size
+        k = mode * math.pi / length
+        return math.sqrt(self.gravity * k * math.tanh(k * depth)) / (2.0 * math.pi)
+
+    def stokes_layer(self, frequency: float) -> tuple[float, float]:
+        """Damping and added mass of the Stokes layer of the sphere oscillating at ``frequency``.
+
+        A sphere of radius R oscillating with velocity ``u e^{-i w t}`` in a viscous fluid at rest
+        (density rho, viscosity mu = rho nu) feels the force (Stokes 1851; Landau and Lifshitz,
+        *Fluid Mechanics*, 2nd ed., par. 24, problem 5)::
+
+            F = -6 pi mu R (1 + R / delta) u
+                - 3 pi R^2 sqrt(2 mu rho / w) (1 + 2 R / (9 delta)) du/dt
+
+        with the thickness of the oscillatory boundary layer ``delta = sqrt(2 nu / w)``. Since
+        ``sqrt(2 mu rho / w) = rho delta``, the part ``3 pi R^2 rho delta 2 R / (9 delta) du/dt =
+        1/2 rho V du/dt`` is the inviscid added mass (Ca = 1/2), which the Morison term already
+        carries with the case's Ca. What the boundary layer adds is therefore::
+
+            F_v = -c u - m_v du/dt,   c = 6 pi mu R (1 + R / delta),   m_v = 3 pi R^2 rho delta
+
+        The fluid of the closed tank moves rigidly with it, so in the tank's frame it is at rest
+        (the frame's acceleration is balanced by the pressure gradient that gives the
+        Froude-Krylov force) and u is the sphere centre's velocity relative to the tank. The
+        result is linear: it holds for displacements small against R, a single frequency, and
+        attached flow; at the amplitudes of the study (relative motion near R at resonance) the
+        flow separates, which is what Morison's quadratic drag models, so adding both may count
+        part of the dissipation twice. See ``docs/buoy/stokes-layer.md``.
+
+        Arguments:
+            frequency: the oscillation's frequency, in Hz (> 0).
+
+        Returns:
+            ``(c, m_v)``: the damping coefficient in N s/m and the added mass in kg.
+
+        Raises:
+            InvalidInputError: if ``frequency`` is not finite and positive.
+        """
+        _positive("BuoyCase.stokes_layer", "frequency", frequency, "Hz")
+        omega = 2.0 * math.pi * frequency
+        delta = math.sqrt(2.0 * self.kinematic_viscosity / omega)
+        viscosity = self.fluid_density * self.kinematic_viscosity
+        radius = self.radius
+        damping = 6.0 * math.pi * viscosity * radius * (1.0 + radius / delta)
+        added_mass = 3.0 * math.pi * radius**2 * self.fluid_density * delta
+        return damping, added_mass
+
     # ---- conversion --------------------------------------------------------------------------
 
     def to_dict(self) -> dict[str, Any]:
@@ -282,13 +401,15 @@ class SweepSettings:
 
     Each run simulates ``settle_periods`` periods for the transient to die out, then
     ``fit_periods`` periods over which amplitude and phase are fitted, so it ends at
-    ``(settle_periods + fit_periods) / f``. The default of 30 settling periods is set by the slow
-    decay of the transient: the only damping is quadratic drag, weak at millimetre amplitudes, so
-    the free oscillation at the natural frequency that the start leaves behind dies out slowly.
-    With a 3-period ramp the relative amplitude fitted over periods 30-40 differs from the one
-    over periods 20-30 by up to about 2 % across 0.5-1.5 Hz (largest off resonance); the default
-    10-period ramp excites less of it and brings this under 0.6 %.
-    :attr:`vinculo.buoy.harmonic.SteadyResponse.settling` reports it for each run.
+    ``(settle_periods + fit_periods) / f``. The transient dies out slowly: the only damping is
+    quadratic drag, weak at millimetre amplitudes, so the free oscillation at the natural
+    frequency that the start leaves behind lingers. Each run therefore checks its steady state:
+    the relative motion's amplitude and phase fitted over the last window and over the window
+    before it must agree within ``amplitude_tolerance`` (relative) and ``phase_tolerance``
+    (degrees); when they do not, the run is continued from its last state by ``fit_periods``
+    periods at a time, up to ``max_periods`` periods in all, and a run that still does not meet
+    them is reported as not converged
+    (:attr:`vinculo.buoy.harmonic.SteadyResponse.converged`, in ``sweep.csv`` and the summary).
 
     Arguments:
         f_min: lowest excitation frequency, in Hz.
@@ -299,6 +420,16 @@ class SweepSettings:
             amplitudes by less than 1e-4 relative (second-order rule).
         settle_periods: periods simulated before the fit window (the ramp-up counts among them).
         fit_periods: whole periods in the fit window (>= 1).
+        amplitude_tolerance: largest relative change of the fitted relative amplitude between
+            the last two windows of ``fit_periods`` periods for the run to count as steady.
+        phase_tolerance: largest change of the fitted relative phase between those windows, in
+            degrees.
+        max_periods: longest run, in periods, that the steady-state check may extend a run to
+            (``settle_periods + fit_periods`` or less: no extension).
+        refine_rounds: most rounds of the resonance's refinement (three fresh runs per model and
+            round, :mod:`vinculo.buoy.resonance`); 0: report the sweep's own estimate.
+        resonance_tolerance: the refinement stops when a round moves the peak's frequency by
+            less than this, in Hz.
 
     Raises:
         InvalidInputError: if a field is out of its domain, or the range has no points.
@@ -310,10 +441,26 @@ class SweepSettings:
     dt: float = 2e-3
     settle_periods: float = 30.0
     fit_periods: int = 10
+    amplitude_tolerance: float = 1e-3
+    phase_tolerance: float = 0.1
+    max_periods: float = 100.0
+    refine_rounds: int = 4
+    resonance_tolerance: float = 1e-4
 
     def __post_init__(self) -> None:
         owner = "SweepSettings"
         _positive(owner, "f_min", self.f_min, "Hz")
+        _positive(owner, "amplitude_tolerance", self.amplitude_tolerance, "relative")
+        _positive(owner, "phase_tolerance", self.phase_tolerance, "degrees")
+        _positive(owner, "max_periods", self.max_periods, "periods")
+        _positive(owner, "resonance_tolerance", self.resonance_tolerance, "Hz")
+        if not _is_integer(self.refine_rounds) or self.refine_rounds < 0:
+            raise InvalidInputError(
+                f"SweepSettings.refine_rounds must be a whole number >= 0, got "
+                f"{self.refine_rounds!r}",
+                name="refine_rounds",
+                value=self.refine_rounds,
+            )
         _positive(owner, "f_max", self.f_max, "Hz")
         _positive(owner, "dt", self.dt, "s")
         _non_negative(owner, "settle_periods", self.settle_periods, "periods")
@@ -366,11 +513,14 @@ class SweepSettings:
         """The excitation frequencies, in Hz: ``np.linspace(f_min, f_max, count)``."""
         return np.linspace(self.f_min, self.f_max, self.count)
 
-    def t_end(self, frequency: float) -> float:
+    def t_end(self, frequency: float, extension: int = 0) -> float:
         """Duration of the run at ``frequency``: ``(settle_periods + fit_periods) / frequency``.
 
         Arguments:
             frequency: excitation frequency, in Hz (> 0).
+            extension: how many times the steady-state check has extended the run, each time by
+                ``fit_periods`` periods (one window), the whole run at most ``max_periods``
+                periods.
 
         Returns:
             The end time, in s.
@@ -379,7 +529,30 @@ class SweepSettings:
             InvalidInputError: if ``frequency`` is not finite and positive.
         """
         _positive("SweepSettings.t_end", "frequency", frequency, "Hz")
-        return (self.settle_periods + self.fit_periods) / frequency
+        return self.run_periods(extension) / frequency
+
+    def run_periods(self, extension: int = 0) -> float:
+        """Periods simulated by a run after ``extension`` extensions (see :meth:`t_end`).
+
+        Arguments:
+            extension: number of extensions (0: the first run).
+
+        Returns:
+            The number of periods (not always whole).
+        """
+        base = self.settle_periods + self.fit_periods
+        return max(min(base + extension * self.fit_periods, self.max_periods), base)
+
+    def can_extend(self, extension: int) -> bool:
+        """Whether the steady-state check may extend a run once more after ``extension``.
+
+        Arguments:
+            extension: extensions made so far.
+
+        Returns:
+            True when the next extension runs longer than the current run.
+        """
+        return self.run_periods(extension + 1) > self.run_periods(extension) + 1e-9
 
     def to_dict(self) -> dict[str, Any]:
         """The fields as a plain dict.

@@ -219,6 +219,11 @@ class SteadyResponse:
             out (NaN when the history is too short for the earlier window).
         residual_rms: rms residual of the fit of the relative displacement, in m (non-harmonic
             content: transient, higher harmonics).
+        phase_change_deg: change of the relative phase between the window before this one and
+            this one, ``|phi_last - phi_before|`` in degrees (NaN when there is no earlier window).
+        converged: whether ``settling`` and ``phase_change_deg`` meet the tolerances of the
+            steady-state check (:class:`vinculo.buoy.case.SweepSettings`); None when unchecked.
+        periods: periods of the excitation simulated by the run (NaN when not recorded).
     """
 
     frequency: float
@@ -232,6 +237,9 @@ class SteadyResponse:
     relative_phase_deg: float
     settling: float
     residual_rms: float
+    phase_change_deg: float = math.nan
+    converged: bool | None = None
+    periods: float = math.nan
 
 
 def steady_response(
@@ -251,7 +259,8 @@ def steady_response(
         fit_periods: whole periods in the fit window.
 
     Returns:
-        The response; ``settling`` reports how far the transient has died out (it does not fail).
+        The response; ``settling`` and ``phase_change_deg`` report how far the transient has died
+        out (they do not fail; ``converged`` is left None).
 
     Raises:
         InvalidInputError: if the arrays do not match, the window does not fit in the history, or
@@ -294,10 +303,12 @@ def steady_response(
     relative = fit_harmonic(t, x_rel, frequency, window)
     earlier = (window[0] - (window[1] - window[0]), window[0])
     if earlier[0] >= t[0] - _EDGE * max(1.0, abs(earlier[0])):
-        before = fit_harmonic(t, x_rel, frequency, earlier).amplitude
-        settling = abs(relative.amplitude - before) / relative.amplitude
+        before = fit_harmonic(t, x_rel, frequency, earlier)
+        settling = abs(relative.amplitude - before.amplitude) / relative.amplitude
+        turn = (relative.phase_deg - before.phase_deg + 180.0) % 360.0 - 180.0
+        phase_change = abs(turn)
     else:
-        settling = math.nan
+        settling = phase_change = math.nan
     return SteadyResponse(
         frequency=float(frequency),
         window=window,
@@ -310,4 +321,5 @@ def steady_response(
         relative_phase_deg=wrap_phase(relative.phase_deg - tank.phase_deg),
         settling=float(settling),
         residual_rms=relative.residual_rms,
+        phase_change_deg=float(phase_change),
     )

@@ -12,7 +12,10 @@ absolute position of its centre and ``r = b - (X_t, 0)`` its position relative t
     added mass                 m_a ((X_t'', 0) - b'') = -m_a r''
     drag                       1/2 rho_f Cd A |u_f - b'| (u_f - b') = -k |r'| r'
 
-with ``k = 1/2 rho_f Cd A``.
+with ``k = 1/2 rho_f Cd A``. With ``viscous_force = "stokes-layer"`` the Stokes layer adds
+``-c r' - m_v r''`` (:meth:`vinculo.buoy.case.BuoyCase.stokes_layer`, evaluated at the excitation
+frequency, or at the lowest non-zero natural frequency for a tank at rest): ``m_v`` joins the
+translating mass and ``-c r'`` the applied force.
 
 Newton's law for the centre, ``m_s b'' = sum of forces + string force``, with ``b'' = (X_t'', 0) +
 r''``, becomes in the tank frame::
@@ -153,6 +156,29 @@ class _PendulumModel:
         self._mass = case.sphere_mass + case.added_mass
         self._mu = case.displaced_mass - case.sphere_mass
         self._drag = 0.5 * case.fluid_density * case.drag_coefficient * case.frontal_area
+        self._viscous = 0.0  # Stokes-layer damping c, N s/m (set per run)
+        self._viscous_mass = 0.0  # Stokes-layer added mass m_v, kg (set per run)
+
+    def _swing_frequency(self) -> float:
+        """The lowest non-zero linear natural frequency (Hz), without the Stokes layer."""
+        raise NotImplementedError
+
+    def viscous_terms(self, frequency: float | None) -> tuple[float, float]:
+        """The Stokes-layer damping and added mass the model uses at ``frequency``.
+
+        Arguments:
+            frequency: the excitation frequency, in Hz; None (a tank at rest): the lowest non-zero
+                natural frequency, the frequency of the free swing.
+
+        Returns:
+            ``(c, m_v)`` in N s/m and kg (both 0 unless ``case.viscous_force`` is
+            ``"stokes-layer"``).
+        """
+        if self.case.viscous_force != "stokes-layer":
+            return 0.0, 0.0
+        if frequency is None:
+            frequency = self._swing_frequency()
+        return self.case.stokes_layer(frequency)
 
     # subclasses: shortest free period, rest state for a tank velocity, and the dynamics
     def _shortest_period(self) -> float:
@@ -173,6 +199,7 @@ class _PendulumModel:
         initial: Any = None,
         sample_dt: float = 1e-3,
         tank: TankMotion | MeasuredTankMotion | None = None,
+        t_start: float = 0.0,
     ) -> ReferenceRun:
         """Integrate the model with the tank shaken at ``frequency`` from ``t = 0`` to ``t_end``.
 
@@ -190,6 +217,8 @@ class _PendulumModel:
             tank: a tank motion to use instead of the harmonic one at ``frequency``, such as a
                 measured record (:func:`vinculo.buoy.tank.read_tank_motion`); ``frequency`` is
                 then ignored and the run is labelled with the motion's frequency.
+            t_start: the time at which the run starts, in s (samples at ``t_start + k *
+                sample_dt``); with ``initial``, continue an earlier run from its last state.
 
         Returns:
             The time history.
@@ -204,9 +233,15 @@ class _PendulumModel:
             frequency = None if frequency is None else tank.frequency
         else:
             frequency = tank.frequency
-        if not (math.isfinite(t_end) and t_end > 0.0):
+        if not (math.isfinite(t_start) and t_start >= 0.0):
             raise InvalidInputError(
-                f"t_end must be a finite positive time in s, got {t_end!r}",
+                f"t_start must be a finite time >= 0 in s, got {t_start!r}",
+                name="t_start",
+                value=t_start,
+            )
+        if not (math.isfinite(t_end) and t_end > t_start):
+            raise InvalidInputError(
+                f"t_end must be a finite time in s after t_start = {t_start!r}, got {t_end!r}",
                 name="t_end",
                 value=t_end,
             )
@@ -216,14 +251,15 @@ class _PendulumModel:
                 name="t_end",
                 value=t_end,
             )
-        if not (math.isfinite(sample_dt) and 0.0 < sample_dt <= t_end):
+        if not (math.isfinite(sample_dt) and 0.0 < sample_dt <= t_end - t_start):
             raise InvalidInputError(
-                f"sample_dt must be positive and at most t_end = {t_end!r} s, got {sample_dt!r}",
+                f"sample_dt must be positive and at most the run's duration "
+                f"{t_end - t_start!r} s, got {sample_dt!r}",
                 name="sample_dt",
                 value=sample_dt,
             )
         if initial is None:
-            y0 = self._rest_state(tank.at(0.0)[1])
+            y0 = self._rest_state(tank.at(t_start)[1])
         else:
             y0 = np.asarray(initial, dtype=np.float64).reshape(-1)
             if y0.shape != (2 * self.dof,) or not np.all(np.isfinite(y0)):
@@ -233,8 +269,8 @@ class _PendulumModel:
                     name="initial",
                     value=initial,
                 )
-        count = math.floor(t_end / sample_dt + 1e-9)
-        times = np.arange(count + 1) * sample_dt
+        count = math.floor((t_end - t_start) / sample_dt + 1e-9)
+        times = t_start + np.arange(count + 1) * sample_dt
         if times[-1] < t_end * (1.0 - 1e-12):
             times = np.append(times, t_end)
         times[-1] = min(times[-1], t_end)
@@ -248,6 +284,7 @@ class _PendulumModel:
             # sample at most are not rejected at the kinks (about 9 times fewer evaluations).
             max_step = min(max_step, float(np.max(np.diff(knots))))
         dof = self.dof
+        self._viscous, self._viscous_mass = self.viscous_terms(frequency)
 
         def rhs(t: float, y: np.ndarray) -> list[float]:
             a_t = tank.at(t)[2]
@@ -256,7 +293,7 @@ class _PendulumModel:
 
         result = solve_ivp(
             rhs,
-            (0.0, float(times[-1])),
+            (float(times[0]), float(times[-1])),
             y0,
             method="DOP853",
             t_eval=times,
@@ -336,6 +373,9 @@ class OneDofModel(_PendulumModel):
     def _shortest_period(self) -> float:
         return 1.0 / self.natural_frequency()
 
+    def _swing_frequency(self) -> float:
+        return self.natural_frequency()
+
     def _rest_state(self, tank_velocity: float) -> np.ndarray:
         return np.array([0.0, -tank_velocity / self.length])
 
@@ -343,13 +383,15 @@ class OneDofModel(_PendulumModel):
         theta, rate = angles[0], rates[0]
         length, mu, g = self.length, self._mu, self.case.gravity
         sine, cosine = xp.sin(theta), xp.cos(theta)
+        mass = self._mass + self._viscous_mass
         moment = (
             -mu * g * length * sine
             + mu * a_t * length * cosine
             - self._drag * length**3 * abs(rate) * rate
+            - self._viscous * length**2 * rate
         )
-        acceleration = moment / (self._mass * length**2 + self.inertia)
-        tension = mu * (a_t * sine + g * cosine) + self._mass * length * rate**2
+        acceleration = moment / (mass * length**2 + self.inertia)
+        tension = mu * (a_t * sine + g * cosine) + mass * length * rate**2
         return (acceleration,), length * sine, length * cosine, tension
 
 
@@ -471,6 +513,10 @@ class TwoDofModel(_PendulumModel):
         frequencies = self.natural_frequencies()
         return 1.0 / float(frequencies.max())
 
+    def _swing_frequency(self) -> float:
+        frequencies = self.natural_frequencies()
+        return float(frequencies[frequencies > 0.0].min())
+
     def _rest_state(self, tank_velocity: float) -> np.ndarray:
         if self.rigid:
             return np.array([0.0, -tank_velocity / (self.string_length + self.offset)])
@@ -484,14 +530,14 @@ class TwoDofModel(_PendulumModel):
         else:
             th1, th2 = angles[0], angles[1]
             w1, w2 = rates[0], rates[1]
-        m, mu, g = self._mass, self._mu, self.case.gravity
+        m, mu, g = self._mass + self._viscous_mass, self._mu, self.case.gravity
         ell, r = self.string_length, self.offset
         s1, c1, s2, c2 = xp.sin(th1), xp.cos(th1), xp.sin(th2), xp.cos(th2)
         vx = ell * w1 * c1 + r * w2 * c2
         vz = -ell * w1 * s1 - r * w2 * s2
         speed = xp.sqrt(vx * vx + vz * vz)
-        fx = mu * a_t - self._drag * speed * vx
-        fz = mu * g - self._drag * speed * vz
+        fx = mu * a_t - (self._drag * speed + self._viscous) * vx
+        fz = mu * g - (self._drag * speed + self._viscous) * vz
         q1 = ell * (fx * c1 - fz * s1)
         q2 = r * (fx * c2 - fz * s2)
         along_string = fx * s1 + fz * c1
