@@ -462,12 +462,19 @@ def _history_figure(plt: Any, study: StudyResult, f: float, record: str, runs: l
         ax.set_xlim(start, t_last)
     time = first["time"]
     shown = time >= start - 1e-9
-    steady.plot(time[shown], first["tank"][shown] * 1e3, color="0.55", lw=2.2, label="tank")
-    for r in runs:
+    # the tank on its own axis (right), scaled to the buoy's, so that the phase can be read
+    tank_axis = steady.twinx()
+    tank_axis.plot(time[shown], first["tank"][shown] * 1e3, color="0.6", lw=2.5, alpha=0.8,
+                   label="tank (right axis)", zorder=1)
+    tank_axis.set_ylabel("tank displacement (mm)", color="0.4")
+    steady.set_zorder(tank_axis.get_zorder() + 1)
+    steady.patch.set_visible(False)
+    for index, r in enumerate(runs):
         h = r.history
         keep = h["time"] >= start - 1e-9
+        step = max(1, int(keep.sum()) // 45)  # about 45 markers, staggered between models
         steady.plot(h["time"][keep], h["buoy"][keep] * 1e3, lw=1.2, label=_label(r.model, r),
-                    **_line(r.model, markevery=max(1, int(keep.sum()) // 60)))
+                    **_line(r.model, markevery=(index * step // 3, step)))
         whole.plot(h["time"], h["buoy"] * 1e3, lw=0.8, **_line(r.model, marker=False))
     whole.plot(time, first["tank"] * 1e3, color="0.55", lw=1.0)
     # differences from the particle model (or the first model run), on the common samples
@@ -484,6 +491,10 @@ def _history_figure(plt: Any, study: StudyResult, f: float, record: str, runs: l
         delta = (r.history["buoy"][:common] - base.history["buoy"][:common])[keep]
         difference.plot(t[keep], delta * 1e3, lw=1.0, **_line(r.model, marker=False))
         drawn = True
+    buoy_limit = max(abs(v) for v in steady.get_ylim())
+    tank_limit = float(np.max(np.abs(first["tank"][shown]))) * 1e3 or 1.0
+    steady.set_ylim(-buoy_limit, buoy_limit)
+    tank_axis.set_ylim(-1.1 * tank_limit, 1.1 * tank_limit)
     difference.axhline(0.0, color="0.3", lw=0.6)
     difference.set_ylabel(f"minus {base.model}\n(mm)")
     if not drawn:
@@ -493,17 +504,20 @@ def _history_figure(plt: Any, study: StudyResult, f: float, record: str, runs: l
         for ax in (steady, difference, whole):
             ax.axvspan(*window, color="gold", alpha=0.15, lw=0)
         steady.axvline(window[0], color="0.35", lw=0.8, ls="--")
-        steady.text(window[0], 1.01, f"  fit window: last {study.settings.fit_periods} periods",
-                    transform=steady.get_xaxis_transform(), fontsize=8, va="bottom", color="0.3")
-        whole.text(window[0], 0.97, " fit window", transform=whole.get_xaxis_transform(),
-                   fontsize=8, va="top", color="0.3")
+        label = dict(fontsize=8, va="top", color="0.25",
+                     bbox=dict(boxstyle="square,pad=0.15", fc="white", ec="none", alpha=0.8))
+        steady.text(window[0], 0.985, f" fit window: the last {study.settings.fit_periods} "
+                    f"periods, {window[0]:.2f}-{window[1]:.2f} s",
+                    transform=steady.get_xaxis_transform(), **label)
+        whole.text(window[0], 0.96, " fit window", transform=whole.get_xaxis_transform(),
+                   ha="right", **label)
     steady.set_ylabel("horizontal displacement (mm)")
     whole.set_ylabel("displacement\n(mm)")
     whole.set_xlabel("time (s)")
-    steady.set_title("steady state: the last periods (each model's fit window shaded)",
-                     fontsize=9, loc="left")
-    difference.set_title("difference from the particle model (same time samples)",
-                         fontsize=9, loc="left")
+    steady.set_title("steady state: the fit window and the period before it", fontsize=9,
+                     loc="left")
+    difference.set_title(f"difference from the {LABELS[base.model].split(' (')[0]} (same time "
+                         f"samples)", fontsize=9, loc="left")
     whole.set_title("the whole run, from rest", fontsize=9, loc="left")
     for ax in (steady, difference, whole):
         ax.grid(alpha=0.3)
@@ -514,7 +528,9 @@ def _history_figure(plt: Any, study: StudyResult, f: float, record: str, runs: l
         title = f"buoy and tank displacement at {f:g} Hz (X0 = {x0_mm:g} mm)"
     fig.suptitle(title, fontsize=11)
     handles, labels = steady.get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside upper center", ncols=2, fontsize=8, frameon=False)
+    tank_handles, tank_labels = tank_axis.get_legend_handles_labels()
+    fig.legend(tank_handles + handles, tank_labels + labels, loc="outside lower center",
+               ncols=2, fontsize=8, frameon=False)
     return fig
 
 
@@ -526,6 +542,35 @@ def _line(model: str, marker: bool = True, **extra: Any) -> dict[str, Any]:
     else:
         style["marker"] = ""
     return style
+
+
+def _peak_inset(ax: Any, study: StudyResult) -> None:
+    """A zoom on the refined peaks of the relative amplitude, where the models' curves and
+    their refinement runs would otherwise overlap, in the upper right of ``ax``."""
+    peaks = [r for r in study.resonances.values() if math.isfinite(r.frequency)]
+    if not peaks:
+        return
+    centre = float(np.mean([r.frequency for r in peaks]))
+    runs = [f for r in peaks for f in r.runs] or [r.frequency for r in peaks]
+    half = max(max(abs(f - centre) for f in runs), 1e-4) * 1.15
+    inset = ax.inset_axes((0.6, 0.42, 0.38, 0.52))
+    top = []
+    for model in MODELS:
+        f, y = study.curve(model, "relative_amplitude")
+        near = np.abs(f - centre) <= half
+        if near.any():
+            inset.plot(f[near], y[near] * 1e3, lw=1.0, **_line(model))
+            top.append(y[near])
+    for r in peaks:
+        inset.plot(r.frequency, r.peak * 1e3, marker="*", ms=11, color=_STYLE[r.model]["color"],
+                   mec="k", mew=0.5, ls="")
+    values = np.concatenate(top) * 1e3 if top else np.array([0.0])
+    spread = max(float(values.max() - values.min()), 1e-3)
+    inset.set_xlim(centre - half, centre + half)
+    inset.set_ylim(values.max() - 1.1 * spread, values.max() + 0.25 * spread)
+    inset.tick_params(labelsize=7)
+    inset.set_title("near the peak: refinement runs and refined peaks (stars)", fontsize=7)
+    inset.grid(alpha=0.3)
 
 
 def _response_figure(plt: Any, study: StudyResult, kind: str, data: Measurements | None) -> Any:
@@ -557,26 +602,27 @@ def _response_figure(plt: Any, study: StudyResult, kind: str, data: Measurements
                              color=_STYLE[model]["color"], mec="k", mew=0.6, ls="",
                              label=f"peak, {model}: {res.frequency:.4f} Hz, "
                              f"{res.peak * 1e3:.2f} mm")
-    # differences from the particle model at the frequencies both ran
-    base = "particle"
+    if kind == "amplitude" and study.resonances:
+        _peak_inset(axes[1], study)
+    # differences from the particle model (else the first model run) at common frequencies
+    present = [m for m in MODELS if study.of(m)]
+    base = present[0] if present else "particle"
     quantity = "relative_amplitude" if kind == "amplitude" else "relative_phase_deg"
     fb, yb = study.curve(base, quantity)
     drawn = False
-    for model in MODELS:
-        if model == base or not len(fb):
-            continue
+    for model in present[1:]:
         f, y = study.curve(model, quantity)
         common, ib, im = np.intersect1d(np.round(fb, 9), np.round(f, 9), return_indices=True)
-        if len(common):
+        if len(common) and len(fb):
             axes[2].plot(common, (y[im] - yb[ib]) * scale, lw=1.2, **_line(model))
             drawn = True
     axes[2].axhline(0.0, color="0.3", lw=0.6)
     axes[2].grid(alpha=0.3)
-    axes[2].set_ylabel(f"minus particle\n({unit})")
-    axes[2].set_title(f"relative {kind}: difference from the particle model "
+    axes[2].set_ylabel(f"minus {base}\n({unit})")
+    axes[2].set_title(f"relative {kind}: difference from the {LABELS[base].split(' (')[0]} "
                       "(at the frequencies both ran)", fontsize=9, loc="left")
     if not drawn:
-        axes[2].text(0.5, 0.5, "no common frequencies with the particle model", ha="center",
+        axes[2].text(0.5, 0.5, "one model only: no differences", ha="center",
                      va="center", transform=axes[2].transAxes, color="0.4")
     axes[-1].set_xlabel("excitation frequency (Hz)")
     if kind == "amplitude":
@@ -592,7 +638,7 @@ def _response_figure(plt: Any, study: StudyResult, kind: str, data: Measurements
             if lab not in labels:
                 handles.append(h)
                 labels.append(lab)
-    fig.legend(handles, labels, loc="outside upper center", ncols=2, fontsize=8, frameon=False)
+    fig.legend(handles, labels, loc="outside lower center", ncols=2, fontsize=8, frameon=False)
     return fig
 
 
