@@ -173,7 +173,7 @@ def run_task(
             response.settling <= settings.amplitude_tolerance
             and response.phase_change_deg <= settings.phase_tolerance
         )  # NaN (no earlier window) compares False: not converged
-        response = replace(response, converged=converged, periods=t_end * frequency)
+        response = replace(response, converged=converged, periods=round(t_end * frequency, 9))
         if converged or motion is not None or not settings.can_extend(extension):
             break
         extension += 1
