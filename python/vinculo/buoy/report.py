@@ -452,8 +452,10 @@ def _history_figure(plt: Any, study: StudyResult, f: float, record: str, runs: l
     )
     first = runs[0].history
     window = next((r.response.window for r in runs if r.response is not None), None)
+    # runs extended by the steady-state check end later: show up to the latest, shade each window
+    windows = sorted({r.response.window for r in runs if r.response is not None})
     period = 1.0 / f
-    t_last = float(first["time"][-1])
+    t_last = max(float(r.history["time"][-1]) for r in runs)
     if window is not None:
         start = max(window[0] - period, 0.0)
     else:  # a failed run: its last periods
@@ -502,7 +504,8 @@ def _history_figure(plt: Any, study: StudyResult, f: float, record: str, runs: l
                         va="center", transform=difference.transAxes, color="0.4")
     if window is not None:
         for ax in (steady, difference, whole):
-            ax.axvspan(*window, color="gold", alpha=0.15, lw=0)
+            for span in windows:
+                ax.axvspan(*span, color="gold", alpha=0.15, lw=0)
         steady.axvline(window[0], color="0.35", lw=0.8, ls="--")
         label = dict(fontsize=8, va="top", color="0.25",
                      bbox=dict(boxstyle="square,pad=0.15", fc="white", ec="none", alpha=0.8))
