@@ -264,7 +264,11 @@ class StudyResult:
         return [r for r in self.results if r.error is not None]
 
     def unconverged(self) -> list[ModelResult]:
-        """The runs whose steady-state check failed (the fit may still hold a transient)."""
+        """The runs whose steady-state check failed (their fit may still hold a transient).
+
+        Returns:
+            Those results, in the order of :attr:`results`.
+        """
         return [r for r in self.results if r.response is not None and r.response.converged is False]
 
     def curve(
