@@ -14,12 +14,11 @@ and is fitted over its last ``fit_periods`` periods at the record's frequency.
 from __future__ import annotations
 
 import math
-import multiprocessing
 import os
 import sys
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from typing import IO
@@ -27,6 +26,7 @@ from typing import IO
 import numpy as np
 
 from vinculo.buoy.case import BuoyCase, SweepSettings
+from vinculo.buoy.executors import open_executor
 from vinculo.buoy.harmonic import SteadyResponse, steady_response
 from vinculo.buoy.model import run_particle_model
 from vinculo.buoy.reference import OneDofModel, TwoDofModel
@@ -300,11 +300,9 @@ def run_study(
             for m, f, k, motion in tasks:
                 report(run_task(case, settings, m, f, k, motion))
         else:
-            # fork starts workers at once and needs no __main__ guard in the user's script; other
-            # platforms spawn (scripts then need `if __name__ == "__main__":`).
-            method = "fork" if sys.platform.startswith("linux") else "spawn"
-            context = multiprocessing.get_context(method)
-            with ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
+            # Workers die with this process and ignore Ctrl-C, which stops them (executors).
+            with open_executor(workers, None) as (pool, _):
+                assert pool is not None  # workers > 1
                 futures = {
                     pool.submit(run_task, case, settings, m, f, k, motion): (m, f, motion)
                     for m, f, k, motion in tasks
