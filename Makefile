@@ -1,35 +1,51 @@
 # Two user-facing targets: `make run` (the main job) and `make test` (every check and test).
 # Both set everything up from a fresh clone: a virtual environment in .venv with the pinned
 # tools of requirements-dev.txt, and the compiled extension built into it by maturin.
+#
+# Compile work is shared: the release build (maturin) compiles the dependencies once, in the
+# release profile, and the Rust tests then run in that profile with both crates selected, so
+# cargo resolves the same dependency features and reuses those compiled dependencies instead of
+# building them again (a plain `cargo test -p vinculo` builds them a second time, in the dev
+# profile and with other features). clippy only type-checks, after the build.
 
 PYTHON ?= python3
 VENV := .venv
 VENV_STAMP := $(VENV)/.installed
+# pip is told to be quiet through the environment, so that the pip run inside `maturin develop`
+# does not list every requirement that is already satisfied.
+QUIET_PIP := PIP_QUIET=1 PIP_DISABLE_PIP_VERSION_CHECK=1
 
-.PHONY: run test build .venv
+.PHONY: run test build rust-test .venv
 
 ## run: build, then run the main job (the buoy study; tables, figures and summary go to output/)
 run: build
 	$(VENV)/bin/vinculo buoy --output output
 
-## test: formatting, lints, Rust tests, build, Python lint and tests, in that order
+## test: formatting, build, Rust tests, lints, Python tests, in that order
 test: $(VENV_STAMP)
 	cargo fmt --all --check
-	cargo clippy --workspace --all-targets -- -D warnings
-	cargo test -p vinculo
 	$(MAKE) build
+	$(MAKE) rust-test
+	cargo clippy --workspace --all-targets --release -- -D warnings
 	$(VENV)/bin/ruff check python tests examples
 	$(VENV)/bin/pytest
 
-# Build the extension in release mode and install the package (editable) into .venv.
+# The Rust tests, in the release profile with both crates selected (see the top of this file).
+# The binding crate has no test targets of its own (its behaviour is tested through pytest).
+rust-test:
+	cargo test --release -p vinculo -p vinculo-python
+
+# Build the extension in release mode and install the package (editable) into .venv, showing
+# cargo's progress (compiling the dependencies takes minutes the first time; see the README).
 # maturin and cargo rebuild incrementally, so this is quick when nothing changed.
 build: $(VENV_STAMP)
-	VIRTUAL_ENV=$(CURDIR)/$(VENV) $(VENV)/bin/maturin develop --release --quiet
+	@echo "building the extension (release; first build compiles the dependencies: minutes)"
+	VIRTUAL_ENV=$(CURDIR)/$(VENV) $(QUIET_PIP) $(VENV)/bin/maturin develop --release
 
 .venv: $(VENV_STAMP)
 
 # The stamp file makes the installation happen once (and again when the pins change).
 $(VENV_STAMP): requirements-dev.txt
 	$(PYTHON) -m venv $(VENV)
-	$(VENV)/bin/python -m pip install --quiet --disable-pip-version-check -r requirements-dev.txt
+	$(QUIET_PIP) $(VENV)/bin/python -m pip install -r requirements-dev.txt
 	touch $@

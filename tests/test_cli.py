@@ -96,3 +96,94 @@ def test_buoy_command_rejects_bad_values_by_name(tmp_path, capsys):
     code = cli.main(["buoy", "--output", str(tmp_path), "--data", str(bad), "--no-progress"])
     assert code != 0
     assert "line 3" in capsys.readouterr().err
+
+
+def _exit_code(arguments: list[str]) -> int:
+    """The command's exit code, whether it returns it or argparse exits."""
+    try:
+        return cli.main(arguments)
+    except SystemExit as exit_:
+        return int(exit_.code)
+
+
+def _hostile_files(folder):
+    binary = folder / "binary.toml"
+    binary.write_bytes(b"\x00\xff\xfe\x01\x89PNG not text")
+    utf16 = folder / "utf16.toml"
+    utf16.write_bytes("[case]\namplitude = 0.004\n".encode("utf-16"))
+    return binary, utf16
+
+
+# Hostile input found by trying: each one was a traceback (ZeroDivisionError, UnicodeDecodeError,
+# OverflowError, ValueError from numpy) or exit code 1; each must be a one-line error naming the
+# value, with the exit code 2 that `vinculo --help` promises for bad arguments.
+HOSTILE = [
+    (["buoy", "sweep", "-p", "frequency=0"], "frequency = 0.0 Hz"),
+    (["buoy", "sweep", "-p", "frequency=nan"], "frequency = nan Hz"),
+    (["buoy", "sweep", "-p", "frequency=1e-300"], "time steps"),
+    (["buoy", "sweep", "-p", "frequency=0.5:1:99999999999999999999"], "more than 10000"),
+    (["buoy", "sweep", "-p", "drag_coefficient=0:1:5000", "-p", "amplitude=0.001:0.01:5000"],
+     "more than 1000000"),
+    (["buoy", "sweep", "-p", "string_beads=1e30"], "string_beads"),
+    (["buoy", "sweep", "-p", "attachment=top"], "attachment"),
+    (["buoy", "sweep", "-p", "cd=1"], "unknown study parameter 'cd'"),
+    (["buoy", "--case", "{binary}"], "not UTF-8 text"),
+    (["buoy", "--case", "{utf16}"], "UTF-16"),
+    (["buoy", "--count", "99999999999999999999999"], "--count"),
+    (["buoy", "--string-beads", "100000000000000000000"], "--string-beads"),
+    (["buoy", "--fit-periods", "100000000000"], "fit_periods"),
+    (["buoy", "--settle-periods", "1e308"], "settle_periods"),
+    (["buoy", "--dt", "1e-300"], "dt = 1e-300"),
+    (["buoy", "--amplitude", "1e400"], "--amplitude"),
+    (["buoy", "--workers", "0"], "--workers"),
+    (["buoy", "--attachment", "top"], "--attachment"),
+    (["buoy", "--models", "particle,foo"], "unknown model 'foo'"),
+    (["buoy", "--animate", "1", "--animation-frames", "10000000000000"], "--animation-frames"),
+    (["buoy", "--tank-motion", "{binary}"], "binary.toml"),
+    (["buoy", "calibrate", "--data", "{utf16}"], "utf16.toml"),
+    (["buoy", "calibrate", "--data", "{binary}", "--max-evaluations", "99999999999999"],
+     "--max-evaluations"),
+]
+
+
+@pytest.mark.parametrize(("arguments", "named"), HOSTILE, ids=[" ".join(a) for a, _ in HOSTILE])
+def test_hostile_input_is_a_typed_error_with_exit_code_2(tmp_path, capsys, arguments, named):
+    binary, utf16 = _hostile_files(tmp_path)
+    arguments = [a.format(binary=binary, utf16=utf16) for a in arguments]
+    code = _exit_code([*arguments, "--output", str(tmp_path / "out"), "--no-progress"])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert "error" in err and named in err
+    assert "Traceback" not in err
+    assert not (tmp_path / "out" / "sweep.csv").exists()  # nothing ran
+
+
+def test_output_folder_that_cannot_exist_is_refused_before_the_runs(tmp_path, capsys):
+    # Before the fix the whole sweep ran, then writing failed with NotADirectoryError.
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    code = _exit_code(["buoy", "--output", str(blocker / "out"), "--count", "1",
+                       "--f-max", "0.5", "--no-progress"])
+    assert code == 2
+    assert "cannot create the output folder" in capsys.readouterr().err
+
+
+def test_buoy_help_gives_units_and_valid_values(capsys):
+    with pytest.raises(SystemExit):
+        cli.main(["buoy", "--help"])
+    text = " ".join(capsys.readouterr().out.split())  # argparse wraps lines
+    # Every case and sweep option states its unit (case.UNITS, read off the dataclass
+    # docstrings), e.g. "--amplitude AMPLITUDE in m (default: 0.005)".
+    from vinculo.buoy.case import UNITS
+
+    for name, unit in UNITS.items():
+        if name in ("tank_size", "attachment"):
+            continue
+        option = "--" + name.replace("_", "-")
+        stated = {"count": "a count", "dimensionless": "dimensionless"}.get(unit, f"in {unit}")
+        assert re.search(rf"{option} \S+ {re.escape(stated)} \(default", text), option
+    assert "{bottom,centre}" in text  # the valid --attachment values
+    unwrapped = re.sub(r"(\w)- (\w)", r"\1-\2", text)  # argparse may break at a hyphen
+    assert "from: particle, two-dof, one-dof" in unwrapped  # the valid --models values
+    assert re.search(r"--animate FREQ .*\(Hz\)", text)
+    assert re.search(r"--tank-smoothing LAM .*s\^3", text)

@@ -110,3 +110,29 @@ def test_progress_bar_draws_the_fraction_done():
     bar(3.0, 3.0)
     bar.close()
     assert stream.getvalue().endswith("\n") and "100.0%" in stream.getvalue()
+
+
+def test_a_solution_keeps_working_after_its_system_is_edited(tmp_path):
+    # A pendulum bob of 0.4 kg on a 0.75 m string; after the run the user adds a particle, a
+    # spring and a link to the same System. Before, the solution read the edited system: its
+    # energies, counts and tensions no longer described the run.
+    # References: the energies from their definitions with the run's masses, and the static
+    # tension 2 lambda L with the run's length.
+    system = vinculo.System(gravity=(0.0, 0.0, -9.81))
+    bob = system.add_particle(0.4, (0.45, 0.0, -0.6))  # 0.75 m from the pivot
+    rod = system.add_distance_to_point(bob, (0.0, 0.0, 0.0), 0.75)
+    solution = vinculo.simulate(system, 0.3, 1e-2)
+    kinetic_before = solution.kinetic_energy().copy()
+    other = system.add_particle(2.0, (1.0, 0.0, 0.0))
+    system.add_spring_damper(bob, other, 10.0)
+    system.add_distance(bob, other, 0.8)
+    assert system.num_particles == 2 and solution.system.num_particles == 1
+    assert solution.system.num_constraints == 1
+    kinetic = 0.5 * 0.4 * np.sum(solution.velocities[:, 0] ** 2, axis=1)
+    potential = 0.4 * 9.81 * solution.positions[:, 0, 2]
+    np.testing.assert_allclose(solution.kinetic_energy(), kinetic, rtol=1e-13, atol=1e-15)
+    np.testing.assert_array_equal(solution.kinetic_energy(), kinetic_before)
+    np.testing.assert_allclose(solution.potential_energy(), potential, rtol=1e-13, atol=1e-15)
+    tension = solution.distance_tension(rod)  # the run's length, 0.75 m
+    np.testing.assert_allclose(tension, 2.0 * 0.75 * solution.multiplier(rod), rtol=1e-15)
+    assert "(1 particles, 1 constraint equations)" in solution.summary()

@@ -70,6 +70,9 @@ class UserGroup:
 
 class System:
     def __init__(self, gravity: Sequence[float] = (0.0, 0.0, 0.0)) -> None: ...
+    def copy(self) -> System:
+        """An independent copy of the system as it is now; handles of this system work with it."""
+    def __copy__(self) -> System: ...
     def add_particle(self, mass: float, position: Sequence[float],
                      velocity: Sequence[float] = (0.0, 0.0, 0.0), fixed: bool = False) -> ParticleId: ...
     def add_distance(self, a: ParticleId, b: ParticleId, length: float | None = None) -> ConstraintId:

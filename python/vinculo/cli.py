@@ -22,21 +22,80 @@ view of the run as an animation (default ``DIR/buoy_<FREQ>Hz.gif``). ``buoy swee
 parameter study (:mod:`vinculo.buoy.parameter_study`) and ``buoy calibrate`` fits the fluid
 coefficients to measurements (:mod:`vinculo.buoy.calibration`).
 
-Exit codes: 0 on success, 1 when a simulation fails, 2 on bad arguments.
+Exit codes: 0 on success, 1 when a simulation fails, 2 on bad arguments (an option, a value or an
+input file), 130 after Ctrl-C (``vinculo buoy`` first writes the runs that finished).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import math
+import signal
 import sys
-from collections.abc import Callable, Sequence
+import time
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
 from vinculo import __version__, demos
-from vinculo.errors import VinculoError
+from vinculo.errors import InvalidInputError, VinculoError
 
 __all__ = ["main"]
+
+
+def _count(low: int, high: int) -> Callable[[str], int]:
+    """An argparse type: a whole number from ``low`` to ``high`` (a usage error otherwise)."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(
+                f"{text} is out of range: give a whole number from {low} to {high}"
+            )
+        return value
+
+    parse.__name__ = "whole number"  # argparse names the type in its messages
+    return parse
+
+
+_workers = _count(1, 1024)
+_frames = _count(1, 100_000)
+
+
+def _number(kind: type, option: str) -> Callable[[str], Any]:
+    """An argparse type for a case or sweep option: a finite float, or a whole number that fits
+    in 64 bits (the fields check their own ranges)."""
+
+    def parse(text: str) -> Any:
+        if kind is int:
+            try:
+                value = int(text)
+            except ValueError:
+                raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+            if abs(value) >= 2**63:
+                raise argparse.ArgumentTypeError(f"{text} is out of range")
+            return value
+        if kind is float:
+            try:
+                value = float(text)
+            except ValueError:
+                raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+            if not math.isfinite(value):
+                raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+            return value
+        return text
+
+    parse.__name__ = "number" if kind in (int, float) else "text"
+    return parse
+
+
+def _unit_text(unit: str) -> str:
+    """How a help text states a unit: ``"in m"``, or ``"a count"`` and ``"dimensionless"``."""
+    return {"count": "a count", "dimensionless": "dimensionless"}.get(unit, f"in {unit}")
 
 
 def _build_parser() -> argparse.ArgumentParser:
@@ -100,23 +159,24 @@ def _add_buoy_parser(commands: Any) -> None:
                       help="penalty lam (s^3) of the records' smoothing spline (0 interpolates; "
                       "default: fit within the noise estimated from the record)")
     buoy.add_argument("--models", default="particle,two-dof,one-dof",
-                      help="comma-separated models to run (default: all three)")
+                      help="comma-separated models to run, from: particle, two-dof, one-dof "
+                      "(default: all three)")
     buoy.add_argument("--history-frequencies", metavar="F1,F2,...", default=None,
                       help="frequencies (Hz) whose time histories to keep and plot, each run "
                       "(added to the sweep when not on its grid; 'none' for none). Default: the "
                       "paper's 0.8, 0.9 and 1.1 Hz that lie within the sweep's range")
-    buoy.add_argument("--workers", type=int, default=None,
-                      help="worker processes (default: one per CPU)")
+    buoy.add_argument("--workers", metavar="N", type=_workers, default=None,
+                      help="worker processes, a count from 1 to 1024 (default: one per CPU)")
     buoy.add_argument("--no-progress", action="store_true", help="do not draw a progress bar")
     buoy.add_argument("--animate", metavar="FREQ", type=float, default=None,
-                      help="instead of the sweep, run the particle model at FREQ Hz and write a "
+                      help="instead of the sweep, run the particle model at FREQ (Hz) and write a "
                       "side view of the run as an animation")
     buoy.add_argument("--animation-file", metavar="PATH", type=Path, default=None,
                       help="the animation's file, .gif or .mp4 (mp4 needs ffmpeg; default: "
                       "DIR/buoy_<FREQ>Hz.gif)")
-    buoy.add_argument("--animation-frames", metavar="N", type=int, default=250,
-                      help="the most frames, at 25 per simulated second: the animation shows "
-                      "the last N/25 s of the run (default: 250)")
+    buoy.add_argument("--animation-frames", metavar="N", type=_frames, default=250,
+                      help="the most frames (a count from 1 to 100000), at 25 per simulated "
+                      "second: the animation shows the last N/25 s of the run (default: 250)")
     _add_case_options(buoy)
     buoy.set_defaults(handler=_buoy)
 
@@ -125,10 +185,12 @@ def _add_case_options(parser: argparse.ArgumentParser) -> None:
     """``--case FILE.toml`` and every case and sweep parameter as an option."""
     import dataclasses
 
-    from vinculo.buoy import BuoyCase, SweepSettings
+    from vinculo.buoy import ATTACHMENTS, BuoyCase, SweepSettings
+    from vinculo.buoy.case import UNITS
 
     parser.add_argument("--case", metavar="FILE.toml", type=Path,
-                        help="TOML file with a [case] and/or [sweep] table; options override it")
+                        help="TOML file (UTF-8) with a [case] and/or [sweep] table; options "
+                        "override it")
     for cls, table in [(BuoyCase, "case"), (SweepSettings, "sweep")]:
         group = parser.add_argument_group(
             f"{table} parameters (override the TOML [{table}] table)"
@@ -138,9 +200,16 @@ def _add_case_options(parser: argparse.ArgumentParser) -> None:
                 continue
             kind = type(f.default)
             option = "--" + f.name.replace("_", "-")
+            if f.name == "attachment":
+                group.add_argument(option, dest=f"{table}__{f.name}", choices=ATTACHMENTS,
+                                   default=None,
+                                   help=f"where the string is tied: {ATTACHMENTS[0]} (the "
+                                   f"sphere's lowest point) or {ATTACHMENTS[1]} (default: "
+                                   f"{f.default})")
+                continue
             group.add_argument(option, dest=f"{table}__{f.name}", metavar=f.name.upper(),
-                               type=kind if kind in (int, float) else str, default=None,
-                               help=f"default: {f.default}")
+                               type=_number(kind, option), default=None,
+                               help=f"{_unit_text(UNITS[f.name])} (default: {f.default})")
 
 
 def _case_and_settings(args: argparse.Namespace) -> tuple[Any, Any]:
@@ -181,7 +250,8 @@ def _study_parser() -> argparse.ArgumentParser:
                         "grid); NAME is a case parameter (drag_coefficient, amplitude, ...), "
                         "frequency, dt, settle_periods or fit_periods")
     parser.add_argument("--models", default="particle",
-                        help="comma-separated models to run at each point (default: particle)")
+                        help="comma-separated models to run at each point, from: particle, "
+                        "two-dof, one-dof (default: particle)")
     parser.add_argument("--retry-failed", action="store_true",
                         help="run again the points whose earlier run failed")
     _add_execution_options(parser, "study", "study.csv and the plot")
@@ -212,9 +282,11 @@ def _calibrate_parser() -> argparse.ArgumentParser:
                         "amplitude)")
     parser.add_argument("--model", default="particle",
                         help="the model to fit: particle, two-dof or one-dof (default: particle)")
-    parser.add_argument("--max-evaluations", type=int, default=60,
-                        help="most model sweeps the optimiser may run (default: 60)")
-    parser.add_argument("--curve-points", type=int, default=21,
+    parser.add_argument("--max-evaluations", metavar="N", type=_count(1, 100_000), default=60,
+                        help="most model sweeps the calibration runs, a count: the optimiser's "
+                        "steps, its finite differences and the fitted curve all count "
+                        "(default: 60)")
+    parser.add_argument("--curve-points", metavar="N", type=_count(0, 10_000), default=21,
                         help="frequencies of the fitted curve drawn over the data (default: 21; "
                         "0: only at the measured frequencies)")
     _add_execution_options(parser, "calibration", "the results")
@@ -228,8 +300,9 @@ def _add_execution_options(parser: argparse.ArgumentParser, folder: str, holds: 
     parser.add_argument("--output", "-o", metavar="DIR", type=Path,
                         default=Path("output") / folder,
                         help=f"folder of {holds} (default: output/{folder})")
-    parser.add_argument("--workers", type=int, default=None,
-                        help="local worker processes (default: one per CPU)")
+    parser.add_argument("--workers", metavar="N", type=_workers, default=None,
+                        help="local worker processes, a count from 1 to 1024 (default: one per "
+                        "CPU)")
     parser.add_argument("--scheduler", metavar="ADDRESS",
                         help="run on an existing Dask distributed cluster (tcp://host:8786)")
     parser.add_argument("--no-progress", action="store_true", help="show no progress")
@@ -292,11 +365,16 @@ def _buoy_calibrate(args: argparse.Namespace, parser: argparse.ArgumentParser) -
     data = read_measurements(args.data, motion=args.data_motion)
     names = [n.strip() for n in args.fit.split(",") if n.strip()]
     output = _output_folder(args.output, parser)
-    result = calibrate(
-        data, case=case, settings=settings, parameters=names, model=args.model,
-        workers=args.workers, scheduler=args.scheduler, max_evaluations=args.max_evaluations,
-        curve_points=args.curve_points, progress=not args.no_progress,
-    )
+    try:
+        result = calibrate(
+            data, case=case, settings=settings, parameters=names, model=args.model,
+            workers=args.workers, scheduler=args.scheduler, max_evaluations=args.max_evaluations,
+            curve_points=args.curve_points, progress=not args.no_progress,
+        )
+    except KeyboardInterrupt:
+        print("vinculo buoy calibrate: interrupted; nothing written (a calibration does not "
+              "resume: run it again)", file=sys.stderr, flush=True)
+        return 130
     paths = write_calibration(result, output)
     print(result.summary(), flush=True)
     print(f"results: {len(paths)} files in {output}", flush=True)
@@ -333,7 +411,7 @@ def _buoy(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     """Run the buoy study and write its report into args.output."""
     from vinculo.buoy import read_measurements, read_tank_motion
     from vinculo.buoy.report import summary, write_report
-    from vinculo.buoy.study import run_study
+    from vinculo.buoy.study import _draw, run_study
 
     case, settings = _case_and_settings(args)
     data = read_measurements(args.data, motion=args.data_motion) if args.data else None
@@ -345,10 +423,25 @@ def _buoy(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     if args.animate is not None:
         return _buoy_animation(args, parser, case, settings)
     history = _history_frequencies(args.history_frequencies, parser)
-    study = run_study(case, settings, models=models, workers=args.workers,
-                      progress=not args.no_progress, motions=motions,
-                      history_frequencies=history)
     sources = _parameter_sources(args)
+    _output_folder(output, parser)  # before the runs, so that a bad folder costs nothing
+    finished: list[Any] = []
+    started = time.perf_counter()
+
+    def collect(done: int, total: int, result: Any) -> None:
+        finished.append(result)
+        if not args.no_progress:
+            _draw(sys.stderr, done, total, result, time.perf_counter() - started)
+
+    try:
+        study = run_study(case, settings, models=models, workers=args.workers,
+                          progress=collect, motions=motions, history_frequencies=history)
+    except KeyboardInterrupt:
+        if finished and not args.no_progress:
+            print(file=sys.stderr, flush=True)  # end the progress bar's line
+        return _buoy_interrupted(finished, case, settings, output, data, started, sources)
+    if finished and not args.no_progress:
+        print(file=sys.stderr, flush=True)
     paths = write_report(study, output, data, sources)
     print(summary(study, sources), flush=True)
     print(f"results: {len(paths)} files in {output}", flush=True)
@@ -395,6 +488,46 @@ def _parameter_sources(args: argparse.Namespace) -> dict[str, str]:
         prefix = "" if table == "case" else "sweep."
         sources[prefix + name] = f"option --{name.replace('_', '-')}"
     return sources
+
+
+def _buoy_interrupted(
+    finished: list[Any],
+    case: Any,
+    settings: Any,
+    output: Path,
+    data: Any,
+    started: float,
+    sources: dict[str, str],
+) -> int:
+    """After Ctrl-C of the study: write the runs that finished, say so in one line, exit 130."""
+    from vinculo.buoy.report import write_report
+    from vinculo.buoy.study import MODELS, StudyResult
+
+    order = {m: i for i, m in enumerate(MODELS)}
+    runs = sorted(finished, key=lambda r: (order[r.model], r.frequency, r.record or ""))
+    kept = ""
+    if any(r.response is not None for r in runs):
+        partial = StudyResult(case, settings, runs, time.perf_counter() - started, 0)
+        try:
+            with _deferred_interrupts():
+                paths = write_report(partial, output, data, sources)
+            kept = f"; the {len(runs)} finished runs are in {len(paths)} files in {output}"
+        except (VinculoError, OSError, ValueError) as error:
+            kept = f"; writing the {len(runs)} finished runs failed: {error}"
+    print(f"vinculo buoy: interrupted{kept or ' before any run finished; nothing written'}",
+          file=sys.stderr, flush=True)
+    return 130
+
+
+@contextlib.contextmanager
+def _deferred_interrupts() -> Iterator[None]:
+    """Ignore further Ctrl-C while the partial results are written (a second one would leave
+    the report half-written; every file is written under a temporary name, then renamed)."""
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def _buoy_animation(
@@ -456,7 +589,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         argv: the arguments (default: ``sys.argv[1:]``).
 
     Returns:
-        The exit code: 0 on success, 1 if a simulation failed.
+        The exit code: 0 on success, 1 if a simulation failed, 2 for a bad argument or input
+        file (an :class:`~vinculo.errors.InvalidInputError`), 130 after Ctrl-C.
 
     Raises:
         SystemExit: with code 2 on bad arguments (from argparse), or 0 after ``--help``.
@@ -470,9 +604,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         return int(args.handler(args, parser))
+    except InvalidInputError as exc:  # a bad argument, option value or input file
+        print(f"{parser.prog}: error: {exc}", file=sys.stderr)
+        return 2
     except VinculoError as exc:
-        print(f"vinculo: error: {exc}", file=sys.stderr)
+        print(f"{parser.prog}: error: {exc}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt:
+        print(f"{parser.prog}: interrupted", file=sys.stderr, flush=True)
+        return 130
 
 
 if __name__ == "__main__":

@@ -233,7 +233,10 @@ def simulate(
     # A user function's own exception (with its traceback), chained as the cause; it is not
     # part of the solution (which is saved to files).
     cause = data["error"].pop("cause", None) if data.get("error") is not None else None
-    solution = Solution.from_core(data, system)
+    # The solution keeps its own copy of the system, so that editing the system afterwards
+    # (adding particles, constraints or forces) leaves the solution's metadata and energies
+    # those of the run.
+    solution = Solution.from_core(data, system.copy())
     if solution.error is not None:
         raise _convergence_error(solution.error, solution) from cause
     return solution

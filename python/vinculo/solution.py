@@ -65,7 +65,8 @@ class Solution:
         error: None after a complete run; for the partial solution carried by a
             :class:`vinculo.ConvergenceError`, the core's description of the failure (keys
             'kind', 'message', 'time', 'step_size', 'residual', 'iterations', 'equation').
-        system: the :class:`vinculo.System` that was simulated.
+        system: a copy of the :class:`vinculo.System` that was simulated, taken when the run
+            ended (:meth:`vinculo.System.copy`): later edits of the original do not reach it.
         linear_solver: the linear solver the run used: 'dense LU' (small systems),
             'tree elimination' (tree-shaped constraint graphs: chains, ropes, branched strings)
             or 'sparse LU' (graphs with loops; and every GGL run above the dense size).

@@ -103,3 +103,59 @@ def test_cli_calibrate_writes_results(tmp_path, capsys):
     assert not list(output.glob(".*partial"))
     assert "drag_coefficient" in capsys.readouterr().out
     assert math.isfinite(float(sd))
+
+
+def _oscillator(case, settings, frequencies, *, model="particle", motion="absolute", pool=None):
+    """A closed-form stand-in for a model sweep: a linear oscillator of mass m_s + Ca m_f,
+    damping proportional to Cd and the buoyant stiffness of the 1-DOF pendulum, forced by
+    (m_f - m_s) X0 w^2 (amplitude and phase of x = A sin(w t + phase), the steady state of
+    m x'' + c x' + k x = F sin(w t))."""
+    w = 2.0 * np.pi * np.asarray(frequencies, dtype=float)
+    mass = case.sphere_mass + case.added_mass
+    stiffness = (case.displaced_mass - case.sphere_mass) * case.gravity / case.pendulum_length
+    damping = 4.0 * case.drag_coefficient
+    force = (case.displaced_mass - case.sphere_mass) * case.amplitude * w**2
+    denominator = (stiffness - mass * w**2) + 1j * damping * w
+    response = force / denominator
+    return np.abs(response), np.degrees(np.angle(response))
+
+
+def test_max_evaluations_bounds_every_model_sweep(tmp_path, monkeypatch, capsys):
+    # Before, least_squares' max_nfev left out the sweeps of its finite differences (and the
+    # fitted curve came on top): --max-evaluations 10 ran 17 sweeps. Counted here by wrapping
+    # the one function that runs a sweep; the model is the closed-form oscillator above, so
+    # the fit itself is exact and quick.
+    from vinculo.buoy import calibration
+
+    calls: list[int] = []
+
+    def counted(*args, **kwargs):
+        calls.append(len(args[2]))
+        return _oscillator(*args, **kwargs)
+
+    monkeypatch.setattr(calibration, "model_curve", counted)
+    truth = dataclasses.replace(BuoyCase(), **TRUE)
+    amplitude, phase = _oscillator(truth, SETTINGS, FREQUENCIES)
+    path = tmp_path / "measured.csv"
+    path.write_text("frequency, amplitude, phase\n" + "".join(
+        f"{f!r}, {float(a)!r}, {float(p)!r}\n"
+        for f, a, p in zip(FREQUENCIES.tolist(), amplitude, phase, strict=True)
+    ))
+    code = main(["buoy", "calibrate", "--data", str(path), "--max-evaluations", "10",
+                 "--workers", "1", "-o", str(tmp_path / "cal"), "--no-progress"])
+    assert code in (0, 1)  # 1: stopped by the budget before convergence
+    assert 1 <= len(calls) <= 10
+    assert f"{len(calls)} model sweeps" in capsys.readouterr().out
+    # With room to converge, the same fit recovers the coefficients of the exact data (the
+    # optimiser's tolerance, 1e-8 relative in cost, leaves them to about 1e-6), within budget.
+    calls.clear()
+    data = read_measurements(path)
+    result = calibrate(data, workers=1, progress=False, max_evaluations=40)
+    assert result.success and 1 <= len(calls) <= 40 and result.evaluations == len(calls)
+    for name, value in zip(result.names, result.values, strict=True):
+        assert value == pytest.approx(TRUE[name], rel=1e-5)
+    # Too small a budget for one Jacobian is refused before anything runs.
+    calls.clear()
+    with pytest.raises(InvalidInputError, match="max_evaluations = 3"):
+        calibrate(data, workers=1, progress=False, max_evaluations=3)
+    assert calls == []

@@ -2,6 +2,7 @@
 
 import dataclasses
 import math
+from decimal import Decimal
 
 import numpy as np
 import pytest
@@ -131,7 +132,14 @@ def test_mapping_accepts_integers_for_lengths():
 
 def test_sweep_defaults_and_frequencies():
     sweep = SweepSettings()
-    assert np.array_equal(sweep.frequencies, np.linspace(0.5, 1.5, 21))
+    # The grid is linspace's, to round-off, and every point is the decimal number it stands
+    # for (reference: exact decimal arithmetic), so sweep.csv shows 0.85, not 0.8500000000000001.
+    assert np.allclose(sweep.frequencies, np.linspace(0.5, 1.5, 21), rtol=1e-12, atol=0)
+    decimal = [float(Decimal("0.5") + Decimal("0.05") * k) for k in range(21)]
+    assert sweep.frequencies.tolist() == decimal
+    assert [repr(f) for f in SweepSettings(f_min=0.1, f_max=0.7, count=7).frequencies.tolist()] == [
+        "0.1", "0.2", "0.3", "0.4", "0.5", "0.6", "0.7"
+    ]
     assert sweep.frequencies[1] - sweep.frequencies[0] == pytest.approx(0.05, rel=1e-12)
     # A run lasts settle + fit periods.
     assert sweep.t_end(0.5) == pytest.approx((30 + 10) / 0.5, rel=1e-15)

@@ -7,6 +7,7 @@ with the same case and settings (the study must reproduce it exactly, wherever i
 from __future__ import annotations
 
 import dataclasses
+import socket
 
 import numpy as np
 import pytest
@@ -108,13 +109,32 @@ def test_unreachable_scheduler_is_a_typed_error_and_writes_nothing(tmp_path):
     assert not (tmp_path / "study.csv").exists()
 
 
+def _occupy(port: int) -> socket.socket | None:
+    """Listen on ``port`` (None if something else already does: it is occupied either way)."""
+    sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    try:
+        sock.bind(("", port))
+        sock.listen(1)
+    except OSError:
+        sock.close()
+        return None
+    return sock
+
+
 def test_dask_local_cluster_gives_the_same_results(tmp_path):
     distributed = pytest.importorskip("distributed")
     points = grid({"drag_coefficient": [0.2, 0.3], "frequency": [0.9]})
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster:
-        study = run_parameter_study(points, settings=SETTINGS, output=tmp_path,
-                                    scheduler=cluster.scheduler_address, progress=False)
+    # Dask's default dashboard port, 8787, taken first: the cluster must not need it (Dask reads
+    # dashboard_address=None as 8787 and warns, an error under pytest; ":0" takes a free port).
+    blocker = _occupy(8787)
+    try:
+        with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                      dashboard_address=":0") as cluster:
+            study = run_parameter_study(points, settings=SETTINGS, output=tmp_path,
+                                        scheduler=cluster.scheduler_address, progress=False)
+    finally:
+        if blocker is not None:
+            blocker.close()
     assert study.workers.startswith("dask tcp://") and study.computed == 2
     for row in study.rows:
         assert row.results["relative_amplitude"] == pytest.approx(
@@ -136,5 +156,5 @@ def test_cli_sweep_writes_table_and_plot(tmp_path, capsys):
     amplitude = {float(r.split(",")[0]): float(r.split(",")[7]) for r in rows[1:]}
     assert amplitude[0.1] > amplitude[0.4]
     assert np.isclose(amplitude[0.1], _direct({"drag_coefficient": 0.1, "frequency": 0.9}))
-    assert main(["buoy", "sweep", "-p", "cd=1", "-o", str(tmp_path)]) == 1
+    assert main(["buoy", "sweep", "-p", "cd=1", "-o", str(tmp_path)]) == 2  # a bad argument
     assert "unknown study parameter 'cd'" in capsys.readouterr().err

@@ -155,6 +155,21 @@ impl PySystem {
         })
     }
 
+    /// An independent copy of the system as it is now (particles, constraints, forces, initial
+    /// state); later edits of either leave the other unchanged. Handles of this system work with
+    /// the copy. A `Solution` holds such a copy, taken when its run ended.
+    fn copy(&self) -> PySystem {
+        PySystem {
+            inner: self.inner.clone(),
+            // The user groups (cloned with `inner`) report their exceptions to this slot.
+            user_errors: self.user_errors.clone(),
+        }
+    }
+
+    fn __copy__(&self) -> PySystem {
+        self.copy()
+    }
+
     /// Adds a point mass; returns its handle. Fixed particles never move.
     #[pyo3(signature = (mass, position, velocity=None, fixed=false))]
     fn add_particle(

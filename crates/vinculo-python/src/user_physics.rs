@@ -83,6 +83,20 @@ impl Calling {
         let array = match obj.extract::<PyReadonlyArrayDyn<'_, f64>>() {
             Ok(a) => a,
             Err(_) => {
+                // numpy would drop the imaginary parts (with only a ComplexWarning): refuse them.
+                let complex = py
+                    .import("numpy")
+                    .and_then(|np| np.getattr("iscomplexobj"))
+                    .and_then(|f| f.call1((obj,)))
+                    .and_then(|r| r.extract::<bool>())
+                    .unwrap_or(false);
+                if complex {
+                    return Err(UserFailure::Shape {
+                        returned: "a complex-valued array (its imaginary parts would be lost)"
+                            .to_string(),
+                        expected: format!("real floats of shape {expected}"),
+                    });
+                }
                 let converted = py
                     .import("numpy")
                     .and_then(|np| np.getattr("asarray"))
@@ -109,7 +123,7 @@ impl Calling {
         };
         if !shapes.iter().any(|s| s.as_slice() == array.shape()) {
             return Err(UserFailure::Shape {
-                returned: shape_text(array.shape()),
+                returned: format!("an array of shape {}", shape_text(array.shape())),
                 expected,
             });
         }

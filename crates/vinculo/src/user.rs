@@ -39,7 +39,7 @@ pub enum UserFailure {
     Raised(String),
     /// The function returned an array of another shape than the one expected.
     Shape {
-        /// The shape returned, e.g. "(10, 2)".
+        /// What was returned, e.g. "an array of shape (10, 2)".
         returned: String,
         /// The shape expected, e.g. "(10, 3)".
         expected: String,
@@ -65,7 +65,7 @@ impl UserFailure {
                 group: group.into(),
                 call: call.into(),
                 t,
-                problem: format!("returned an array of shape {returned}, expected {expected}"),
+                problem: format!("returned {returned}, expected {expected}"),
             },
             UserFailure::NonFinite { element } => Error::UserFunctionOutput {
                 group: group.into(),

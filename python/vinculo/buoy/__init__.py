@@ -1,5 +1,8 @@
 """The buoy case study: a buoyant sphere tethered to the floor of a shaken water tank.
 
+- :mod:`vinculo.buoy.study`: the sweep, every model at every frequency in parallel
+  (:func:`run_study`, also here);
+- :mod:`vinculo.buoy.model`: the particle model (:func:`run_particle_model`, also here);
 - :mod:`vinculo.buoy.case`: the study's parameters (:class:`BuoyCase`), the frequency sweep
   (:class:`SweepSettings`) and reading both from a TOML file;
 - :mod:`vinculo.buoy.reference`: the reference models integrated with scipy (the rigid pendulum of
@@ -37,6 +40,7 @@ from vinculo.buoy.harmonic import (
     steady_window,
     wrap_phase,
 )
+from vinculo.buoy.model import run_particle_model
 from vinculo.buoy.parameter_study import (
     ParameterStudy,
     grid,
@@ -50,6 +54,7 @@ from vinculo.buoy.reference import (
     antiresonance_frequency,
     high_frequency_ratio,
 )
+from vinculo.buoy.study import MODELS, StudyResult, run_study
 from vinculo.buoy.tank import (
     MOTION_COLUMNS,
     MeasuredTankMotion,
@@ -63,6 +68,7 @@ __all__ = [
     "ATTACHMENTS",
     "CALIBRATABLE",
     "COLUMNS",
+    "MODELS",
     "MOTIONS",
     "MOTION_COLUMNS",
     "PAPER_VALUES",
@@ -77,6 +83,7 @@ __all__ = [
     "ParameterStudy",
     "ReferenceRun",
     "SteadyResponse",
+    "StudyResult",
     "SweepSettings",
     "TankMotion",
     "TwoDofModel",
@@ -92,6 +99,8 @@ __all__ = [
     "read_measurements",
     "read_tank_motion",
     "run_parameter_study",
+    "run_particle_model",
+    "run_study",
     "steady_response",
     "steady_window",
     "tank_motion",

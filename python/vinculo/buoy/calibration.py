@@ -74,7 +74,7 @@ class Calibration:
         initial_amplitude, initial_phase_deg: the starting model there.
         curve_frequency, curve_amplitude, curve_phase_deg: the fitted model on an even grid over
             the measured range (for the plot; empty when ``curve_points`` was 0).
-        evaluations: model sweeps run (each: one run per measured frequency).
+        evaluations: model sweeps run (each: one run per frequency), the fitted curve included.
         success: whether the optimiser reported convergence; ``message`` says why it stopped.
         elapsed: wall time, in s.
     """
@@ -208,7 +208,11 @@ def calibrate(
         model: one of :data:`~vinculo.buoy.study.MODELS`.
         workers: local worker processes (default: one per CPU).
         scheduler: a Dask distributed scheduler address to run on instead.
-        max_evaluations: most model sweeps the optimiser may ask for.
+        max_evaluations: most model sweeps the whole calibration runs: the starting point, the
+            optimiser's steps, the forward differences of its Jacobian (one sweep per parameter)
+            and the fitted curve (one sweep when ``curve_points > 0``) all count. When the budget
+            runs out, the best point found is returned with ``success`` False. At least
+            ``len(parameters) + 1`` (+1 with a curve) are needed for one Jacobian.
         curve_points: frequencies of the fitted curve drawn over the data, evenly spread over
             the measured range (one more sweep; 0: none).
         progress: True prints one line per model sweep on ``stream`` (standard error); a
@@ -254,6 +258,18 @@ def calibrate(
             name="data",
             value=data.path,
         )
+    curve_sweeps = 1 if curve_points > 0 else 0
+    needed = len(names) + 1 + curve_sweeps
+    if not (isinstance(max_evaluations, int) and max_evaluations >= needed):
+        raise InvalidInputError(
+            f"max_evaluations = {max_evaluations!r} model sweeps is too few: fitting "
+            f"{len(names)} parameter(s) needs at least {needed} (the starting point, one per "
+            f"parameter for the Jacobian" + (", and the fitted curve)" if curve_sweeps else ")")
+            + f"; give max_evaluations >= {needed}",
+            name="max_evaluations",
+            value=max_evaluations,
+        )
+    budget = max_evaluations - curve_sweeps
     initial = np.array([float(getattr(case, n)) for n in names])
     for name, value in zip(names, initial, strict=True):
         if name in ("string_length", "amplitude") and value <= 0.0:
@@ -286,52 +302,90 @@ def calibrate(
     def case_at(x: np.ndarray) -> BuoyCase:
         return dataclasses.replace(case, **dict(zip(names, (x * scale).tolist(), strict=True)))
 
+    # Every sweep goes through evaluate(), which refuses to run more than the budget; the
+    # Jacobian is computed here (forward differences through evaluate) rather than by scipy,
+    # whose max_nfev does not count the sweeps of its finite differences.
+    costs: dict[tuple[float, ...], tuple[float, np.ndarray]] = {}
+    jacobians: list[tuple[np.ndarray, np.ndarray]] = []
+
     with open_executor(_workers(workers), scheduler) as (pool, how):
 
         def evaluate(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             key = tuple(np.round(x, 15))
             if key not in cache:
+                if len(cache) >= budget:
+                    raise _OutOfSweeps
                 trial = case_at(x)
                 cache[key] = model_curve(
                     trial, settings, data.frequency, model=model, motion=data.motion, pool=pool
                 )
                 values = ", ".join(f"{n} = {v:.6g}" for n, v in zip(names, x * scale, strict=True))
-                say(f"calibrate: sweep {len(cache)} ({how}): {values}")
+                say(f"calibrate: sweep {len(cache)} of at most {budget} ({how}): {values}")
             return cache[key]
 
         def residuals(x: np.ndarray) -> np.ndarray:
             amplitude, phase = evaluate(x)
-            return np.concatenate([
+            r = np.concatenate([
                 (amplitude - data.amplitude) / amplitude_sd,
                 wrap_phase_difference(phase - data.phase_deg) / phase_sd,
             ])
+            costs[tuple(np.round(x, 15))] = (float(np.sum(r**2)), np.array(x, dtype=float))
+            return r
+
+        def jacobian(x: np.ndarray) -> np.ndarray:
+            f0 = residuals(x)
+            columns = []
+            for j in range(x.size):
+                shifted = np.array(x, dtype=float)
+                shifted[j] += DIFF_STEP * max(1.0, abs(float(x[j])))
+                columns.append((residuals(shifted) - f0) / (shifted[j] - x[j]))
+            jac = np.column_stack(columns)
+            jacobians.append((np.array(x, dtype=float), jac))
+            return jac
 
         x0 = initial / scale
         start_amplitude, start_phase = evaluate(x0)
-        result = least_squares(
-            residuals,
-            x0,
-            jac="2-point",
-            diff_step=DIFF_STEP,
-            bounds=(np.zeros_like(x0), np.full_like(x0, np.inf)),
-            max_nfev=max_evaluations,
-            x_scale=1.0,
-        )
-        fitted_amplitude, fitted_phase = evaluate(result.x)
+        try:
+            result = least_squares(
+                residuals,
+                x0,
+                jac=jacobian,
+                bounds=(np.zeros_like(x0), np.full_like(x0, np.inf)),
+                max_nfev=budget,
+                x_scale=1.0,
+            )
+            best, jac = result.x, result.jac
+            success, message = bool(result.success), str(result.message)
+        except _OutOfSweeps:
+            best = min(costs.values(), key=lambda item: item[0])[1]
+            jac = jacobians[-1][1] if jacobians else None
+            success = False
+            message = (
+                f"stopped after {len(cache)} model sweeps (max_evaluations = "
+                f"{max_evaluations}); the best point found is reported, with uncertainties "
+                f"from the last Jacobian"
+            )
+        if jac is None:  # pragma: no cover - the budget check above leaves room for one
+            raise InvalidInputError(
+                "the sweep budget ran out before a Jacobian; raise max_evaluations",
+                name="max_evaluations", value=max_evaluations,
+            )
+        fitted_amplitude, fitted_phase = evaluate(best)
+        fitted_residuals = residuals(best)
         curve_frequency = np.linspace(
             float(np.min(data.frequency)), float(np.max(data.frequency)), max(curve_points, 0)
         )
         curve_amplitude, curve_phase = (
-            model_curve(case_at(result.x), settings, curve_frequency, model=model,
+            model_curve(case_at(best), settings, curve_frequency, model=model,
                         motion=data.motion, pool=pool)
             if curve_points > 0
             else (np.zeros(0), np.zeros(0))
         )
-    values = result.x * scale
-    chi_square = float(np.sum(result.fun**2))
+    values = best * scale
+    chi_square = float(np.sum(fitted_residuals**2))
     dof = m - len(names)
     # Covariance of x from the weighted Jacobian, by SVD (robust to a near-singular J).
-    _, singular, vt = np.linalg.svd(result.jac, full_matrices=False)
+    _, singular, vt = np.linalg.svd(jac, full_matrices=False)
     keep = singular > singular[0] * 1e-12
     covariance_x = (vt[keep].T / singular[keep] ** 2) @ vt[keep]
     if not absolute_weights:
@@ -349,22 +403,26 @@ def calibrate(
         chi_square=chi_square,
         degrees_of_freedom=dof,
         absolute_weights=absolute_weights,
-        case=case_at(result.x),
+        case=case_at(best),
         model=model,
         data=data,
         fitted_amplitude=fitted_amplitude,
         fitted_phase_deg=fitted_phase,
         initial_amplitude=start_amplitude,
         initial_phase_deg=start_phase,
-        evaluations=len(cache),
-        success=bool(result.success),
-        message=str(result.message),
+        evaluations=len(cache) + curve_sweeps,
+        success=success,
+        message=message,
         elapsed=time.perf_counter() - started,
         log=log,
         curve_frequency=curve_frequency,
         curve_amplitude=curve_amplitude,
         curve_phase_deg=curve_phase,
     )
+
+
+class _OutOfSweeps(Exception):
+    """Raised inside the optimiser when the next model sweep would exceed the budget."""
 
 
 def _workers(workers: int | None) -> int:

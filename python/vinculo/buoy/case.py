@@ -43,6 +43,7 @@ __all__ = [
     "ASSUMPTIONS",
     "ATTACHMENTS",
     "PAPER_VALUES",
+    "UNITS",
     "VISCOUS_FORCES",
     "BuoyCase",
     "SweepSettings",
@@ -92,6 +93,48 @@ ASSUMPTIONS: dict[str, str] = {
     "free surface, no sloshing); an open tank would slosh (first mode near 1.43 Hz for the "
     "study's tank, inside the sweep)",
 }
+
+
+#: The unit (or kind of value) of every field of :class:`BuoyCase` and :class:`SweepSettings`,
+#: for help texts and tables.
+UNITS: dict[str, str] = {
+    "diameter": "m",
+    "sphere_density": "kg/m^3",
+    "fluid_density": "kg/m^3",
+    "string_length": "m",
+    "attachment": "one of " + ", ".join(ATTACHMENTS),
+    "drag_coefficient": "dimensionless",
+    "added_mass_coefficient": "dimensionless",
+    "gravity": "m/s^2",
+    "amplitude": "m",
+    "ramp_periods": "periods of the excitation",
+    "string_beads": "count",
+    "string_mass": "kg",
+    "tank_size": "m",
+    "f_min": "Hz",
+    "f_max": "Hz",
+    "count": "count",
+    "dt": "s",
+    "settle_periods": "periods of the excitation",
+    "fit_periods": "whole periods",
+}
+#: Largest whole-number settings: beyond them a run could not be held in memory (or finish).
+MAX_STRING_BEADS = 10_000
+MAX_COUNT = 10_000
+MAX_FIT_PERIODS = 10_000
+#: Most time steps one run of a sweep may take (its longest run, at f_min).
+MAX_STEPS = 10**9
+
+
+def _at_most(owner: str, name: str, value: int, limit: int, why: str) -> None:
+    """Raise unless the whole number ``value`` is at most ``limit``."""
+    if value > limit:
+        raise InvalidInputError(
+            f"{owner}.{name} = {value!r} is out of range: at most {limit} ({why}); give a "
+            f"smaller value",
+            name=name,
+            value=value,
+        )
 
 
 def _is_number(value: Any) -> bool:
@@ -224,6 +267,8 @@ class BuoyCase:
                 name="string_beads",
                 value=self.string_beads,
             )
+        _at_most(owner, "string_beads", self.string_beads, MAX_STRING_BEADS,
+                 "each bead is a particle of the model")
         if self.string_beads > 0 and self.string_mass == 0.0:
             raise InvalidInputError(
                 f"BuoyCase.string_mass is 0 but string_beads is {self.string_beads}: beads must "
@@ -471,6 +516,7 @@ class SweepSettings:
                 name="count",
                 value=self.count,
             )
+        _at_most(owner, "count", self.count, MAX_COUNT, "frequencies in one sweep")
         if self.f_max < self.f_min:
             raise InvalidInputError(
                 f"SweepSettings.f_max = {self.f_max!r} Hz is below f_min = {self.f_min!r} Hz; "
@@ -498,6 +544,18 @@ class SweepSettings:
                 name="fit_periods",
                 value=self.fit_periods,
             )
+        _at_most(owner, "fit_periods", self.fit_periods, MAX_FIT_PERIODS,
+                 "periods in one fit window")
+        longest = (self.settle_periods + self.fit_periods) / (self.f_min * self.dt)
+        if not longest <= MAX_STEPS:
+            raise InvalidInputError(
+                f"SweepSettings: the run at f_min = {self.f_min!r} Hz would take {longest:.3g} "
+                f"steps of dt = {self.dt!r} s over settle_periods + fit_periods = "
+                f"{self.settle_periods!r} + {self.fit_periods!r} periods, more than "
+                f"{MAX_STEPS:.0e}; give fewer periods, a larger dt or a higher f_min",
+                name="settle_periods",
+                value=self.settle_periods,
+            )
         steps_per_period = 1.0 / (self.f_max * self.dt)
         if steps_per_period < 20.0:
             raise InvalidInputError(
@@ -510,8 +568,13 @@ class SweepSettings:
 
     @property
     def frequencies(self) -> np.ndarray:
-        """The excitation frequencies, in Hz: ``np.linspace(f_min, f_max, count)``."""
-        return np.linspace(self.f_min, self.f_max, self.count)
+        """The excitation frequencies, in Hz: ``np.linspace(f_min, f_max, count)``.
+
+        Each is rounded to 12 significant digits, far below any physical resolution, so that
+        grid points are the decimal numbers they stand for (0.85, not 0.8500000000000001).
+        """
+        grid = np.linspace(self.f_min, self.f_max, self.count)
+        return np.array([float(f"{f:.12g}") for f in grid])
 
     def t_end(self, frequency: float, extension: int = 0) -> float:
         """Duration of the run at ``frequency``: ``(settle_periods + fit_periods) / frequency``.
@@ -660,6 +723,14 @@ def _read_toml(path: str | Path) -> dict[str, Any]:
     except tomllib.TOMLDecodeError as error:
         raise InvalidInputError(
             f"case file {str(path)!r} is not valid TOML: {error}",
+            name="path",
+            value=str(path),
+        ) from None
+    except UnicodeDecodeError as error:
+        raise InvalidInputError(
+            f"case file {str(path)!r} is not UTF-8 text (byte {error.start} is "
+            f"{error.object[error.start : error.start + 1]!r}): it is binary or in another "
+            f"encoding such as UTF-16; save it as UTF-8 TOML",
             name="path",
             value=str(path),
         ) from None

@@ -6,6 +6,10 @@ letter case, a unit in parentheses or brackets allowed, as in ``time (s)``; othe
 ignored); without a header the required columns come in their stated order. Anything after ``#``
 on a line is a comment, and blank lines are skipped. Every error names the file and, where there
 is one, the line (1-based), and quotes it.
+
+Plain numeric rows are parsed by :func:`numpy.loadtxt` (a record of 10^6 samples reads in about
+a second); anything else (quoted fields, empty optional fields, a malformed row) goes through a
+line-by-line reader that also finds and names the first bad line.
 """
 
 from __future__ import annotations
@@ -32,21 +36,22 @@ class Table:
     Attributes:
         values: one row per data line, one column per required column, shape (n, k).
         lines: the 1-based line number of each row, shape (n,).
-        texts: the text of each data line (stripped), for messages that quote it.
+        source: every line of the file, for messages that quote one.
         path: the file read.
         name: the ``name`` given to errors about it.
     """
 
     values: np.ndarray
     lines: np.ndarray
-    texts: list[str]
+    source: list[str]
     path: Path
     name: str = "data"
 
     def error(self, row: int, message: str) -> InvalidInputError:
         """An error about data row ``row`` (0-based), naming its line and quoting it."""
+        line = int(self.lines[row])
         return table_error(
-            f"{message}: {self.texts[row]!r}", self.path, int(self.lines[row]), self.name
+            f"{message}: {self.source[line - 1].strip()!r}", self.path, line, self.name
         )
 
 
@@ -107,46 +112,107 @@ def read_table(
         reason = getattr(error, "strerror", None) or str(error)
         raise table_error(f"cannot read the {what}: {reason}", path, None, name) from None
 
+    source = text.splitlines()
+    contents = [line.split("#", 1)[0] for line in source] if "#" in text else source
+    data_lines = [k for k, content in enumerate(contents) if content.strip()]
     indices: dict[str, int] | None = None
     width = len(columns)
-    rows: list[list[float]] = []
-    lines: list[int] = []
-    texts: list[str] = []
-    for number, raw in enumerate(text.splitlines(), start=1):
-        content = raw.split("#", 1)[0]
-        if not content.strip():
-            continue
-        fields = [field.strip() for field in next(csv.reader([content]))]
-        if indices is None and not rows and not all(_is_number(field) for field in fields):
+    if data_lines:
+        first = data_lines[0]
+        fields = [field.strip() for field in next(csv.reader([contents[first]]))]
+        if not all(_is_number(field) for field in fields):
             names = [_column_name(field) for field in fields]
             missing = [c for c in columns if c not in names]
+            raw = source[first]
             if missing and any(_is_number(field) for field in fields):
                 bad = next(field for field in fields if not _is_number(field))
                 raise table_error(
                     f"{bad!r} is not a number, and the line is no header (it lacks the "
                     f"column(s) {', '.join(missing)}): {raw.strip()!r}",
-                    path, number, name,
+                    path, first + 1, name,
                 )
             if missing:
                 raise table_error(
                     f"the header {raw.strip()!r} lacks the column(s) {', '.join(missing)}; name "
                     f"the columns {', '.join(columns)} (any order), or drop the header and give "
                     f"the {len(columns)} columns in that order",
-                    path, number, name,
+                    path, first + 1, name,
                 )
             indices = {c: names.index(c) for c in (*columns, *optional) if c in names}
             width = len(fields)
-            continue
+            data_lines = data_lines[1:]
+    order = indices or {c: k for k, c in enumerate(columns)}
+    if not data_lines:
+        raise table_error(
+            f"no data rows (only blank lines, comments or a header); add rows of "
+            f"{', '.join(columns)}",
+            path, None, name,
+        )
+    rows = [contents[k] for k in data_lines]
+    values = _parse_fast(rows, width, order, columns, optional)
+    if values is None:
+        values = _parse_slow(rows, data_lines, source, width, order, columns, optional, path,
+                             name)
+    return Table(values, np.array(data_lines, dtype=np.int64) + 1, source, path, name)
+
+
+def _parse_fast(
+    rows: list[str],
+    width: int,
+    order: dict[str, int],
+    columns: tuple[str, ...],
+    optional: tuple[str, ...],
+) -> np.ndarray | None:
+    """The rows parsed by numpy, or None when they need the line-by-line reader (quotes, a
+    row of another width, an empty or non-numeric field, a value that is not finite)."""
+    if any('"' in row for row in rows):
+        return None
+    commas = np.fromiter((row.count(",") for row in rows), dtype=np.int64, count=len(rows))
+    if np.any(commas != width - 1):
+        return None
+    wanted = [c for c in (*columns, *optional) if c in order]
+    try:
+        parsed = np.loadtxt(
+            rows, delimiter=",", usecols=[order[c] for c in wanted], dtype=np.float64,
+            comments=None, ndmin=2,
+        )
+    except ValueError:
+        return None
+    if not np.all(np.isfinite(parsed)):
+        return None
+    values = np.full((len(rows), len(columns) + len(optional)), np.nan)
+    for k, column in enumerate((*columns, *optional)):
+        if column in order:
+            values[:, k] = parsed[:, wanted.index(column)]
+    return values
+
+
+def _parse_slow(
+    rows: list[str],
+    data_lines: list[int],
+    source: list[str],
+    width: int,
+    order: dict[str, int],
+    columns: tuple[str, ...],
+    optional: tuple[str, ...],
+    path: Path,
+    name: str,
+) -> np.ndarray:
+    """The rows parsed one by one (csv quoting, empty optional fields), raising at the first
+    bad one with its line."""
+    values: list[list[float]] = []
+    for content, k in zip(rows, data_lines, strict=True):
+        number, raw = k + 1, source[k]
+        fields = [field.strip() for field in next(csv.reader([content]))]
         if len(fields) != width:
             raise table_error(
                 f"expected {width} comma-separated fields, found {len(fields)}: {raw.strip()!r}",
                 path, number, name,
             )
-        order = indices or {c: k for k, c in enumerate(columns)}
-        values = []
+        row = []
         for column in (*columns, *optional):
             if column not in order or (column in optional and not fields[order[column]]):
-                values.append(math.nan)
+                row.append(math.nan)
                 continue
             field = fields[order[column]]
             try:
@@ -160,16 +226,6 @@ def read_table(
                     f"{column} {field!r} is not a finite number: {raw.strip()!r}",
                     path, number, name,
                 )
-            values.append(value)
-        rows.append(values)
-        lines.append(number)
-        texts.append(raw.strip())
-    if not rows:
-        raise table_error(
-            f"no data rows (only blank lines, comments or a header); add rows of "
-            f"{', '.join(columns)}",
-            path, None, name,
-        )
-    return Table(
-        np.array(rows, dtype=np.float64), np.array(lines, dtype=np.int64), texts, path, name
-    )
+            row.append(value)
+        values.append(row)
+    return np.array(values, dtype=np.float64).reshape(len(rows), len(columns) + len(optional))

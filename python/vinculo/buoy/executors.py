@@ -1,21 +1,69 @@
 """Where parallel runs execute: local worker processes, or an existing Dask distributed cluster.
 
 Local processes start by fork on Linux (no ``__main__`` guard needed in user scripts) and by spawn
-elsewhere. A Dask cluster is reached by its scheduler's address; its executor returns standard
+elsewhere. Each worker watches the process that started it: on Linux the kernel kills the worker
+when that process dies (``prctl(PR_SET_PDEATHSIG)``), elsewhere a thread in the worker polls the
+parent's id, so no worker outlives a parent killed by SIGKILL. Workers ignore SIGINT: a Ctrl-C
+reaches the parent, which stops them (:func:`open_executor`) and keeps what had finished.
+
+A Dask cluster is reached by its scheduler's address; its executor returns standard
 :class:`concurrent.futures.Future` objects, so callers treat both alike.
 """
 
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import multiprocessing
+import os
+import signal
 import sys
+import threading
+import time
 from collections.abc import Iterator
 from concurrent.futures import Executor, ProcessPoolExecutor
 
 from vinculo.errors import SchedulerError
 
-__all__ = ["open_executor"]
+__all__ = ["open_executor", "watch_parent"]
+
+#: ``PR_SET_PDEATHSIG`` of ``<linux/prctl.h>``: the signal a process gets when its parent dies.
+_PR_SET_PDEATHSIG = 1
+#: Seconds between two looks at the parent's id where the kernel cannot watch it.
+_PARENT_POLL = 1.0
+
+
+def watch_parent(parent: int) -> None:
+    """Make this worker process end when ``parent`` dies, and ignore Ctrl-C (SIGINT).
+
+    The initializer of every local worker. On Linux the kernel sends SIGKILL to the worker
+    when the parent exits (``prctl(PR_SET_PDEATHSIG, SIGKILL)``); elsewhere a daemon thread
+    checks the parent's id every second and exits the worker when it changed. A parent that
+    died before this call is noticed at once.
+
+    Arguments:
+        parent: the process id of the parent (``os.getpid()`` where the pool was made).
+    """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    watched = False
+    if sys.platform.startswith("linux"):
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            watched = libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) == 0
+        except (OSError, AttributeError):  # pragma: no cover - a libc without prctl
+            watched = False
+    if os.getppid() != parent:  # the parent died before the watch began
+        os._exit(1)
+    if watched:
+        return
+
+    def poll() -> None:  # pragma: no cover - only where prctl is missing
+        while True:
+            time.sleep(_PARENT_POLL)
+            if os.getppid() != parent:
+                os._exit(1)
+
+    threading.Thread(target=poll, name="vinculo-watch-parent", daemon=True).start()
 
 
 @contextlib.contextmanager
@@ -62,7 +110,12 @@ def open_executor(
         yield None, "1 process"
         return
     method = "fork" if sys.platform.startswith("linux") else "spawn"
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method))
+    pool = ProcessPoolExecutor(
+        max_workers=workers,
+        mp_context=multiprocessing.get_context(method),
+        initializer=watch_parent,
+        initargs=(os.getpid(),),
+    )
     try:
         yield pool, f"{workers} local processes"
     except BaseException:

@@ -38,7 +38,7 @@ from typing import IO, Any
 
 import numpy as np
 
-from vinculo.buoy.case import BuoyCase, SweepSettings
+from vinculo.buoy.case import MAX_STEPS, BuoyCase, SweepSettings
 from vinculo.buoy.executors import open_executor
 from vinculo.buoy.study import MODELS, run_task
 from vinculo.errors import InvalidInputError, VinculoError
@@ -55,6 +55,9 @@ __all__ = [
 
 #: Per-run settings that a study may vary besides the case's fields and the frequency.
 RUN_SETTINGS = ("dt", "settle_periods", "fit_periods")
+#: Most values on one axis, and most points in a grid (a study beyond them would not finish).
+MAX_AXIS_VALUES = 10_000
+MAX_POINTS = 1_000_000
 #: Result columns of the CSV file, after the parameters and the model.
 RESULT_COLUMNS = (
     "status",
@@ -136,7 +139,8 @@ def parse_axis(text: str) -> tuple[str, list[Any]]:
         ``(name, values)``.
 
     Raises:
-        InvalidInputError: an unknown name, a malformed range, a count below 1, or no values.
+        InvalidInputError: an unknown name, a malformed range, a count below 1 or above
+            :data:`MAX_AXIS_VALUES`, or no values.
     """
     name, sep, values = text.partition("=")
     name = name.strip().replace("-", "_")
@@ -165,6 +169,13 @@ def parse_axis(text: str) -> tuple[str, list[Any]]:
                 name=name,
                 value=values,
             )
+        if count > MAX_AXIS_VALUES:
+            raise InvalidInputError(
+                f"{name}: the range {values!r} has {count} points, more than "
+                f"{MAX_AXIS_VALUES}; give a smaller COUNT",
+                name=name,
+                value=values,
+            )
         axis = np.linspace(float(start), float(stop), count)
         result = [round(v) for v in axis] if _kind(name) is int else axis.tolist()
     else:
@@ -179,6 +190,8 @@ def parse_axis(text: str) -> tuple[str, list[Any]]:
 def grid(axes: Mapping[str, Sequence[Any]]) -> list[dict[str, Any]]:
     """Every combination of the axes' values (the last axis varies fastest).
 
+    At most :data:`MAX_POINTS` combinations.
+
     Arguments:
         axes: parameter name -> values.
 
@@ -186,7 +199,8 @@ def grid(axes: Mapping[str, Sequence[Any]]) -> list[dict[str, Any]]:
         The points, each a dict name -> value.
 
     Raises:
-        InvalidInputError: an unknown name, or an axis without values (the grid has no points).
+        InvalidInputError: an unknown name, an axis without values (the grid has no points), or
+            more than :data:`MAX_POINTS` points.
     """
     for name, values in axes.items():
         if name not in parameter_names():
@@ -195,6 +209,14 @@ def grid(axes: Mapping[str, Sequence[Any]]) -> list[dict[str, Any]]:
             raise InvalidInputError(
                 f"the axis {name!r} has no values: the grid has no points", name=name, value=[]
             )
+    size = math.prod(len(values) for values in axes.values())
+    if size > MAX_POINTS:
+        raise InvalidInputError(
+            f"the grid has {size} points ({' x '.join(str(len(v)) for v in axes.values())}), "
+            f"more than {MAX_POINTS}; use fewer or shorter axes",
+            name="points",
+            value=size,
+        )
     names = list(axes)
     return [dict(zip(names, combo, strict=True)) for combo in itertools.product(*axes.values())]
 
@@ -278,6 +300,49 @@ def _point_task(
 
 
 _CASE_NAMES = frozenset(f.name for f in dataclasses.fields(BuoyCase))
+
+
+def _check_points(
+    points: Sequence[Mapping[str, Any]], case: BuoyCase, settings: SweepSettings
+) -> None:
+    """Raise before anything runs if a point's frequency or parameters are out of their domain.
+
+    Raises:
+        InvalidInputError: naming the value (each distinct combination is checked once).
+    """
+    base_case, base_settings = case.to_dict(), settings.to_dict()
+    seen: set[tuple[str, ...]] = set()
+    for point in points:
+        value = point["frequency"]
+        frequency = float(value)
+        if not (math.isfinite(frequency) and frequency > 0.0):
+            raise InvalidInputError(
+                f"study point frequency = {value!r} Hz: a frequency must be a finite number "
+                f"greater than 0; change the frequency axis",
+                name="frequency",
+                value=value,
+            )
+        key = tuple(f"{k}={v!r}" for k, v in point.items() if k != "frequency")
+        where = "the study point " + (", ".join(key) or "(base case)")
+        if key not in seen:
+            seen.add(key)
+            BuoyCase.from_mapping(
+                {**base_case, **{k: v for k, v in point.items() if k in _CASE_NAMES}},
+                source=where,
+            )
+        run = SweepSettings.from_mapping(
+            {**base_settings, **{k: v for k, v in point.items() if k in RUN_SETTINGS}},
+            source=where,
+        )
+        steps = run.t_end(frequency) / run.dt
+        if not steps <= MAX_STEPS:
+            raise InvalidInputError(
+                f"{where} at frequency = {value!r} Hz would take {steps:.3g} time steps of "
+                f"{run.dt!r} s, more than {MAX_STEPS:.0e}; raise the frequency or dt, or "
+                f"lower the periods",
+                name="frequency",
+                value=value,
+            )
 
 
 def _failed(point: dict[str, Any], model: str, error: str, started: float) -> StudyRow:
@@ -420,6 +485,7 @@ def run_parameter_study(
             raise InvalidInputError(
                 f"unknown model {m!r}: choose from {', '.join(MODELS)}", name="models", value=m
             )
+    _check_points(full, case, settings)
     workers = (os.cpu_count() or 1) if workers is None else workers
     if not (isinstance(workers, int) and workers >= 1):
         raise InvalidInputError(

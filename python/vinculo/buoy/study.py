@@ -22,13 +22,13 @@ and is fitted over its last ``fit_periods`` periods at the record's frequency.
 
 from __future__ import annotations
 
+import contextlib
 import math
-import multiprocessing
 import os
 import sys
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import Executor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field, replace
 from typing import IO, Any
@@ -36,6 +36,7 @@ from typing import IO, Any
 import numpy as np
 
 from vinculo.buoy.case import BuoyCase, SweepSettings
+from vinculo.buoy.executors import open_executor
 from vinculo.buoy.harmonic import SteadyResponse, steady_response
 from vinculo.buoy.model import run_particle_model
 from vinculo.buoy.reference import OneDofModel, TwoDofModel
@@ -329,20 +330,16 @@ class _Runner:
     def __init__(self, workers: int, report: Callable[[ModelResult], None]) -> None:
         self.workers = workers
         self.report = report
-        self.pool: ProcessPoolExecutor | None = None
+        self.pool: Executor | None = None
+        self._stack = contextlib.ExitStack()
 
     def __enter__(self) -> _Runner:
-        if self.workers > 1:
-            # fork starts workers at once and needs no __main__ guard in the user's script; other
-            # platforms spawn (scripts then need `if __name__ == "__main__":`).
-            method = "fork" if sys.platform.startswith("linux") else "spawn"
-            context = multiprocessing.get_context(method)
-            self.pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=context)
+        # Workers die with this process and ignore Ctrl-C, which stops them (executors).
+        self.pool, _ = self._stack.enter_context(open_executor(self.workers, None))
         return self
 
-    def __exit__(self, *exc: object) -> None:
-        if self.pool is not None:
-            self.pool.shutdown(cancel_futures=True)
+    def __exit__(self, *exc: Any) -> bool | None:
+        return self._stack.__exit__(*exc)
 
     def run(
         self,
