@@ -177,12 +177,13 @@ def test_buoy_help_gives_units_and_valid_values(capsys):
     from vinculo.buoy.case import UNITS
 
     for name, unit in UNITS.items():
-        if name in ("tank_size", "attachment"):
+        if name in ("tank_size", "attachment", "viscous_force"):
             continue
         option = "--" + name.replace("_", "-")
         stated = {"count": "a count", "dimensionless": "dimensionless"}.get(unit, f"in {unit}")
         assert re.search(rf"{option} \S+ {re.escape(stated)} \(default", text), option
     assert "{bottom,centre}" in text  # the valid --attachment values
+    assert "{none,stokes-layer}" in text  # the valid --viscous-force values
     unwrapped = re.sub(r"(\w)- (\w)", r"\1-\2", text)  # argparse may break at a hyphen
     assert "from: particle, two-dof, one-dof" in unwrapped  # the valid --models values
     assert re.search(r"--animate FREQ .*\(Hz\)", text)

@@ -185,7 +185,7 @@ def _add_case_options(parser: argparse.ArgumentParser) -> None:
     """``--case FILE.toml`` and every case and sweep parameter as an option."""
     import dataclasses
 
-    from vinculo.buoy import ATTACHMENTS, BuoyCase, SweepSettings
+    from vinculo.buoy import ATTACHMENTS, VISCOUS_FORCES, BuoyCase, SweepSettings
     from vinculo.buoy.case import UNITS
 
     parser.add_argument("--case", metavar="FILE.toml", type=Path,
@@ -206,6 +206,13 @@ def _add_case_options(parser: argparse.ArgumentParser) -> None:
                                    help=f"where the string is tied: {ATTACHMENTS[0]} (the "
                                    f"sphere's lowest point) or {ATTACHMENTS[1]} (default: "
                                    f"{f.default})")
+                continue
+            if f.name == "viscous_force":
+                group.add_argument(option, dest=f"{table}__{f.name}", choices=VISCOUS_FORCES,
+                                   default=None,
+                                   help=f"viscous force on the sphere besides Morison's: none, "
+                                   f"or stokes-layer (oscillatory boundary layer, Stokes 1851) "
+                                   f"(default: {f.default})")
                 continue
             group.add_argument(option, dest=f"{table}__{f.name}", metavar=f.name.upper(),
                                type=_number(kind, option), default=None,

@@ -111,12 +111,19 @@ UNITS: dict[str, str] = {
     "string_beads": "count",
     "string_mass": "kg",
     "tank_size": "m",
+    "viscous_force": "one of " + ", ".join(VISCOUS_FORCES),
+    "kinematic_viscosity": "m^2/s",
     "f_min": "Hz",
     "f_max": "Hz",
     "count": "count",
     "dt": "s",
     "settle_periods": "periods of the excitation",
     "fit_periods": "whole periods",
+    "amplitude_tolerance": "dimensionless",
+    "phase_tolerance": "degrees",
+    "max_periods": "periods of the excitation",
+    "refine_rounds": "count",
+    "resonance_tolerance": "Hz",
 }
 #: Largest whole-number settings: beyond them a run could not be held in memory (or finish).
 MAX_STRING_BEADS = 10_000
