@@ -6,7 +6,9 @@
 # release profile, and the Rust tests then run in that profile with both crates selected, so
 # cargo resolves the same dependency features and reuses those compiled dependencies instead of
 # building them again (a plain `cargo test -p vinculo` builds them a second time, in the dev
-# profile and with other features). clippy only type-checks, after the build.
+# profile and with other features). clippy only type-checks, after the build, in the dev
+# profile: in the release profile it would rerun pyo3's build script without the environment
+# maturin gives it, and the next `make build` would then recompile pyo3 and the binding crate.
 
 PYTHON ?= python3
 VENV := .venv
@@ -26,7 +28,7 @@ test: $(VENV_STAMP)
 	cargo fmt --all --check
 	$(MAKE) build
 	$(MAKE) rust-test
-	cargo clippy --workspace --all-targets --release -- -D warnings
+	cargo clippy --workspace --all-targets -- -D warnings
 	$(VENV)/bin/ruff check python tests examples
 	$(VENV)/bin/pytest
 
