@@ -58,6 +58,7 @@ build: $(VENV_STAMP)
 
 # The stamp file makes the installation happen once (and again when the pins change).
 $(VENV_STAMP): requirements-dev.txt
+	@echo "setting up $(VENV): the pinned tools of requirements-dev.txt (about a minute the first time)"
 	$(PYTHON) -m venv $(VENV)
 	$(QUIET_PIP) $(VENV)/bin/python -m pip install -r requirements-dev.txt
 	touch $@
