@@ -38,6 +38,18 @@ def test_the_release_build_shows_progress_and_keeps_pip_quiet():
     assert "make test" in (ROOT / ".ci" / "run").read_text().splitlines()[-1]
 
 
+def test_clippy_shares_the_release_builds_pyo3_configuration():
+    # clippy in the release profile reuses the build's proc-macros and build scripts; with the
+    # environment maturin gives pyo3 (its configuration file above all) it does not rerun pyo3's
+    # build scripts, which made the next build recompile pyo3 and the binding crate.
+    text = (ROOT / "Makefile").read_text()
+    recipe = re.search(r"^clippy:.*\n((?:\t.*\n)+)", text, re.MULTILINE).group(1)
+    assert "cargo clippy" in recipe and "--release" in recipe and "-D warnings" in recipe
+    for variable in ("PYO3_CONFIG_FILE", "PYO3_PYTHON", "PYO3_ENVIRONMENT_SIGNATURE",
+                     "PYO3_BUILD_EXTENSION_MODULE"):
+        assert variable in recipe, variable
+
+
 def _features(arguments: list[str]) -> dict[str, str]:
     """``{package: features}`` of a cargo build, from ``cargo tree``."""
     result = subprocess.run(

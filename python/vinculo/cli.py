@@ -63,6 +63,30 @@ def _count(low: int, high: int) -> Callable[[str], int]:
 
 
 _workers = _count(1, 1024)
+
+
+def _models(text: str) -> tuple[str, ...]:
+    """An argparse type: a comma-separated list of one or more of the study's models."""
+    from vinculo.buoy.study import MODELS
+
+    models = tuple(m.strip() for m in text.split(",") if m.strip())
+    unknown = [m for m in models if m not in MODELS]
+    if unknown or not models:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: give one or more of {', '.join(MODELS)}, separated by commas"
+        )
+    return models
+
+
+def _smoothing(text: str) -> float:
+    """An argparse type: a finite number >= 0 (a smoothing penalty)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not (math.isfinite(value) and value >= 0.0):
+        raise argparse.ArgumentTypeError(f"{text!r}: give a finite number >= 0")
+    return value
 _frames = _count(1, 100_000)
 
 
@@ -155,10 +179,10 @@ def _add_buoy_parser(commands: Any) -> None:
                       "drive the models instead of the harmonic sweep; repeat for several "
                       "records. Each is smoothed by a spline and fitted at its dominant "
                       "frequency over its last fit-periods periods")
-    buoy.add_argument("--tank-smoothing", metavar="LAM", type=float, default=None,
+    buoy.add_argument("--tank-smoothing", metavar="LAM", type=_smoothing, default=None,
                       help="penalty lam (s^3) of the records' smoothing spline (0 interpolates; "
                       "default: fit within the noise estimated from the record)")
-    buoy.add_argument("--models", default="particle,two-dof,one-dof",
+    buoy.add_argument("--models", type=_models, default="particle,two-dof,one-dof",
                       help="comma-separated models to run, from: particle, two-dof, one-dof "
                       "(default: all three)")
     buoy.add_argument("--history-frequencies", metavar="F1,F2,...", default=None,
@@ -256,7 +280,7 @@ def _study_parser() -> argparse.ArgumentParser:
                         help="an axis: NAME=START:STOP:COUNT or NAME=V1,V2,... (repeat for a "
                         "grid); NAME is a case parameter (drag_coefficient, amplitude, ...), "
                         "frequency, dt, settle_periods or fit_periods")
-    parser.add_argument("--models", default="particle",
+    parser.add_argument("--models", type=_models, default="particle",
                         help="comma-separated models to run at each point, from: particle, "
                         "two-dof, one-dof (default: particle)")
     parser.add_argument("--retry-failed", action="store_true",
@@ -334,7 +358,7 @@ def _buoy_sweep(args: argparse.Namespace, parser: argparse.ArgumentParser) -> in
     case, settings = _case_and_settings(args)
     axes = dict(parse_axis(text) for text in args.param)
     points = grid(axes)
-    models = tuple(m.strip() for m in args.models.split(",") if m.strip())
+    models = args.models
     output = _output_folder(args.output, parser)
     try:
         study = run_parameter_study(
@@ -423,7 +447,7 @@ def _buoy(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     case, settings = _case_and_settings(args)
     data = read_measurements(args.data, motion=args.data_motion) if args.data else None
     motions = [read_tank_motion(p, smoothing=args.tank_smoothing) for p in args.tank_motion]
-    models = tuple(m.strip() for m in args.models.split(",") if m.strip())
+    models = args.models
     output: Path = args.output
     if output.exists() and not output.is_dir():
         parser.error(f"--output {str(output)!r} exists and is not a folder")

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import csv
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -136,8 +137,9 @@ def test_ctrl_c_of_buoy_writes_the_finished_runs_and_exits_130(tmp_path):
         tmp_path,
     )
     pid = command.process.pid
-    # The progress bar shows "1/8 runs" once the first run has finished.
-    command.wait_for(lambda: b" 1/8 runs" in command.err, "finished run")
+    # The progress bar shows "1/N runs" once the first run has finished.
+    command.wait_for(lambda: re.search(rb" 1/\d+ runs", command.err), "finished run")
+    total = int(re.search(rb" 1/(\d+) runs", command.err).group(1))
     workers = _children(pid)
     os.killpg(pid, signal.SIGINT)  # what Ctrl-C in a terminal does: the whole foreground group
     assert command.finish() == 130
@@ -146,10 +148,10 @@ def test_ctrl_c_of_buoy_writes_the_finished_runs_and_exits_130(tmp_path):
     tail = [line for line in message if line.strip()][-1]
     assert tail.startswith("vinculo buoy: interrupted") and "out" in tail
     assert "Traceback" not in command.err.decode()
-    # What finished is written: sweep.csv holds between 1 and 7 of the 8 runs (5 sweep
-    # frequencies and the three history frequencies), each with its fitted amplitude.
+    # What finished is written: sweep.csv holds some but not all of the runs (the 5 sweep
+    # frequencies, and any history frequencies the study adds), each with its amplitude.
     with (tmp_path / "out" / "sweep.csv").open() as f:
         rows = [r for r in csv.DictReader(f) if r["model"] == "particle"]
-    assert 1 <= len(rows) < 8
+    assert 1 <= len(rows) < total
     assert all(float(r["relative_amplitude"]) > 0.0 for r in rows)
     assert (tmp_path / "out" / "summary.txt").exists()
