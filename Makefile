@@ -6,20 +6,26 @@ PYTHON ?= python3
 VENV := .venv
 VENV_STAMP := $(VENV)/.installed
 
-.PHONY: run test build .venv
+.PHONY: run test build docs .venv
 
 ## run: build, then run the main job (the buoy study; tables, figures and summary go to output/)
 run: build
 	$(VENV)/bin/vinculo buoy --output output
 
-## test: formatting, lints, Rust tests, build, Python lint and tests, in that order
+## test: formatting, lints, Rust tests, build, Python lint and tests, the docs, in that order
 test: $(VENV_STAMP)
 	cargo fmt --all --check
 	cargo clippy --workspace --all-targets -- -D warnings
 	cargo test -p vinculo
 	$(MAKE) build
-	$(VENV)/bin/ruff check python tests examples
+	$(VENV)/bin/ruff check python tests examples tools
 	$(VENV)/bin/pytest
+	$(MAKE) docs
+
+## docs: build the documentation site into site/ in strict mode (any warning fails the build):
+## runs every example for the gallery and generates the command-line reference (see mkdocs.yml)
+docs: build
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --site-dir site
 
 # Build the extension in release mode and install the package (editable) into .venv.
 # maturin and cargo rebuild incrementally, so this is quick when nothing changed.

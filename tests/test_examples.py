@@ -78,3 +78,77 @@ def test_result_files(tmp_path):
     assert number_after("largest tension error:", out) < 1e-9
     assert (tmp_path / "files" / "chain.nc").is_file()
     assert (tmp_path / "files" / "chain_vtk" / "state.pvd").is_file()
+
+
+def test_result_files_plot(tmp_path):
+    # The figure option draws what the two files hold; the numbers are those of the test above.
+    plot = tmp_path / "files.png"
+    out = run_example("result_files.py", str(tmp_path / "files"), "--plot", str(plot))
+    assert number_after("largest tension error:", out) < 1e-9
+    assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_swinging_pendulum():
+    # Exact period 4 sqrt(L/g) K(sin 45 deg) = 2.367841947576237 s for L = 1 m, g = 9.81
+    # (elliptic integral); at dt = 1 ms the second-order rule is within ~1e-6.
+    out = run_example("swinging_pendulum.py")
+    assert number_after("period:", out) == pytest.approx(2.367841947576237, rel=1e-5)
+    # Tension 3 m g cos(theta) (energy conservation + radial balance), O(dt^2) at mid-step.
+    assert number_after("largest tension error:", out) < 1e-4
+    # The trapezoidal rule conserves the energy of a conservative system to Newton tolerance.
+    assert number_after("largest energy change:", out) < 1e-9
+
+
+def test_chain():
+    # 20 beads of 0.05 kg hanging at rest: the top link carries the whole weight, 20 m g.
+    out = run_example("chain.py")
+    assert number_after("top tension", out) == pytest.approx(20 * 0.05 * G, rel=1e-9)
+    assert number_after("largest error", out) < 1e-9
+    assert number_after("largest energy change:", out) < 1e-9
+    assert number_after("largest constraint residual:", out) < 1e-12
+    assert "linear solver: tree elimination" in out  # a chain's constraint graph is a tree
+
+
+def test_rigid_body():
+    # Torque-free body: angular momentum and kinetic energy are constants of the motion.
+    out = run_example("rigid_body.py")
+    assert number_after("largest change of angular momentum:", out) < 1e-9
+    assert number_after("largest change of kinetic energy:", out) < 1e-9
+    # Intermediate-axis theorem: the perturbation grows at omega sqrt((I2-I1)(I3-I2)/(I1 I3))
+    # = 0.71 /s for I = (0.2, 0.3, 0.4) kg m^2, omega = 2 rad/s, so the axis flips within 30 s.
+    assert number_after("the intermediate axis turned over", out) >= 1
+    # Steady spin about the major axis: angle omega t, up to the midpoint rule's phase error
+    # (omega h)^2 / 12 * omega t = 8.3e-5 rad for h = 5 ms, t = 5 s.
+    assert number_after("largest angle error against omega t:", out) < 2e-4
+
+
+def test_moving_constraints():
+    # A plane rising with acceleration a pushes a resting mass with m (g + a) (m = 2 kg, a = 3).
+    out = run_example("moving_constraints.py")
+    assert number_after("elevator: normal force", out) == pytest.approx(2.0 * (G + 3.0), rel=1e-9)
+    # A prescribed coordinate needs the force m x''; index-3 multipliers ring at O(dt), GGL
+    # enforces the velocity level too (see docs/theory/ggl.md).
+    assert number_after("prescribed coordinate, index-3: largest force error", out) < 5e-3
+    assert number_after("prescribed coordinate, GGL: largest force error", out) < 1e-4
+
+
+def test_user_groups():
+    # The Python groups compute the same physics as the built-in elements (the peer here).
+    out = run_example("user_groups.py")
+    assert number_after("largest position gap to the built-in drag:", out) < 1e-9
+    assert number_after("largest position gap to the built-in distance:", out) < 1e-9
+    assert number_after("largest tension gap:", out) < 1e-6
+
+
+@pytest.mark.slow
+def test_buoy_study(tmp_path):
+    # About 15 s of CPU (three models, a parameter study, a calibration); the docs build runs it
+    # too. The particle model against the scipy 2-DOF reference (the same physics, derived
+    # independently by Lagrange in the tank frame): within 2 % of the peak.
+    out = run_example("buoy_study.py", "--output", str(tmp_path))
+    assert number_after("largest gap", out) < 2.0  # printed in percent
+    # A second call of the parameter study resumes from its CSV file: nothing recomputed.
+    assert number_after("then", out) == 0
+    # Synthetic data from Cd = 0.35, Ca = 0.60: the calibration recovers them.
+    assert number_after("calibrated drag_coefficient:", out) == pytest.approx(0.35, rel=1e-3)
+    assert number_after("calibrated added_mass_coefficient:", out) == pytest.approx(0.6, rel=1e-3)
