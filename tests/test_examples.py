@@ -34,7 +34,7 @@ def number_after(label: str, text: str) -> float:
 
 def test_pendulum(tmp_path):
     # Exact period for L = 1 m, g = 9.81, horizontal release: 2.367841947576237 s
-    # (formulation.md); the example's dt = 1 ms gives ~1e-6 relative error.
+    # (docs/theory/formulation.md); the example's dt = 1 ms gives ~1e-6 relative error.
     plot = tmp_path / "pendulum.png"
     out = run_example("pendulum.py", "--plot", str(plot))
     assert number_after("period:", out) == pytest.approx(2.367841947576237, rel=1e-5)
@@ -42,7 +42,7 @@ def test_pendulum(tmp_path):
 
 
 def test_double_pendulum():
-    # omega^2 = (2 -/+ sqrt 2) g / l for l = 1 m (formulation.md); amplitude 0.01 rad.
+    # omega^2 = (2 -/+ sqrt 2) g / l for l = 1 m (docs/theory/formulation.md); amplitude 0.01 rad.
     out = run_example("double_pendulum.py")
     assert number_after("slow mode: omega =", out) == pytest.approx(
         np.sqrt((2 - np.sqrt(2)) * G), rel=1e-3

@@ -100,9 +100,15 @@ def on_page_markdown(markdown, page, config, files):
         if name not in _outputs:
             raise PluginError(f"{page.file.src_uri} asks for the output of {name}, "
                               f"which is not a script of examples/")
-        return "```text\n" + _outputs[name].rstrip() + "\n```"
+        return "```text\n" + _shown(_outputs[name]) + "\n```"
 
     return OUTPUT_MARKER.sub(output, markdown)
+
+
+def _shown(output: str) -> str:
+    """An example's output as shown on a page: without the line naming its scratch figure."""
+    lines = [line for line in output.rstrip().splitlines() if not line.startswith("plot: ")]
+    return "\n".join(lines)
 
 
 def on_post_build(config):
@@ -167,13 +173,16 @@ def _parser_section(title: str, parser, level: int, with_commands: bool = False)
     if parser.description:
         lines += [parser.description, ""]
     formatter = parser._get_formatter()
+    units = _parameter_units()
     for group in parser._action_groups:
         rows = []
+        with_units = any(_unit(action, units) for action in group._group_actions)
         for action in group._group_actions:
             if isinstance(action, argparse._SubParsersAction):
                 if with_commands:
                     rows += [
-                        f"| `{choice.dest}` | | | {_cell(choice.help or '')} |"
+                        f"| `{choice.dest}` | |{' |' if with_units else ''} | "
+                        f"{_cell(choice.help or '')} |"
                         for choice in action._choices_actions
                     ]
                 continue
@@ -183,7 +192,8 @@ def _parser_section(title: str, parser, level: int, with_commands: bool = False)
             argument = _argument(action)
             default = _default(action)
             text = formatter._expand_help(action) if action.help else ""
-            rows.append(f"| {name} | {argument} | {default} | {_cell(text)} |")
+            unit = f" {_unit(action, units)} |" if with_units else ""
+            rows.append(f"| {name} | {argument} |{unit} {default} | {_cell(text)} |")
         if not rows:
             continue
         heading = group.title or "arguments"
@@ -191,12 +201,28 @@ def _parser_section(title: str, parser, level: int, with_commands: bool = False)
         lines += [
             f"{hashes}# {heading} of `{title}`" if heading else "",
             "",
-            "| option | value | default | meaning (units) |",
-            "| --- | --- | --- | --- |",
+            "| option | value | unit | default | meaning |" if with_units
+            else "| option | value | default | meaning (units) |",
+            "| --- | --- | --- | --- | --- |" if with_units else "| --- | --- | --- | --- |",
             *rows,
             "",
         ]
     return lines
+
+
+def _parameter_units() -> dict[str, str]:
+    """The unit of each buoy case and sweep parameter, as the study writes it to parameters.csv."""
+    try:
+        from vinculo.buoy import report
+    except ImportError:
+        return {}
+    return dict(getattr(report, "_UNITS", {}))
+
+
+def _unit(action: argparse.Action, units: dict[str, str]) -> str:
+    """The unit of a case or sweep parameter option (its dest is ``case__NAME``), else ""."""
+    _, _, name = action.dest.rpartition("__")
+    return units.get(name, "") if "__" in action.dest else ""
 
 
 def _argument(action: argparse.Action) -> str:
@@ -348,7 +374,7 @@ def gallery_page(runs: list[ExampleRun]) -> str:
             '??? example "Output"',
             "",
             "    ```text",
-            *("    " + line for line in run.output.rstrip().splitlines()),
+            *("    " + line for line in _shown(run.output).splitlines()),
             "    ```",
             "",
             '??? example "Source"',
