@@ -12,15 +12,16 @@ VENV_STAMP := $(VENV)/.installed
 run: build
 	$(VENV)/bin/vinculo buoy --output output
 
-## test: formatting, lints, Rust tests, build, Python lint and tests, the docs, in that order
+## test: formatting, lints, Rust tests, build, Python lint, the strict docs build, Python tests,
+## in that order (pytest last, so that its summary closes the output)
 test: $(VENV_STAMP)
 	cargo fmt --all --check
 	cargo clippy --workspace --all-targets -- -D warnings
 	cargo test -p vinculo
 	$(MAKE) build
 	$(VENV)/bin/ruff check python tests examples tools
-	$(VENV)/bin/pytest
 	$(MAKE) docs
+	$(VENV)/bin/pytest
 
 ## docs: build the documentation site into site/ in strict mode (any warning fails the build):
 ## runs every example for the gallery and generates the command-line reference (see mkdocs.yml)
