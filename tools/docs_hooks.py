@@ -196,7 +196,8 @@ def _parser_section(title: str, parser, level: int, with_commands: bool = False)
             rows.append(f"| {name} | {argument} |{unit} {default} | {_cell(text)} |")
         if not rows:
             continue
-        heading = group.title or "arguments"
+        commands = any(isinstance(a, argparse._SubParsersAction) for a in group._group_actions)
+        heading = "commands" if commands else (group.title or "arguments")
         heading = heading[0].upper() + heading[1:]
         lines += [
             f"{hashes}# {heading} of `{title}`" if heading else "",
