@@ -103,15 +103,75 @@ class System:
             InvalidInputError: a mass <= 0 or a non-finite position or velocity.
         """
     def add_distance(self, a: ParticleId, b: ParticleId, length: float | None = None) -> ConstraintId:
-        """Phi = L^2 - |q_a - q_b|^2 (paper eq. 17). length=None: the current distance."""
+        """A rigid link between two particles: Phi = L^2 - |q_a - q_b|^2 (paper eq. 17).
+
+        The multiplier lambda is positive in tension; the tension is 2 lambda L
+        (``Solution.distance_tension``).
+
+        Arguments:
+            a: one end.
+            b: the other end.
+            length: L (m, > 0); None: the current distance.
+
+        Returns:
+            The constraint's handle (one equation).
+
+        Raises:
+            InvalidInputError: a == b, or a length that is not finite and positive.
+            UnknownHandleError: a handle of another system.
+        """
     def add_distance_to_point(self, particle: ParticleId, point: Vector,
                               length: float | None = None) -> ConstraintId:
-        """Phi = L^2 - |q - p(t)|^2 with a prescribed point p(t)."""
+        """A link from a particle to a prescribed point p(t): Phi = L^2 - |q - p(t)|^2.
+
+        Arguments:
+            particle: the particle.
+            point: p(t) (m), each component a number or a Law (an anchor on a moving floor).
+            length: L (m, > 0); None: the current distance at t = 0.
+
+        Returns:
+            The constraint's handle (one equation; tension 2 lambda L).
+
+        Raises:
+            InvalidInputError: a length that is not finite and positive.
+            UnknownHandleError: a handle of another system.
+        """
     def add_plane(self, particle: ParticleId, normal: Vector, point: Vector) -> ConstraintId:
-        """Phi = n(t) . (q - p0(t)) (paper eq. 18); n need not be unit (it is normalised at t=0 for scaling)."""
+        """Hold a particle on a plane: Phi = n(t) . (q - p0(t)) (paper eq. 18).
+
+        The constraint force is n lambda: with a unit normal, lambda is the normal force.
+
+        Arguments:
+            particle: the particle.
+            normal: n(t), each component a number or a Law; it need not be unit (its length at
+                t = 0 scales the equation).
+            point: p0(t) (m), a point of the plane, numbers or Laws.
+
+        Returns:
+            The constraint's handle (one equation).
+
+        Raises:
+            InvalidInputError: a normal of zero length.
+            UnknownHandleError: a handle of another system.
+        """
     def add_fixed_coordinate(self, particle: ParticleId, axis: int | str,
                              value: Scalar | None = None) -> ConstraintId:
-        """Phi = q[axis] - value(t); value=None keeps the current coordinate."""
+        """Prescribe one coordinate of a particle: Phi = q[axis] - value(t).
+
+        The multiplier is the force along +axis.
+
+        Arguments:
+            particle: the particle.
+            axis: 0, 1, 2 or "x", "y", "z".
+            value: the coordinate (m), a number or a Law; None keeps the current coordinate.
+
+        Returns:
+            The constraint's handle (one equation).
+
+        Raises:
+            InvalidInputError: an axis that is not one of the three.
+            UnknownHandleError: a handle of another system.
+        """
     def add_spring_damper(self, a: ParticleId, b: ParticleId, stiffness: float, damping: float = 0.0,
                           rest_length: float | None = None) -> ForceId:
         """A linear spring and dashpot between two particles: axial force k (l - L0) + c l'.
@@ -144,9 +204,33 @@ class System:
             UnknownHandleError: a handle of another system.
         """
     def add_linear_drag(self, particle: ParticleId, coefficient: float) -> ForceId:
-        """f = -c v."""
+        """Linear drag f = -c v on one particle.
+
+        Arguments:
+            particle: the particle.
+            coefficient: c (N s/m, >= 0).
+
+        Returns:
+            The force's handle.
+
+        Raises:
+            InvalidInputError: a negative or non-finite coefficient.
+            UnknownHandleError: a handle of another system.
+        """
     def add_quadratic_drag(self, particle: ParticleId, coefficient: float) -> ForceId:
-        """f = -c |v| v."""
+        """Quadratic drag f = -c |v| v on one particle.
+
+        Arguments:
+            particle: the particle.
+            coefficient: c (N s^2/m^2, >= 0).
+
+        Returns:
+            The force's handle.
+
+        Raises:
+            InvalidInputError: a negative or non-finite coefficient.
+            UnknownHandleError: a handle of another system.
+        """
     def add_force_group(
         self,
         particles: npt.ArrayLike,
@@ -248,12 +332,38 @@ class System:
         density: float = 1000.0,
         fluid_motion: Vector | None = None,
     ) -> ForceId:
-        """Fluid forces on a body's centre particle, the fluid moving as a rigid body by
-        X_f(t) = fluid_motion (None: still): rho V (a_f - g) + Ca rho V a_f
-        + 1/2 rho Cd A |u_f - v| (u_f - v); the added mass Ca rho V joins the particle's inertia."""
+        """Fluid forces on a body's centre particle (Morison equation, docs/theory/hydrodynamics.md).
+
+        The fluid moves as a rigid body by X_f(t) = fluid_motion: rho V (a_f - g) + Ca rho V a_f
+        + 1/2 rho Cd A |u_f - v| (u_f - v), with u_f, a_f the derivatives of X_f; the added mass
+        Ca rho V joins the particle's translational inertia.
+
+        Arguments:
+            particle: the body's reference particle (its centre).
+            volume: displaced volume V (m^3, > 0).
+            area: frontal area A for the drag (m^2, >= 0).
+            drag_coefficient: Cd (>= 0).
+            added_mass_coefficient: Ca (>= 0).
+            density: fluid density rho (kg/m^3, > 0).
+            fluid_motion: X_f(t) (m), numbers or Laws; None: still fluid.
+
+        Returns:
+            The force's handle.
+
+        Raises:
+            InvalidInputError: a value outside its domain.
+            UnknownHandleError: a handle of another system.
+        """
     def set_tension_only(self, constraint: ConstraintId) -> None:
         """Declare a distance constraint a string: runs stop with NegativeTensionError when it
-        would have to push."""
+        would have to push.
+
+        Arguments:
+            constraint: a distance (to a particle or to a point).
+
+        Raises:
+            InvalidInputError: a constraint that is not a distance, or not one of this system's.
+        """
     @property
     def constraint_lengths(self) -> npt.NDArray[np.float64]:
         """Length of each constraint (m); NaN for constraints that are not distances."""
