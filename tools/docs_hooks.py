@@ -105,6 +105,63 @@ def on_page_markdown(markdown, page, config, files):
     return OUTPUT_MARKER.sub(output, markdown)
 
 
+# Sphinx roles in docstrings (:class:`X`, :func:`~a.b`) reach the HTML as ":class:<code>X</code>".
+SPHINX_ROLE = re.compile(r":(?:class|func|meth|mod|data|attr|exc|obj):<code>(~?)([\w.]+)</code>")
+_objects: dict[str, str | None] = {}
+
+
+def _object_index() -> dict[str, str | None]:
+    """Every dotted suffix of every object's path in the package -> that path (None: ambiguous)."""
+    if not _objects:
+        import griffe
+
+        package = griffe.load("vinculo", search_paths=[str(ROOT / "python")],
+                              allow_inspection=False)
+        paths: set[str] = set()
+
+        def walk(obj) -> None:
+            paths.add(obj.path)
+            for member in obj.members.values():
+                if not member.is_alias:
+                    walk(member)
+
+        walk(package)
+        for path in paths:
+            parts = path.split(".")
+            for k in range(len(parts)):
+                suffix = ".".join(parts[k:])
+                _objects[suffix] = path if _objects.get(suffix, path) == path else None
+    return _objects
+
+
+def on_page_content(html, page, config, files):
+    """Turn the Sphinx roles of docstrings into cross-references (or plain code).
+
+    Arguments:
+        html: the page's HTML.
+        page: the page.
+        config: the site's configuration.
+        files: the site's files.
+
+    Returns:
+        The HTML with ``:class:`X``` and the like replaced by links to X's documentation where X
+        names one object of the package, else by ``X`` as code.
+    """
+    if ":<code>" not in html:
+        return html
+    index = _object_index()
+
+    def reference(match: re.Match) -> str:
+        tilde, target = match.groups()
+        shown = target.rsplit(".", 1)[-1] if tilde else target
+        path = index.get(target)
+        if path is None:
+            return f"<code>{shown}</code>"
+        return f'<autoref identifier="{path}" optional><code>{shown}</code></autoref>'
+
+    return SPHINX_ROLE.sub(reference, html)
+
+
 def _shown(output: str) -> str:
     """An example's output as shown on a page: without the line naming its scratch figure."""
     lines = [line for line in output.rstrip().splitlines() if not line.startswith("plot: ")]
