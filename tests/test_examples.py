@@ -197,3 +197,17 @@ def test_generalized_alpha_damping_matches_its_spectral_radius(rho_inf, omega_h)
     # A strongly damped motion reaches round-off within a few steps, so its fit still sees the
     # subdominant roots: the tolerance widens from 2e-3 (no damping) to 2.2e-2 (|R| -> 0).
     assert measured == pytest.approx(expected, abs=2e-3 + 0.02 * (1.0 - expected))
+
+
+def test_convergence_order():
+    # Observed orders against scipy's DOP853 solution of the pendulum ODE (an independent
+    # solution): 2 for alpha = 1/2, generalised-alpha and GGL; 1 for alpha > 1/2 and backward
+    # Euler (docs/theory/time-rules.md; Arnold and Brüls 2007 for generalised-alpha).
+    out = run_example("convergence_order.py")
+    expected = {
+        "trapezoidal (alpha = 0.5)": 2, "trapezoidal (alpha = 0.75)": 1, "backward Euler": 1,
+        "generalised-alpha (rho_inf = 0.9)": 2, "generalised-alpha (rho_inf = 0.5)": 2,
+        "GGL, trapezoidal (alpha = 0.5)": 2,
+    }
+    for name, order in expected.items():
+        assert number_after(f"{name}: observed order", out) == pytest.approx(order, abs=0.15)
