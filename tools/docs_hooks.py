@@ -213,6 +213,17 @@ def cli_reference(cli) -> str:
         if name == "buoy":
             lines += _parser_section("vinculo buoy sweep", cli._study_parser(), level=2)
             lines += _parser_section("vinculo buoy calibrate", cli._calibrate_parser(), level=2)
+    lines += [
+        "## From Python",
+        "",
+        "The program is `vinculo.cli.main`; `python -m vinculo` runs it too.",
+        "",
+        "::: vinculo.cli",
+        "    options:",
+        "      show_root_heading: false",
+        "      heading_level: 3",
+        "",
+    ]
     return "\n".join(lines) + "\n"
 
 
