@@ -222,3 +222,21 @@ def test_adaptive_steps():
         line = next(row for row in out.splitlines() if row.startswith(f"rtol {rtol}"))
         assert 1.0 < number_after("m =", line) < 10.0
         assert number_after("m,", line) > 1.0
+
+
+def test_rising_sphere():
+    # Closed forms of (m_s + m_a) v' = (m_f - m_s) g - k v|v| from rest (docs/theory/
+    # hydrodynamics.md): a_0 = (m_f - m_s) g / (m_s + m_a), v = v_t tanh(a_0 t / v_t),
+    # v_t = sqrt((m_f - m_s) g / k). Computed here from the buoy's data, independently.
+    volume, area = np.pi * 0.1**3 / 6, np.pi * 0.1**2 / 4
+    m_s, m_f = 366.69 * volume, 1000.0 * volume
+    m_a, k = 0.52 * m_f, 0.5 * 1000.0 * 0.22 * area
+    out = run_example("rising_sphere.py")
+    a_0 = (m_f - m_s) * G / (m_s + m_a)
+    # The first step's mean acceleration is a(dt / 2) = a_0 (1 - O((a_0 dt / v_t)^2)).
+    assert number_after("initial acceleration:", out) == pytest.approx(a_0, rel=1e-4)
+    v_t = np.sqrt((m_f - m_s) * G / k)
+    assert number_after("terminal velocity", out) == pytest.approx(v_t, rel=1e-6)  # printed
+    # After 2 s (7 times v_t / a_0) the sphere moves at v_t to within 1e-5 relative.
+    assert number_after("velocity at 2 s:", out) == pytest.approx(v_t, rel=1e-5)
+    assert number_after("largest velocity error:", out) < 1e-5
