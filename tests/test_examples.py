@@ -240,3 +240,14 @@ def test_rising_sphere():
     # After 2 s (7 times v_t / a_0) the sphere moves at v_t to within 1e-5 relative.
     assert number_after("velocity at 2 s:", out) == pytest.approx(v_t, rel=1e-5)
     assert number_after("largest velocity error:", out) < 1e-5
+
+
+def test_consistent_start():
+    # For one particle tied to a fixed point the least mass-weighted change onto the constraints
+    # is the radial projection of the position and the removal of the velocity's radial part
+    # (closed form, docs/theory/initialisation.md).
+    out = run_example("consistent_start.py")
+    assert "refused:" in out and "project_initial_state" in out  # the error says what to do
+    assert number_after("position gap to the radial projection:", out) < 1e-12
+    assert number_after("velocity gap to the tangential part:", out) < 1e-12
+    assert number_after("largest constraint residual", out) < 1e-12
