@@ -108,6 +108,7 @@ def on_page_markdown(markdown, page, config, files):
 # Sphinx roles in docstrings (:class:`X`, :func:`~a.b`) reach the HTML as ":class:<code>X</code>".
 SPHINX_ROLE = re.compile(r":(?:class|func|meth|mod|data|attr|exc|obj):<code>(~?)([\w.]+)</code>")
 _objects: dict[str, str | None] = {}
+LITERAL_MARKER = re.compile(r"(?<=\w)::(</p>)")
 
 
 def _object_index() -> dict[str, str | None]:
@@ -135,7 +136,7 @@ def _object_index() -> dict[str, str | None]:
 
 
 def on_page_content(html, page, config, files):
-    """Turn the Sphinx roles of docstrings into cross-references (or plain code).
+    """Turn the Sphinx roles of docstrings into cross-references (or plain code), and "::" to ":".
 
     Arguments:
         html: the page's HTML.
@@ -147,6 +148,8 @@ def on_page_content(html, page, config, files):
         The HTML with ``:class:`X``` and the like replaced by links to X's documentation where X
         names one object of the package, else by ``X`` as code.
     """
+    # A reST literal-block marker ("reads::") ends a paragraph before a code block: one colon.
+    html = LITERAL_MARKER.sub(r":\1", html)
     if ":<code>" not in html:
         return html
     index = _object_index()
