@@ -262,3 +262,23 @@ def test_tree_scaling():
     assert "closed by a spring: linear solver sparse LU;" in out
     assert number_after("chain (a tree): linear solver tree elimination; time per step grows as N^",
                         out) < 1.5
+
+
+def test_newton_iterations():
+    # Full Newton factorises at every iteration and converges in a few; modified Newton reuses
+    # factorisations (docs/theory/newton.md): far fewer, more iterations, and the same solution to
+    # within its tolerance (1e-12 of the 1 m length scale per step, accumulated over 1000 steps).
+    out = run_example("newton_iterations.py")
+
+    def counts(name: str) -> tuple[int, int]:
+        line = next(row for row in out.splitlines() if row.startswith(name))
+        match = re.search(r": (\d+) iterations .* (\d+) factorisations", line)
+        assert match, line
+        return int(match.group(1)), int(match.group(2))
+
+    full_iterations, full_factorisations = counts("full Newton")
+    modified_iterations, modified_factorisations = counts("modified Newton")
+    assert full_factorisations == full_iterations <= 5 * 1000  # a few per step, one each
+    assert modified_factorisations < full_factorisations / 3
+    assert modified_iterations > full_iterations  # linear convergence
+    assert number_after("largest position gap between the two:", out) < 1e-8
