@@ -245,6 +245,7 @@ def _parser_section(title: str, parser, level: int, with_commands: bool = False)
         lines += [parser.description, ""]
     formatter = parser._get_formatter()
     units = _parameter_units()
+    descriptions = _parameter_descriptions()
     for group in parser._action_groups:
         rows = []
         with_units = any(_unit(action, units) for action in group._group_actions)
@@ -263,6 +264,11 @@ def _parser_section(title: str, parser, level: int, with_commands: bool = False)
             argument = _argument(action)
             default = _default(action)
             text = formatter._expand_help(action) if action.help else ""
+            if action.dest in descriptions:  # a case or sweep parameter: say what it is
+                described = descriptions[action.dest]
+                if not default and text.startswith("default: ") and ";" not in text:
+                    default, text = f"`{text.removeprefix('default: ')}`", ""
+                text = f"{described} ({text})" if text else described
             unit = f" {_unit(action, units)} |" if with_units else ""
             rows.append(f"| {name} | {argument} |{unit} {default} | {_cell(text)} |")
         if not rows:
@@ -280,6 +286,24 @@ def _parser_section(title: str, parser, level: int, with_commands: bool = False)
             "",
         ]
     return lines
+
+
+def _parameter_descriptions() -> dict[str, str]:
+    """The description of each buoy case and sweep parameter, from the Arguments sections of the
+    docstrings of ``BuoyCase`` and ``SweepSettings`` (keys ``case__NAME`` and ``sweep__NAME``, as
+    the command line's option destinations)."""
+    import griffe
+
+    module = griffe.load("vinculo.buoy.case", search_paths=[str(ROOT / "python")],
+                         allow_inspection=False)
+    descriptions = {}
+    for cls, table in (("BuoyCase", "case"), ("SweepSettings", "sweep")):
+        docstring = module[cls].docstring
+        for section in docstring.parse("google") if docstring else []:
+            if section.kind.value == "parameters":
+                for parameter in section.value:
+                    descriptions[f"{table}__{parameter.name}"] = parameter.description
+    return descriptions
 
 
 def _parameter_units() -> dict[str, str]:
