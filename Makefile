@@ -19,18 +19,20 @@ VENV_STAMP := $(VENV)/.installed
 # does not list every requirement that is already satisfied.
 QUIET_PIP := PIP_QUIET=1 PIP_DISABLE_PIP_VERSION_CHECK=1
 
-.PHONY: run test build rust-test clippy .venv
+.PHONY: run test build rust-test clippy docs .venv
 
 ## run: build, then run the main job (the buoy study; tables, figures and summary go to output/)
 run: build
 	$(VENV)/bin/vinculo buoy --output output
 
-## test: formatting, build, Rust lints, Rust tests, Python lint and tests, in that order
+## test: formatting, build, Rust lints, Rust tests, Python lint, the strict docs build, Python
+## tests, in that order (pytest last, so that its summary closes the output)
 test: $(VENV_STAMP)
 	cargo fmt --all --check
 	$(MAKE) clippy
 	$(MAKE) rust-test
-	$(VENV)/bin/ruff check python tests examples
+	$(VENV)/bin/ruff check python tests examples tools
+	$(MAKE) docs
 	$(VENV)/bin/pytest
 
 # The Rust tests, in the release profile with both crates selected (see the top of this file).
@@ -46,6 +48,11 @@ clippy: build
 	PYO3_ENVIRONMENT_SIGNATURE="$$($(VENV)/bin/python -c 'import struct, sys; print("cpython-%d.%d-%dbit" % (*sys.version_info[:2], 8 * struct.calcsize("P")))')" \
 	PYO3_PYTHON=$(CURDIR)/$(VENV)/bin/python VIRTUAL_ENV=$(CURDIR)/$(VENV) \
 	cargo clippy --workspace --all-targets --release -- -D warnings
+
+## docs: build the documentation site into site/ in strict mode (any warning fails the build):
+## runs every example for the gallery and generates the command-line reference (see mkdocs.yml)
+docs: build
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --site-dir site
 
 # Build the extension in release mode and install the package (editable) into .venv, showing
 # cargo's progress (compiling the dependencies takes minutes the first time; see the README).

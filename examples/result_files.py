@@ -4,7 +4,7 @@ At rest, the top link of a chain of n beads of mass m carries the whole weight n
 link below carries the weight of the beads under it. The script reads the tensions back from the
 NetCDF file and compares them with these weights.
 
-    python examples/result_files.py OUTPUT_FOLDER [--beads 4]
+    python examples/result_files.py OUTPUT_FOLDER [--beads 4] [--plot result_files.png]
 """
 
 import argparse
@@ -23,6 +23,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("output", type=Path, help="folder for the files (created if missing)")
     parser.add_argument("--beads", type=int, default=4, help="number of beads (default 4)")
+    parser.add_argument("--plot", metavar="FILE",
+                        help="write a PNG figure of what the two files hold to FILE")
     args = parser.parse_args()
 
     mass, link = 0.1, 0.25
@@ -44,6 +46,38 @@ def main() -> None:
     print(f"top tension from the file: {tension[0]:.12f} N (weight of the chain: "
           f"{weights[0]:.12f} N)")
     print(f"largest tension error: {np.max(np.abs(tension - weights)):.2e} N")
+    if args.plot:
+        plot(data, index, weights, links, args.plot)
+
+
+def plot(data, index: Path, weights: np.ndarray, links, path: str) -> None:
+    """Draw the tensions read from the NetCDF file and the last state read from the .vtu file."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import meshio
+
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.8), layout="constrained")
+    k = np.arange(1, len(weights) + 1)
+    axes[0].plot(k, weights, "k-", label="weight below the link")
+    axes[0].plot(k, data["tension"].values[-1, [c.index for c in links]], "o",
+                 label="tension from chain.nc")
+    axes[0].set(xlabel="link", ylabel="tension (N)", title="NetCDF: tension, last time")
+    axes[0].legend(fontsize=8)
+    time, last = read_pvd(index)[-1]
+    mesh = meshio.read(last)
+    points = mesh.points
+    for block in mesh.cells:
+        if block.type != "line":  # the particles are vertex cells, the distances lines
+            continue
+        for a, b in block.data:
+            axes[1].plot(points[[a, b], 0], points[[a, b], 2], "-", color="0.5")
+    axes[1].scatter(points[:, 0], points[:, 2], c=mesh.point_data["mass"], zorder=3)
+    axes[1].set(xlabel="x (m)", ylabel="z (m)", title=f"ParaView file: {last.name}, t = {time:g} s",
+                xlim=(-0.5, 0.5))
+    fig.savefig(path, dpi=110)
+    print(f"plot: {path}")
 
 
 if __name__ == "__main__":

@@ -34,9 +34,12 @@ from vinculo.simulate import simulate
 from vinculo.solution import Solution
 
 try:
-    __version__ = version("vinculo")
+    _installed_version = version("vinculo")
 except PackageNotFoundError:  # running from a source tree that was never installed
-    __version__ = "0+unknown"
+    _installed_version = "0+unknown"
+
+__version__ = _installed_version
+"""The installed version of vinculo ("0+unknown" in a source tree that was never installed)."""
 
 __all__ = [
     "ConstraintId",

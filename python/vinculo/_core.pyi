@@ -13,7 +13,8 @@ class Law:
     Built by the constructors ``Law.constant``, ``Law.polynomial``, ``Law.sine`` and ``Law.tabulated``.
     """
     @staticmethod
-    def constant(value: float) -> "Law": ...
+    def constant(value: float) -> "Law":
+        """value at every time (rate and acceleration 0)."""
     @staticmethod
     def polynomial(coefficients: Sequence[float]) -> "Law":
         """c0 + c1 t + c2 t^2 + ...  (coefficients in increasing powers)."""
@@ -26,7 +27,8 @@ class Law:
     def tabulated(times: Sequence[float], values: Sequence[float]) -> "Law":
         """Natural cubic spline through the samples (C2). Runs must stay within [times[0], times[-1]];
         evaluated outside, the spline continues along its end tangents."""
-    def __call__(self, t: float) -> float: ...
+    def __call__(self, t: float) -> float:
+        """The law's value at time t."""
     def derivatives(self, t: float) -> tuple[float, float, float]:
         """(value, first derivative, second derivative) at t."""
     def domain(self) -> tuple[float, float]:
@@ -36,12 +38,17 @@ Scalar = Union[float, Law]
 Vector = Sequence[Scalar]
 
 class ParticleId:
+    """Handle of a particle, returned by ``System.add_particle``; valid only with its system."""
     index: int
+    """Position of the particle in the system (row of ``Solution.positions``)."""
 class ConstraintId:
+    """Handle of a constraint, returned by the ``System.add_*`` constraint methods."""
     index: int
     """Index of the constraint's first equation in the multiplier array."""
 class ForceId:
+    """Handle of a force element, returned by the ``System.add_*`` force methods."""
     index: int
+    """Position of the force element in the system."""
 
 class UserGroup:
     """A group of user-defined forces or constraints (``System.add_force_group`` /
@@ -69,29 +76,164 @@ class UserGroup:
         derivative)."""
 
 class System:
+    """A model: particles, constraints and forces, reached through typed handles.
+
+    Arguments:
+        gravity: the uniform gravity vector (m/s^2), e.g. ``(0, 0, -9.81)``; it acts on every
+            particle's mass (not on added mass).
+
+    Raises:
+        InvalidInputError: a gravity that is not three finite numbers.
+    """
     def __init__(self, gravity: Sequence[float] = (0.0, 0.0, 0.0)) -> None: ...
     def copy(self) -> System:
         """An independent copy of the system as it is now; handles of this system work with it."""
     def __copy__(self) -> System: ...
     def add_particle(self, mass: float, position: Sequence[float],
-                     velocity: Sequence[float] = (0.0, 0.0, 0.0), fixed: bool = False) -> ParticleId: ...
+                     velocity: Sequence[float] = (0.0, 0.0, 0.0), fixed: bool = False) -> ParticleId:
+        """Add a point mass.
+
+        Arguments:
+            mass: the mass (kg, > 0).
+            position: the initial position (m), three finite numbers.
+            velocity: the initial velocity (m/s).
+            fixed: a fixed particle never moves and carries no unknowns (a pivot, an anchor).
+
+        Returns:
+            The particle's handle.
+
+        Raises:
+            InvalidInputError: a mass <= 0 or a non-finite position or velocity.
+        """
     def add_distance(self, a: ParticleId, b: ParticleId, length: float | None = None) -> ConstraintId:
-        """Phi = L^2 - |q_a - q_b|^2 (paper eq. 17). length=None: the current distance."""
+        """A rigid link between two particles: Phi = L^2 - |q_a - q_b|^2 (paper eq. 17).
+
+        The multiplier lambda is positive in tension; the tension is 2 lambda L
+        (``Solution.distance_tension``).
+
+        Arguments:
+            a: one end.
+            b: the other end.
+            length: L (m, > 0); None: the current distance.
+
+        Returns:
+            The constraint's handle (one equation).
+
+        Raises:
+            InvalidInputError: a == b, or a length that is not finite and positive.
+            UnknownHandleError: a handle of another system.
+        """
     def add_distance_to_point(self, particle: ParticleId, point: Vector,
                               length: float | None = None) -> ConstraintId:
-        """Phi = L^2 - |q - p(t)|^2 with a prescribed point p(t)."""
+        """A link from a particle to a prescribed point p(t): Phi = L^2 - |q - p(t)|^2.
+
+        Arguments:
+            particle: the particle.
+            point: p(t) (m), each component a number or a Law (an anchor on a moving floor).
+            length: L (m, > 0); None: the current distance at t = 0.
+
+        Returns:
+            The constraint's handle (one equation; tension 2 lambda L).
+
+        Raises:
+            InvalidInputError: a length that is not finite and positive.
+            UnknownHandleError: a handle of another system.
+        """
     def add_plane(self, particle: ParticleId, normal: Vector, point: Vector) -> ConstraintId:
-        """Phi = n(t) . (q - p0(t)) (paper eq. 18); n need not be unit (it is normalised at t=0 for scaling)."""
+        """Hold a particle on a plane: Phi = n(t) . (q - p0(t)) (paper eq. 18).
+
+        The constraint force is n lambda: with a unit normal, lambda is the normal force.
+
+        Arguments:
+            particle: the particle.
+            normal: n(t), each component a number or a Law; it need not be unit (its length at
+                t = 0 scales the equation).
+            point: p0(t) (m), a point of the plane, numbers or Laws.
+
+        Returns:
+            The constraint's handle (one equation).
+
+        Raises:
+            InvalidInputError: a normal of zero length.
+            UnknownHandleError: a handle of another system.
+        """
     def add_fixed_coordinate(self, particle: ParticleId, axis: int | str,
                              value: Scalar | None = None) -> ConstraintId:
-        """Phi = q[axis] - value(t); value=None keeps the current coordinate."""
+        """Prescribe one coordinate of a particle: Phi = q[axis] - value(t).
+
+        The multiplier is the force along +axis.
+
+        Arguments:
+            particle: the particle.
+            axis: 0, 1, 2 or "x", "y", "z".
+            value: the coordinate (m), a number or a Law; None keeps the current coordinate.
+
+        Returns:
+            The constraint's handle (one equation).
+
+        Raises:
+            InvalidInputError: an axis that is not one of the three.
+            UnknownHandleError: a handle of another system.
+        """
     def add_spring_damper(self, a: ParticleId, b: ParticleId, stiffness: float, damping: float = 0.0,
-                          rest_length: float | None = None) -> ForceId: ...
-    def add_force(self, particle: ParticleId, force: Vector) -> ForceId: ...
+                          rest_length: float | None = None) -> ForceId:
+        """A linear spring and dashpot between two particles: axial force k (l - L0) + c l'.
+
+        Arguments:
+            a: one end.
+            b: the other end.
+            stiffness: k (N/m, >= 0).
+            damping: c (N s/m, >= 0).
+            rest_length: L0 (m); None: the current distance.
+
+        Returns:
+            The force's handle.
+
+        Raises:
+            InvalidInputError: a negative or non-finite coefficient, or a == b.
+            UnknownHandleError: a handle of another system.
+        """
+    def add_force(self, particle: ParticleId, force: Vector) -> ForceId:
+        """A prescribed force on one particle, each component a number or a Law of time (N).
+
+        Arguments:
+            particle: the particle.
+            force: (fx, fy, fz), floats or Laws.
+
+        Returns:
+            The force's handle.
+
+        Raises:
+            UnknownHandleError: a handle of another system.
+        """
     def add_linear_drag(self, particle: ParticleId, coefficient: float) -> ForceId:
-        """f = -c v."""
+        """Linear drag f = -c v on one particle.
+
+        Arguments:
+            particle: the particle.
+            coefficient: c (N s/m, >= 0).
+
+        Returns:
+            The force's handle.
+
+        Raises:
+            InvalidInputError: a negative or non-finite coefficient.
+            UnknownHandleError: a handle of another system.
+        """
     def add_quadratic_drag(self, particle: ParticleId, coefficient: float) -> ForceId:
-        """f = -c |v| v."""
+        """Quadratic drag f = -c |v| v on one particle.
+
+        Arguments:
+            particle: the particle.
+            coefficient: c (N s^2/m^2, >= 0).
+
+        Returns:
+            The force's handle.
+
+        Raises:
+            InvalidInputError: a negative or non-finite coefficient.
+            UnknownHandleError: a handle of another system.
+        """
     def add_force_group(
         self,
         particles: npt.ArrayLike,
@@ -193,12 +335,38 @@ class System:
         density: float = 1000.0,
         fluid_motion: Vector | None = None,
     ) -> ForceId:
-        """Fluid forces on a body's centre particle, the fluid moving as a rigid body by
-        X_f(t) = fluid_motion (None: still): rho V (a_f - g) + Ca rho V a_f
-        + 1/2 rho Cd A |u_f - v| (u_f - v); the added mass Ca rho V joins the particle's inertia."""
+        """Fluid forces on a body's centre particle (Morison equation, docs/theory/hydrodynamics.md).
+
+        The fluid moves as a rigid body by X_f(t) = fluid_motion: rho V (a_f - g) + Ca rho V a_f
+        + 1/2 rho Cd A |u_f - v| (u_f - v), with u_f, a_f the derivatives of X_f; the added mass
+        Ca rho V joins the particle's translational inertia.
+
+        Arguments:
+            particle: the body's reference particle (its centre).
+            volume: displaced volume V (m^3, > 0).
+            area: frontal area A for the drag (m^2, >= 0).
+            drag_coefficient: Cd (>= 0).
+            added_mass_coefficient: Ca (>= 0).
+            density: fluid density rho (kg/m^3, > 0).
+            fluid_motion: X_f(t) (m), numbers or Laws; None: still fluid.
+
+        Returns:
+            The force's handle.
+
+        Raises:
+            InvalidInputError: a value outside its domain.
+            UnknownHandleError: a handle of another system.
+        """
     def set_tension_only(self, constraint: ConstraintId) -> None:
         """Declare a distance constraint a string: runs stop with NegativeTensionError when it
-        would have to push."""
+        would have to push.
+
+        Arguments:
+            constraint: a distance (to a particle or to a point).
+
+        Raises:
+            InvalidInputError: a constraint that is not a distance, or not one of this system's.
+        """
     @property
     def constraint_lengths(self) -> npt.NDArray[np.float64]:
         """Length of each constraint (m); NaN for constraints that are not distances."""
@@ -206,24 +374,30 @@ class System:
     def inertia(self) -> npt.NDArray[np.float64]:
         """Translational inertia of each particle: mass plus added mass (kg)."""
     @property
-    def num_particles(self) -> int: ...
+    def num_particles(self) -> int:
+        """Number of particles, fixed ones included."""
     @property
     def num_constraints(self) -> int:
         """Number of constraint equations (= length of the multiplier vector)."""
     @property
-    def gravity(self) -> tuple[float, float, float]: ...
-    def masses(self) -> npt.NDArray[np.float64]: ...
-    def fixed(self) -> npt.NDArray[np.bool_]: ...
+    def gravity(self) -> tuple[float, float, float]:
+        """The gravity vector (m/s^2)."""
+    def masses(self) -> npt.NDArray[np.float64]:
+        """(n,) mass of each particle (kg), added mass excluded."""
+    def fixed(self) -> npt.NDArray[np.bool_]:
+        """(n,) True for the fixed particles."""
     def initial_positions(self) -> npt.NDArray[np.float64]:
         """(n, 3)."""
-    def initial_velocities(self) -> npt.NDArray[np.float64]: ...
+    def initial_velocities(self) -> npt.NDArray[np.float64]:
+        """(n, 3) initial velocities (m/s)."""
     def constraint_names(self) -> list[str]:
         """One readable name per constraint equation, e.g. 'distance #0 (particles 0-1)'."""
     def constraint_scales(self) -> npt.NDArray[np.float64]:
         """Per equation: the factor s_k such that s_k Phi_k is a length (1/(2L) for a distance)."""
     def length_scale(self) -> float:
         """Characteristic length of the model: Newton and initial tolerances are relative to it."""
-    def particles(self) -> list[ParticleId]: ...
+    def particles(self) -> list[ParticleId]:
+        """The handles of every particle, in the order they were added."""
     def constraint_residual(self, positions: npt.ArrayLike, t: float = 0.0) -> npt.NDArray[np.float64]:
         """Phi(q, t) for an (n, 3) array of positions, per equation (unscaled)."""
     def kinetic_energy(self, velocities: npt.ArrayLike) -> npt.NDArray[np.float64]:

@@ -171,6 +171,18 @@ def table(sizes: tuple[int, ...], steps: int, out: Callable[[str], None] = print
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Print the table of the Python-force benchmark.
+
+    Arguments:
+        argv: the command-line arguments (default: ``sys.argv[1:]``); ``--sizes N ...`` and
+            ``--steps K``.
+
+    Returns:
+        The exit code, 0.
+
+    Raises:
+        SystemExit: on bad arguments (from argparse).
+    """
     parser = argparse.ArgumentParser(
         prog="python -m vinculo.bench.user_physics", description=__doc__
     )
