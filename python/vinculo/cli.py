@@ -215,6 +215,13 @@ def _add_case_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--case", metavar="FILE.toml", type=Path,
                         help="TOML file (UTF-8) with a [case] and/or [sweep] table; options "
                         "override it")
+    # The text-valued fields: their valid values and what they mean.
+    choices = {
+        "attachment": (ATTACHMENTS, f"where the string is tied: {ATTACHMENTS[0]} (the sphere's "
+                       f"lowest point) or {ATTACHMENTS[1]}"),
+        "viscous_force": (VISCOUS_FORCES, "viscous force on the sphere besides Morison's: none, "
+                          "or stokes-layer (oscillatory boundary layer, Stokes 1851)"),
+    }
     for cls, table in [(BuoyCase, "case"), (SweepSettings, "sweep")]:
         group = parser.add_argument_group(
             f"{table} parameters (override the TOML [{table}] table)"
@@ -224,19 +231,10 @@ def _add_case_options(parser: argparse.ArgumentParser) -> None:
                 continue
             kind = type(f.default)
             option = "--" + f.name.replace("_", "-")
-            if f.name == "attachment":
-                group.add_argument(option, dest=f"{table}__{f.name}", choices=ATTACHMENTS,
-                                   default=None,
-                                   help=f"where the string is tied: {ATTACHMENTS[0]} (the "
-                                   f"sphere's lowest point) or {ATTACHMENTS[1]} (default: "
-                                   f"{f.default})")
-                continue
-            if f.name == "viscous_force":
-                group.add_argument(option, dest=f"{table}__{f.name}", choices=VISCOUS_FORCES,
-                                   default=None,
-                                   help=f"viscous force on the sphere besides Morison's: none, "
-                                   f"or stokes-layer (oscillatory boundary layer, Stokes 1851) "
-                                   f"(default: {f.default})")
+            if f.name in choices:
+                values, meaning = choices[f.name]
+                group.add_argument(option, dest=f"{table}__{f.name}", choices=values,
+                                   default=None, help=f"{meaning} (default: {f.default})")
                 continue
             group.add_argument(option, dest=f"{table}__{f.name}", metavar=f.name.upper(),
                                type=_number(kind, option), default=None,

@@ -156,6 +156,19 @@ def _is_integer(value: Any) -> bool:
     return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
 
 
+def _whole(owner: str, name: str, value: Any, minimum: int, meaning: str = "") -> None:
+    """Raise unless ``value`` is a whole number (not a bool) of at least ``minimum``; ``meaning``
+    says what a smaller value would stand for."""
+    if not _is_integer(value) or value < minimum:
+        why = f": {meaning}" if meaning else ""
+        raise InvalidInputError(
+            f"{owner}.{name} must be a whole number >= {minimum}, got {value!r}{why}; give a "
+            f"whole number >= {minimum}",
+            name=name,
+            value=value,
+        )
+
+
 def _positive(owner: str, name: str, value: float, unit: str) -> None:
     """Raise unless ``value`` is finite and positive."""
     if not (math.isfinite(value) and value > 0.0):
@@ -268,12 +281,7 @@ class BuoyCase:
                 name="viscous_force",
                 value=self.viscous_force,
             )
-        if not _is_integer(self.string_beads) or self.string_beads < 0:
-            raise InvalidInputError(
-                f"BuoyCase.string_beads must be a whole number >= 0, got {self.string_beads!r}",
-                name="string_beads",
-                value=self.string_beads,
-            )
+        _whole(owner, "string_beads", self.string_beads, 0)
         _at_most(owner, "string_beads", self.string_beads, MAX_STRING_BEADS,
                  "each bead is a particle of the model")
         if self.string_beads > 0 and self.string_mass == 0.0:
@@ -506,23 +514,11 @@ class SweepSettings:
         _positive(owner, "phase_tolerance", self.phase_tolerance, "degrees")
         _positive(owner, "max_periods", self.max_periods, "periods")
         _positive(owner, "resonance_tolerance", self.resonance_tolerance, "Hz")
-        if not _is_integer(self.refine_rounds) or self.refine_rounds < 0:
-            raise InvalidInputError(
-                f"SweepSettings.refine_rounds must be a whole number >= 0, got "
-                f"{self.refine_rounds!r}",
-                name="refine_rounds",
-                value=self.refine_rounds,
-            )
+        _whole(owner, "refine_rounds", self.refine_rounds, 0)
         _positive(owner, "f_max", self.f_max, "Hz")
         _positive(owner, "dt", self.dt, "s")
         _non_negative(owner, "settle_periods", self.settle_periods, "periods")
-        if not _is_integer(self.count) or self.count < 1:
-            raise InvalidInputError(
-                f"SweepSettings.count is {self.count!r}: a frequency range with no points; give "
-                f"a whole number >= 1",
-                name="count",
-                value=self.count,
-            )
+        _whole(owner, "count", self.count, 1, "a frequency range with no points")
         _at_most(owner, "count", self.count, MAX_COUNT, "frequencies in one sweep")
         if self.f_max < self.f_min:
             raise InvalidInputError(
@@ -545,12 +541,7 @@ class SweepSettings:
                 name="count",
                 value=self.count,
             )
-        if not _is_integer(self.fit_periods) or self.fit_periods < 1:
-            raise InvalidInputError(
-                f"SweepSettings.fit_periods must be a whole number >= 1, got {self.fit_periods!r}",
-                name="fit_periods",
-                value=self.fit_periods,
-            )
+        _whole(owner, "fit_periods", self.fit_periods, 1)
         _at_most(owner, "fit_periods", self.fit_periods, MAX_FIT_PERIODS,
                  "periods in one fit window")
         longest = (self.settle_periods + self.fit_periods) / (self.f_min * self.dt)
