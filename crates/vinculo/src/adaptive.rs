@@ -25,10 +25,9 @@ use crate::assembly::NONE;
 use crate::dense_output::StepEnds;
 use crate::error::Error;
 use crate::initial::{factor_saddle, scaled_velocity_violation, scaled_violation};
-use crate::integrators::error_estimate::sample_offset;
 use crate::integrators::{
-    AccelerationHistory, AlphaState, ErrorConstants, GeneralizedAlpha, GeneralizedTrapezoidal,
-    NewtonFailure, NewtonOptions, NewtonReport, Scheme, StabilizedWorkspace, StepWorkspace,
+    AccelerationHistory, ErrorConstants, NewtonOptions, RuleState, StabilizedWorkspace,
+    StepWorkspace,
 };
 use crate::math::Vec3;
 use crate::model::System;
@@ -53,32 +52,6 @@ pub(crate) struct StartState {
     pub v: Vec<Vec3>,
     pub acceleration: Vec<Vec3>,
     pub lambda: Vec<f64>,
-}
-
-/// One step of the scheme from (t, q, v), on the GGL formulation when `stabilized` is given;
-/// `alpha_state` is generalised-alpha's extra state.
-#[allow(clippy::too_many_arguments)]
-fn take_step(
-    scheme: Scheme,
-    system: &System,
-    ws: &mut StepWorkspace,
-    stabilized: Option<&mut StabilizedWorkspace>,
-    t: f64,
-    q: &[Vec3],
-    v: &[Vec3],
-    alpha_state: &mut AlphaState,
-    h: f64,
-    newton: &NewtonOptions,
-) -> Result<NewtonReport, NewtonFailure> {
-    match (stabilized, scheme) {
-        (Some(ggl), _) => ggl.step(system, ws, scheme, t, q, v, alpha_state, h, newton),
-        (None, Scheme::GeneralizedTrapezoidal { alpha }) => {
-            GeneralizedTrapezoidal { alpha }.step(system, ws, t, q, v, h, newton)
-        }
-        (None, Scheme::GeneralizedAlpha { rho_inf }) => {
-            GeneralizedAlpha { rho_inf }.step(system, ws, t, q, v, alpha_state, h, newton)
-        }
-    }
 }
 
 /// Replaces the accelerations `a` by their part tangent to the constraints, with the
@@ -140,7 +113,7 @@ pub(crate) fn march(
     let t0 = options.t_start;
     let n = q.len();
     let free: Vec<bool> = system.particles().iter().map(|p| !p.fixed).collect();
-    let constants = ErrorConstants::of(&scheme);
+    let constants: ErrorConstants = scheme.error_constants();
     // Built at the first attempt, once a factorisation can project the initial accelerations.
     let mut history = AccelerationHistory::new(t0, &acc);
     let mut projection = vec![0.0; ws.layout.unknowns()];
@@ -159,8 +132,8 @@ pub(crate) fn march(
         }
     }
 
-    let mut alpha_state = AlphaState::new(&acc);
-    let mut alpha_saved = alpha_state.clone();
+    let mut rule_state = RuleState::new(&acc);
+    let mut rule_saved = rule_state.clone();
     let (mut q_new, mut v_new, mut lambda_new) = (q.clone(), v.clone(), lambda.clone());
     let (mut a_sample, mut e_q, mut e_v) = (acc.clone(), acc.clone(), acc.clone());
     let mut full = acc.clone();
@@ -186,23 +159,15 @@ pub(crate) fn march(
             sol.steps_taken += 1;
         }
         let stale = newton.jacobian_reuse && ws.matrix.holds(scheme.matrix_key(h_try));
-        if matches!(scheme, Scheme::GeneralizedAlpha { .. }) {
-            alpha_saved
-                .acceleration
-                .copy_from_slice(&alpha_state.acceleration);
-            alpha_saved
-                .algorithmic
-                .copy_from_slice(&alpha_state.algorithmic);
-        }
-        let attempt = take_step(
-            scheme,
+        rule_saved.copy_from(&rule_state);
+        let attempt = scheme.step(
             system,
             ws,
             stabilized.as_deref_mut(),
             t,
             &q,
             &v,
-            &mut alpha_state,
+            &mut rule_state,
             h_try,
             newton,
         );
@@ -233,18 +198,7 @@ pub(crate) fn march(
         };
 
         // The step's acceleration sample (kept whole for the next predictor) and its error.
-        match scheme {
-            Scheme::GeneralizedTrapezoidal { .. } => {
-                for i in 0..n {
-                    for k in 0..3 {
-                        a_sample[i][k] = (ws.state.v[i][k] - v[i][k]) / h_try;
-                    }
-                }
-            }
-            Scheme::GeneralizedAlpha { .. } => {
-                a_sample.copy_from_slice(&alpha_state.acceleration);
-            }
-        }
+        scheme.end_acceleration(&rule_state, h_try, &v, &ws.state.v, &mut a_sample);
         full.copy_from_slice(&a_sample);
         if stabilized.is_some() {
             // The GGL step factorised its own matrix: the projection needs the index-3
@@ -261,21 +215,14 @@ pub(crate) fn march(
             tangential(ws, &mut initial, &mut projection);
             history = AccelerationHistory::new(t0, &initial);
         }
-        let tau = t + sample_offset(&scheme, h_try);
+        let tau = t + scheme.sample_offset(h_try);
         history.estimate(&constants, t, h_try, tau, &a_sample, &mut e_q, &mut e_v);
         let err = run
             .weights
             .norm(h_try, &free, &e_q, &e_v, &q, &ws.state.q, &v, &ws.state.v);
         if err.is_nan() || err > 1.0 {
             sol.steps_rejected += 1;
-            if matches!(scheme, Scheme::GeneralizedAlpha { .. }) {
-                alpha_state
-                    .acceleration
-                    .copy_from_slice(&alpha_saved.acceleration);
-                alpha_state
-                    .algorithmic
-                    .copy_from_slice(&alpha_saved.algorithmic);
-            }
+            rule_state.copy_from(&rule_saved);
             let proposal = controller.rejected(h_try, err);
             if proposal >= control.h_min || h_try > control.h_min {
                 h = proposal.max(control.h_min);

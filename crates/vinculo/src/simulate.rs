@@ -8,8 +8,8 @@ use crate::initial::{
     consistent_accelerations, scaled_velocity_violation, scaled_violation, singular_error,
 };
 use crate::integrators::{
-    AlphaState, Formulation, GeneralizedAlpha, GeneralizedTrapezoidal, NewtonFailure,
-    NewtonOptions, Scheme, StabilizedWorkspace, StepWorkspace,
+    Formulation, NewtonFailure, NewtonOptions, RuleState, Scheme, StabilizedWorkspace,
+    StepWorkspace,
 };
 use crate::linear::SparseSolver;
 use crate::math::Vec3;
@@ -457,7 +457,7 @@ pub fn simulate_with_observer(
     let mut step = 0usize;
     let mut q_new: Vec<Vec3> = q.clone();
     // Generalised-alpha starts with a_0 = qdd_0, the consistent accelerations.
-    let mut alpha_state = AlphaState::new(&acc);
+    let mut rule_state = RuleState::new(&acc);
     let mut fresh_retry = false;
     while t < options.t_end {
         let h_nominal = unit * (1u64 << level) as f64;
@@ -477,32 +477,17 @@ pub fn simulate_with_observer(
         // Modified Newton starting from a matrix of an earlier step gets one more attempt with a
         // fresh matrix before the step counts as failed.
         let stale = newton.jacobian_reuse && ws.matrix.holds(scheme.matrix_key(h_try));
-        let attempt = match (stabilized.as_mut(), scheme) {
-            (Some(ggl), _) => ggl.step(
-                system,
-                &mut ws,
-                scheme,
-                t,
-                &q,
-                &v,
-                &mut alpha_state,
-                h_try,
-                &newton,
-            ),
-            (None, Scheme::GeneralizedTrapezoidal { alpha }) => {
-                GeneralizedTrapezoidal { alpha }.step(system, &mut ws, t, &q, &v, h_try, &newton)
-            }
-            (None, Scheme::GeneralizedAlpha { rho_inf }) => GeneralizedAlpha { rho_inf }.step(
-                system,
-                &mut ws,
-                t,
-                &q,
-                &v,
-                &mut alpha_state,
-                h_try,
-                &newton,
-            ),
-        };
+        let attempt = scheme.step(
+            system,
+            &mut ws,
+            stabilized.as_mut(),
+            t,
+            &q,
+            &v,
+            &mut rule_state,
+            h_try,
+            &newton,
+        );
         sol.factorisations = ws.matrix.factorisations;
         fresh_retry = false;
         // A failed user function stops the run at once (NaN terms would only fail again).
@@ -512,18 +497,7 @@ pub fn simulate_with_observer(
         }
         match attempt {
             Ok(report) => {
-                match scheme {
-                    Scheme::GeneralizedTrapezoidal { .. } => {
-                        for i in 0..q.len() {
-                            for k in 0..3 {
-                                acc[i][k] = (ws.state.v[i][k] - v[i][k]) / h_try;
-                            }
-                        }
-                    }
-                    Scheme::GeneralizedAlpha { .. } => {
-                        acc.copy_from_slice(&alpha_state.acceleration);
-                    }
-                }
+                scheme.end_acceleration(&rule_state, h_try, &v, &ws.state.v, &mut acc);
                 q_new.copy_from_slice(&ws.state.q);
                 std::mem::swap(&mut q, &mut q_new);
                 v.copy_from_slice(&ws.state.v);

@@ -6,6 +6,7 @@
 
 mod parallel;
 mod pattern;
+mod serial;
 
 pub use parallel::{JacobianTerms, ParallelAssembly, ResidualTerms, MIN_TASK};
 pub use pattern::{Pattern, Storage};
@@ -285,6 +286,28 @@ pub fn number_particles(system: &System) -> (Vec<usize>, usize) {
 pub fn add(values: &mut [f64], slot: Slot, value: f64) {
     if slot != NO_SLOT {
         values[slot as usize] += value;
+    }
+}
+
+/// Places a force's local Jacobians: `dq[x][y]` weighted by `wq` into `blocks_q[x][y]` and
+/// `dv[x][y]` weighted by `wv` into `blocks_v[x][y]`, for its `n` particles, through `add`
+/// (which adds a weighted 3x3 matrix into a block). The index-3 layout has one block per pair
+/// (`blocks_q` and `blocks_v` the same), the GGL layout one in the position and one in the
+/// velocity columns.
+#[inline]
+pub fn add_force_blocks(
+    n: usize,
+    blocks_q: &[[Block; 2]; 2],
+    blocks_v: &[[Block; 2]; 2],
+    (wq, dq): (f64, &crate::forces::Jacobian),
+    (wv, dv): (f64, &crate::forces::Jacobian),
+    mut add: impl FnMut(&Block, f64, &crate::math::Mat3),
+) {
+    for x in 0..n {
+        for y in 0..n {
+            add(&blocks_q[x][y], wq, &dq[x][y]);
+            add(&blocks_v[x][y], wv, &dv[x][y]);
+        }
     }
 }
 

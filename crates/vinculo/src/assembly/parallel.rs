@@ -21,7 +21,7 @@
 
 use rayon::prelude::*;
 
-use super::{Block, Layout, Slot, NONE, NO_SLOT};
+use super::{add_force_blocks, Block, Layout, Slot, NONE, NO_SLOT};
 use crate::constraints::{Gradient, Hessian};
 use crate::forces::{Jacobian, Local};
 use crate::math::{Mat3, Vec3};
@@ -104,6 +104,21 @@ pub struct JacobianTerms<'a> {
     pub lambda: &'a [f64],
     /// Scale of each constraint row.
     pub scales: &'a [f64],
+}
+
+impl ResidualTerms<'_> {
+    /// True when the constraint rows are evaluated where the gradients are (the same positions
+    /// and time), so that one evaluation serves both.
+    pub fn same_point(&self) -> bool {
+        std::ptr::eq(self.q_eval, self.q_end) && self.t_eval.to_bits() == self.t_end.to_bits()
+    }
+}
+
+impl JacobianTerms<'_> {
+    /// True when the Phi_q rows are evaluated where the -Phi_q^T columns are.
+    pub fn same_point(&self) -> bool {
+        std::ptr::eq(self.q_eval, self.q_end) && self.t_eval.to_bits() == self.t_end.to_bits()
+    }
 }
 
 /// The matrix's value array shared by the tasks of one colour.
@@ -387,24 +402,19 @@ impl ParallelAssembly {
                     let mut dq: Jacobian = Default::default();
                     let mut dv: Jacobian = Default::default();
                     f.add_jacobian(at.q_eval, at.v_eval, at.t_eval, &mut dq, &mut dv);
-                    let n = f.particles().len();
-                    for x in 0..n {
-                        for y in 0..n {
-                            let blk = &layout.force_block[fi][x][y];
-                            // SAFETY: rows of this chunk's free particles, which no other chunk
-                            // of this colour touches (see `SharedValues`).
-                            unsafe {
-                                shared.add_block(blk, at.force_dq, &dq[x][y]);
-                                shared.add_block(blk, at.force_dv, &dv[x][y]);
-                            }
-                        }
-                    }
+                    let blocks = &layout.force_block[fi];
+                    let (wq, wv) = ((at.force_dq, &dq), (at.force_dv, &dv));
+                    add_force_blocks(f.particles().len(), blocks, blocks, wq, wv, |b, s, m| {
+                        // SAFETY: the blocks of this force, in rows of this chunk's free
+                        // particles, which no other chunk of this colour touches (see
+                        // `SharedValues`).
+                        unsafe { shared.add_block(b, s, m) }
+                    });
                 }
             });
         }
         let constraints = system.constraints();
-        let same_point =
-            std::ptr::eq(at.q_eval, at.q_end) && at.t_eval.to_bits() == at.t_end.to_bits();
+        let same_point = at.same_point();
         for g in 0..self.constraint_colour_start.len() - 1 {
             let group = &self.constraint_colours
                 [self.constraint_colour_start[g]..self.constraint_colour_start[g + 1]];

@@ -274,7 +274,7 @@ impl StabilizedLayout {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrators::trapezoidal::tests::every_kind;
+    use crate::integrators::fixtures::every_kind;
 
     /// Every slot is in the pattern (a missing entry panics in `Pattern::slot`), and the pattern
     /// has exactly the structural entries counted by hand for a pendulum (1 free particle, one
