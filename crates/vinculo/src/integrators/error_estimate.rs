@@ -206,7 +206,8 @@ impl AccelerationHistory {
 mod tests {
     use super::*;
     use crate::integrators::{
-        GeneralizedAlpha, GeneralizedTrapezoidal, NewtonOptions, RuleState, StepWorkspace,
+        index3_step, GeneralizedAlpha, GeneralizedTrapezoidal, NewtonOptions, RuleState,
+        StepWorkspace,
     };
     use crate::laws::VectorLaw;
     use crate::model::System;
@@ -288,12 +289,14 @@ mod tests {
                 let a = e[2] + delta * h * e[3] + kappa * h * h * e[4];
                 let mut alpha_state = RuleState::new(&state(a));
                 alpha_state.acceleration = state(e[2]);
-                ga.step(
+                let (q, v) = (&q_n, &v_n);
+                index3_step(
+                    ga,
                     &system,
                     &mut ws,
                     t_n,
-                    &q_n,
-                    &v_n,
+                    q,
+                    v,
                     &mut alpha_state,
                     h,
                     &newton,

@@ -67,7 +67,7 @@
 //! w = 1 (everything at t_{n+1}).
 
 use super::error_estimate::ErrorConstants;
-use super::rule::{GglCoefficients, Index3Rule, RuleState, TimeRule};
+use super::rule::{GglCoefficients, Index3Rule, RuleState, StepPoint, TimeRule};
 use crate::math::Vec3;
 
 /// The scheme, given by its spectral radius at infinite frequency rho_inf in [0, 1].
@@ -151,28 +151,19 @@ pub struct AlphaStep<'a> {
     w: &'a [Vec3],
     a_n: &'a [Vec3],
     qdd_n: &'a [Vec3],
-    t_end: f64,
     known: Predictors,
     /// d(qdd_{n+1})/dq = (1 - alpha_m)/((1 - alpha_f) beta h^2).
     c: f64,
     /// d(v_{n+1})/dq = gamma/(beta h).
     dv_dq: f64,
-    sigma: f64,
+    point: StepPoint,
 }
 
 impl Index3Rule for AlphaStep<'_> {
     const AT_END: bool = true;
 
-    fn sigma(&self) -> f64 {
-        self.sigma
-    }
-
-    fn t_eval(&self) -> f64 {
-        self.t_end
-    }
-
-    fn t_end(&self) -> f64 {
-        self.t_end
+    fn point(&self) -> StepPoint {
+        self.point
     }
 
     #[inline(always)]
@@ -195,17 +186,18 @@ impl Index3Rule for AlphaStep<'_> {
         let known = &self.known;
         let a = (q - self.p[i][k]) * known.inv_beta_h2;
         let inertial = known.c_a * a + known.c_m * self.a_n[i][k] - known.c_f * self.qdd_n[i][k];
-        self.sigma * (inertia * inertial - mass * g)
+        self.point.sigma * (inertia * inertial - mass * g)
     }
 
     /// sigma c M = M/m_ref: the scaled mass block.
     #[inline(always)]
     fn mass_diagonal(&self, inertia: f64) -> f64 {
-        self.sigma * self.c * inertia
+        self.point.sigma * self.c * inertia
     }
 
     fn weights(&self) -> (f64, f64, f64) {
-        (-self.sigma, -self.sigma * self.dv_dq, -self.sigma)
+        let sigma = self.point.sigma;
+        (-sigma, -sigma * self.dv_dq, -sigma)
     }
 }
 
@@ -273,11 +265,14 @@ impl TimeRule for GeneralizedAlpha {
             w: &state.predicted_v,
             a_n: &state.algorithmic,
             qdd_n: &state.acceleration,
-            t_end: t_n + h,
             known: Predictors::new(&k, h),
             c,
             dv_dq: k.gamma / (k.beta * h),
-            sigma: 1.0 / (c * mass_ref),
+            point: StepPoint {
+                t_eval: t_n + h,
+                t_end: t_n + h,
+                sigma: 1.0 / (c * mass_ref),
+            },
         }
     }
 

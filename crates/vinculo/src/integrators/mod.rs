@@ -26,7 +26,7 @@ pub use generalized_alpha::{AlphaCoefficients, AlphaStep, GeneralizedAlpha};
 pub use newton::{
     IterationMatrix, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport,
 };
-pub use rule::{GglCoefficients, Index3Rule, RuleState, TimeRule};
+pub use rule::{GglCoefficients, Index3Rule, RuleState, StepPoint, TimeRule};
 pub use stabilized::{phi_qt, Formulation, StabilizedWorkspace};
 pub use stabilized_layout::StabilizedLayout;
 pub use step_problem::{index3_step, StepProblem};
@@ -161,23 +161,5 @@ impl GeneralizedTrapezoidal {
     ) -> Result<NewtonReport, NewtonFailure> {
         let mut none = RuleState::new(&[]);
         index3_step(*self, system, ws, t_n, q_n, v_n, &mut none, h, options)
-    }
-}
-
-impl GeneralizedAlpha {
-    /// Takes one index-3 step of size `h` from (t_n, q_n, v_n, `state`) ([`index3_step`]).
-    #[allow(clippy::too_many_arguments)]
-    pub fn step(
-        &self,
-        system: &System,
-        ws: &mut StepWorkspace,
-        t_n: f64,
-        q_n: &[Vec3],
-        v_n: &[Vec3],
-        state: &mut RuleState,
-        h: f64,
-        options: &NewtonOptions,
-    ) -> Result<NewtonReport, NewtonFailure> {
-        index3_step(*self, system, ws, t_n, q_n, v_n, state, h, options)
     }
 }

@@ -74,12 +74,8 @@ pub trait Index3Rule: Sync {
     /// v_e = v_{n+1}, t_e = t_{n+1}); false: at a point of their own (stored by the step problem
     /// in its evaluation buffers).
     const AT_END: bool;
-    /// Scale of the dynamics rows.
-    fn sigma(&self) -> f64;
-    /// Time of the evaluation point t_e.
-    fn t_eval(&self) -> f64;
-    /// t_{n+1}.
-    fn t_end(&self) -> f64;
+    /// The step's evaluation and end times and the scale of its dynamics rows.
+    fn point(&self) -> StepPoint;
     /// (v_{n+1}, q_e, v_e) of particle `i` at the iterate `q` (q_e and v_e unused when
     /// [`Index3Rule::AT_END`]).
     fn kinematics(&self, i: usize, q: &Vec3) -> (Vec3, Vec3, Vec3);
@@ -100,6 +96,17 @@ pub trait Index3Rule: Sync {
     fn mass_diagonal(&self, inertia: f64) -> f64;
     /// The weights (of df/dq, of df/dv, of lambda_k Phi_k,qq) in the scaled Jacobian.
     fn weights(&self) -> (f64, f64, f64);
+}
+
+/// Where an index-3 step is evaluated and how its dynamics rows are scaled.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepPoint {
+    /// Time of the evaluation point t_e.
+    pub t_eval: f64,
+    /// t_{n+1}.
+    pub t_end: f64,
+    /// Scale of the dynamics rows.
+    pub sigma: f64,
 }
 
 /// The coefficients of a stabilised (GGL) step in its common linear form

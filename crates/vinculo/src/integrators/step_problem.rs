@@ -113,13 +113,14 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
         let b = &*self.buffers;
         let (q_eval, v_eval) = Self::eval_point(b);
         let rule = &self.rule;
+        let point = rule.point();
         let terms = ResidualTerms {
             q_eval,
             v_eval,
-            t_eval: rule.t_eval(),
+            t_eval: point.t_eval,
             q_end: &b.q,
-            t_end: rule.t_end(),
-            sigma: rule.sigma(),
+            t_end: point.t_end,
+            sigma: point.sigma,
             lambda: &b.lambda,
             scales: self.scales,
         };
@@ -140,12 +141,13 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
         let (q_eval, v_eval) = Self::eval_point(b);
         let rule = &self.rule;
         let (force_dq, force_dv, hessian) = rule.weights();
+        let point = rule.point();
         let terms = JacobianTerms {
             q_eval,
             v_eval,
-            t_eval: rule.t_eval(),
+            t_eval: point.t_eval,
             q_end: &b.q,
-            t_end: rule.t_end(),
+            t_end: point.t_end,
             force_dq,
             force_dv,
             hessian,
@@ -162,8 +164,13 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
 
     fn update(&mut self, dx: &[f64]) {
         let b = &mut *self.buffers;
-        self.layout
-            .apply_increment(&mut b.q, &mut b.lambda, dx, self.scales, self.rule.sigma());
+        self.layout.apply_increment(
+            &mut b.q,
+            &mut b.lambda,
+            dx,
+            self.scales,
+            self.rule.point().sigma,
+        );
     }
 }
 

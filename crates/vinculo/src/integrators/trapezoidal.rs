@@ -29,7 +29,7 @@
 //! c_v = 1/h, c = -v_n/h, w = alpha.
 
 use super::error_estimate::ErrorConstants;
-use super::rule::{GglCoefficients, Index3Rule, RuleState, TimeRule};
+use super::rule::{GglCoefficients, Index3Rule, RuleState, StepPoint, TimeRule};
 use crate::math::Vec3;
 
 /// The rule and its parameter alpha in [1/2, 1] (1/2: trapezoidal, 1: backward Euler).
@@ -45,27 +45,18 @@ pub struct GeneralizedTrapezoidal {
 pub struct TrapezoidalStep<'a> {
     q_n: &'a [Vec3],
     v_n: &'a [Vec3],
-    t_n: f64,
     h: f64,
     alpha: f64,
     inv_h: f64,
     inv_alpha: f64,
-    sigma: f64,
+    point: StepPoint,
 }
 
 impl Index3Rule for TrapezoidalStep<'_> {
     const AT_END: bool = false;
 
-    fn sigma(&self) -> f64 {
-        self.sigma
-    }
-
-    fn t_eval(&self) -> f64 {
-        self.t_n + self.alpha * self.h
-    }
-
-    fn t_end(&self) -> f64 {
-        self.t_n + self.h
+    fn point(&self) -> StepPoint {
+        self.point
     }
 
     #[inline(always)]
@@ -89,16 +80,16 @@ impl Index3Rule for TrapezoidalStep<'_> {
         mass: f64,
         g: f64,
     ) -> f64 {
-        self.sigma * (inertia * ((v - self.v_n[i][k]) * self.inv_h) - mass * g)
+        self.point.sigma * (inertia * ((v - self.v_n[i][k]) * self.inv_h) - mass * g)
     }
 
     #[inline(always)]
     fn mass_diagonal(&self, inertia: f64) -> f64 {
-        self.sigma * inertia / (self.alpha * self.h * self.h)
+        self.point.sigma * inertia / (self.alpha * self.h * self.h)
     }
 
     fn weights(&self) -> (f64, f64, f64) {
-        let sigma = self.sigma;
+        let sigma = self.point.sigma;
         (-sigma * self.alpha, -sigma / self.h, -sigma * self.alpha)
     }
 }
@@ -146,12 +137,15 @@ impl TimeRule for GeneralizedTrapezoidal {
         TrapezoidalStep {
             q_n,
             v_n,
-            t_n,
             h,
             alpha: self.alpha,
             inv_h: 1.0 / h,
             inv_alpha: 1.0 / self.alpha,
-            sigma: self.alpha * h * h / mass_ref,
+            point: StepPoint {
+                t_eval: t_n + self.alpha * h,
+                t_end: t_n + h,
+                sigma: self.alpha * h * h / mass_ref,
+            },
         }
     }
 
