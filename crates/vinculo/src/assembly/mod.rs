@@ -199,7 +199,7 @@ impl Layout {
     /// block) and `s grad_row` into its row (the Phi_q block). The schemes differ only in where
     /// they evaluate the two gradients and the Hessian.
     #[allow(clippy::too_many_arguments)]
-    #[inline]
+    #[inline(always)]
     pub fn add_constraint_blocks(
         &self,
         values: &mut [f64],
@@ -279,6 +279,13 @@ pub fn number_particles(system: &System) -> (Vec<usize>, usize) {
         }
     }
     (dof, free)
+}
+
+/// The start of each free particle's three residual rows: its scaled inertia and gravity terms
+/// (what a time rule contributes to the residual besides the elements).
+pub trait InertiaRows: Sync {
+    /// The three rows of particle `i`.
+    fn rows(&self, i: usize) -> crate::math::Vec3;
 }
 
 /// Adds `value` at `slot` unless the slot is absent.

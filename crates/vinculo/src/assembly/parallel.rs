@@ -21,7 +21,7 @@
 
 use rayon::prelude::*;
 
-use super::{add_force_blocks, Block, Layout, Slot, NONE, NO_SLOT};
+use super::{add_force_blocks, Block, InertiaRows, Layout, Slot, NONE, NO_SLOT};
 use crate::constraints::{Gradient, Hessian};
 use crate::forces::{Jacobian, Local};
 use crate::math::{Mat3, Vec3};
@@ -310,7 +310,7 @@ impl ParallelAssembly {
         self.constraint_colour_start.len() - 1
     }
 
-    /// Writes the scaled residual: `row(i, k)` is the start of row k of particle i (its
+    /// Writes the scaled residual: `row.rows(i)` is the start of the three rows of particle i (its
     /// inertia and gravity terms), then forces and constraint gradients are subtracted and the
     /// constraint rows written, as in the serial loops and with the same result.
     pub fn residual(
@@ -319,7 +319,7 @@ impl ParallelAssembly {
         layout: &Layout,
         at: &ResidualTerms<'_>,
         r: &mut [f64],
-        row: impl Fn(usize, usize) -> f64 + Sync,
+        row: &impl InertiaRows,
     ) {
         let m3 = 3 * layout.free;
         let (dynamics, constraint_rows) = r.split_at_mut(m3);
@@ -347,9 +347,7 @@ impl ParallelAssembly {
             .zip(this.free.par_iter())
             .with_min_len(MIN_TASK)
             .for_each(|(out, &i)| {
-                for (k, o) in out.iter_mut().enumerate() {
-                    *o = row(i, k);
-                }
+                out.copy_from_slice(&row.rows(i));
                 for &e in &this.force_incidence[this.force_start[i]..this.force_start[i + 1]] {
                     let fl = &this.forces[e / 2][e % 2];
                     for k in 0..3 {

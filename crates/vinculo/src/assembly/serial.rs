@@ -4,14 +4,14 @@
 //! residual equals this one bit for bit.
 
 use super::JacobianTerms;
-use super::{add_force_blocks, Layout, ResidualTerms, NONE};
+use super::{add_force_blocks, InertiaRows, Layout, ResidualTerms, NONE};
 use crate::constraints::Hessian;
 use crate::forces::Jacobian;
 use crate::model::System;
 
 impl Layout {
-    /// Writes the scaled residual: `row(i, k)` is the start of row k of free particle i (its
-    /// inertia and gravity terms); then each force's local forces and each constraint's
+    /// Writes the scaled residual: `row.rows(i)` is the start of the three rows of free particle i
+    /// (its inertia and gravity terms); then each force's local forces and each constraint's
     /// gradient term at the evaluation point are subtracted, and each constraint's row
     /// s_k Phi_k(q_end, t_end) written.
     pub fn residual(
@@ -19,14 +19,12 @@ impl Layout {
         system: &System,
         at: &ResidualTerms<'_>,
         r: &mut [f64],
-        row: impl Fn(usize, usize) -> f64,
+        row: &impl InertiaRows,
     ) {
         let sigma = at.sigma;
         for (i, &d) in self.dof.iter().enumerate() {
             if d != NONE {
-                for k in 0..3 {
-                    r[d + k] = row(i, k);
-                }
+                r[d..d + 3].copy_from_slice(&row.rows(i));
             }
         }
         for f in system.forces() {

@@ -176,17 +176,20 @@ impl Index3Rule for AlphaStep<'_> {
     fn inertia_row(
         &self,
         i: usize,
-        k: usize,
-        q: f64,
-        _v: f64,
+        q: &Vec3,
+        _v: &Vec3,
         inertia: f64,
         mass: f64,
-        g: f64,
-    ) -> f64 {
+        g: &Vec3,
+    ) -> Vec3 {
         let known = &self.known;
-        let a = (q - self.p[i][k]) * known.inv_beta_h2;
-        let inertial = known.c_a * a + known.c_m * self.a_n[i][k] - known.c_f * self.qdd_n[i][k];
-        self.point.sigma * (inertia * inertial - mass * g)
+        let (p, a_n, qdd_n) = (&self.p[i], &self.a_n[i], &self.qdd_n[i]);
+        let sigma = self.point.sigma;
+        std::array::from_fn(|k| {
+            let a = (q[k] - p[k]) * known.inv_beta_h2;
+            let inertial = known.c_a * a + known.c_m * a_n[k] - known.c_f * qdd_n[k];
+            sigma * (inertia * inertial - mass * g[k])
+        })
     }
 
     /// sigma c M = M/m_ref: the scaled mass block.

@@ -79,19 +79,9 @@ pub trait Index3Rule: Sync {
     /// (v_{n+1}, q_e, v_e) of particle `i` at the iterate `q` (q_e and v_e unused when
     /// [`Index3Rule::AT_END`]).
     fn kinematics(&self, i: usize, q: &Vec3) -> (Vec3, Vec3, Vec3);
-    /// The scaled inertia and gravity term sigma (M qdd_{n+1} - m g) of coordinate `k` of
-    /// particle `i`, from its iterate coordinate `q` and new velocity `v`.
-    #[allow(clippy::too_many_arguments)]
-    fn inertia_row(
-        &self,
-        i: usize,
-        k: usize,
-        q: f64,
-        v: f64,
-        inertia: f64,
-        mass: f64,
-        g: f64,
-    ) -> f64;
+    /// The scaled inertia and gravity terms sigma (M qdd_{n+1} - m g) of particle `i`, from its
+    /// iterate `q` and new velocity `v`.
+    fn inertia_row(&self, i: usize, q: &Vec3, v: &Vec3, inertia: f64, mass: f64, g: &Vec3) -> Vec3;
     /// The scaled mass term sigma (d qdd / dq) M of a particle of inertia `inertia`.
     fn mass_diagonal(&self, inertia: f64) -> f64;
     /// The weights (of df/dq, of df/dv, of lambda_k Phi_k,qq) in the scaled Jacobian.

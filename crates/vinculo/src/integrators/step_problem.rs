@@ -22,8 +22,11 @@ use rayon::prelude::*;
 use super::newton::{self, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport};
 use super::rule::{Index3Rule, RuleState, TimeRule};
 use super::workspace::{StepBuffers, StepWorkspace};
-use crate::assembly::{JacobianTerms, Layout, ParallelAssembly, ResidualTerms, MIN_TASK};
+use crate::assembly::{
+    InertiaRows, JacobianTerms, Layout, ParallelAssembly, ResidualTerms, MIN_TASK,
+};
 use crate::math::Vec3;
+use crate::model::Particle;
 use crate::model::System;
 
 /// One index-3 step's nonlinear problem, for the rule step `R`.
@@ -126,13 +129,17 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
         };
         let (system, layout, inertia) = (self.system, self.layout, self.inertia);
         let (particles, g) = (system.particles(), system.gravity());
-        let row = |i: usize, k: usize| {
-            let mass = particles[i].mass;
-            rule.inertia_row(i, k, b.q[i][k], b.v[i][k], inertia[i], mass, g[k])
+        let row = Rows {
+            rule,
+            q: &b.q,
+            v: &b.v,
+            inertia,
+            particles,
+            g,
         };
         match self.parallel.as_deref_mut() {
-            Some(parallel) => parallel.residual(system, layout, &terms, r, row),
-            None => layout.residual(system, &terms, r, row),
+            Some(parallel) => parallel.residual(system, layout, &terms, r, &row),
+            None => layout.residual(system, &terms, r, &row),
         }
     }
 
@@ -171,6 +178,26 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
             self.scales,
             self.rule.point().sigma,
         );
+    }
+}
+
+/// The inertia and gravity rows of a step of the rule step `R` at the current iterate.
+struct Rows<'b, R> {
+    rule: &'b R,
+    q: &'b [Vec3],
+    v: &'b [Vec3],
+    inertia: &'b [f64],
+    particles: &'b [Particle],
+    g: Vec3,
+}
+
+impl<R: Index3Rule> InertiaRows for Rows<'_, R> {
+    #[inline(always)]
+    fn rows(&self, i: usize) -> Vec3 {
+        let mass = self.particles[i].mass;
+        let (q, v) = (&self.q[i], &self.v[i]);
+        self.rule
+            .inertia_row(i, q, v, self.inertia[i], mass, &self.g)
     }
 }
 

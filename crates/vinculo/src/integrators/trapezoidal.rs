@@ -73,14 +73,15 @@ impl Index3Rule for TrapezoidalStep<'_> {
     fn inertia_row(
         &self,
         i: usize,
-        k: usize,
-        _q: f64,
-        v: f64,
+        _q: &Vec3,
+        v: &Vec3,
         inertia: f64,
         mass: f64,
-        g: f64,
-    ) -> f64 {
-        self.point.sigma * (inertia * ((v - self.v_n[i][k]) * self.inv_h) - mass * g)
+        g: &Vec3,
+    ) -> Vec3 {
+        let v_n = &self.v_n[i];
+        let sigma = self.point.sigma;
+        std::array::from_fn(|k| sigma * (inertia * ((v[k] - v_n[k]) * self.inv_h) - mass * g[k]))
     }
 
     #[inline(always)]
