@@ -333,16 +333,25 @@ impl<'a> Simulation<'a> {
                 sol.truncate(0);
             }
         }
-        let rule = RuleState::new(&acc);
+        let rule = options.scheme.initial_state(&acc);
+        // Buffers of what only some runs do (allocated empty otherwise: at 10^6 particles each
+        // array of 3-vectors is 24 MB).
+        let adaptive = matches!(controller, Controller::Adaptive(_));
+        let dense = options.output_times.is_some();
+        let if_dense = |x: &Vec<Vec3>| if dense { x.clone() } else { Vec::new() };
         let scratch = Scratch {
             q_new: q.clone(),
             v_new: v.clone(),
             lambda_new: lambda.clone(),
             acc_new: acc.clone(),
-            q_out: q.clone(),
-            v_out: v.clone(),
-            lambda_out: lambda.clone(),
-            rule_saved: rule.clone(),
+            q_out: if_dense(&q),
+            v_out: if_dense(&v),
+            lambda_out: if dense { lambda.clone() } else { Vec::new() },
+            rule_saved: if adaptive {
+                rule.clone()
+            } else {
+                RuleState::new(&[])
+            },
         };
         Ok(Simulation {
             system,

@@ -109,6 +109,11 @@ impl Scheme {
         with_rule!(*self, rule => rule.sample_offset(h))
     }
 
+    /// The rule's state at the start of a run with the consistent accelerations `acc`.
+    pub fn initial_state(&self, acc: &[Vec3]) -> RuleState {
+        with_rule!(*self, rule => rule.initial_state(acc))
+    }
+
     /// Takes one step of size `h` from (t_n, q_n, v_n, `state`): on the GGL formulation when
     /// `stabilized` is given, on the index-3 DAE otherwise ([`index3_step`],
     /// [`StabilizedWorkspace::step`] say what the buffers hold before and after).

@@ -129,6 +129,12 @@ pub trait TimeRule: Copy + Send + Sync {
     /// Where, after t_n, a step of size `h` leaves its acceleration sample.
     fn sample_offset(&self, h: f64) -> f64;
 
+    /// The state at the start of a run with the consistent accelerations `acc`
+    /// ([`RuleState::new`]; rules that carry no accelerations may leave it empty).
+    fn initial_state(&self, acc: &[Vec3]) -> RuleState {
+        RuleState::new(acc)
+    }
+
     /// The index-3 step of size `h` from (t_n, q_n, v_n, `state`), computing its predictors into
     /// `state` first; `mass_ref` sets the scaling.
     fn index3<'a>(

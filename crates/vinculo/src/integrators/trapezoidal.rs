@@ -150,6 +150,11 @@ impl TimeRule for GeneralizedTrapezoidal {
         }
     }
 
+    /// Empty: the rule carries no state besides (q, v).
+    fn initial_state(&self, _acc: &[Vec3]) -> RuleState {
+        RuleState::new(&[])
+    }
+
     fn advance(&self, _state: &mut RuleState, _h: f64, _q: &[Vec3]) {}
 
     fn ggl(
