@@ -23,7 +23,10 @@ use rayon::prelude::*;
 
 use super::{add_force_blocks, Block, InertiaRows, Layout, Slot, NONE, NO_SLOT};
 use crate::constraints::{Gradient, Hessian};
-use crate::forces::{Jacobian, Local};
+use crate::forces::{Jacobian, Local, MAX_FORCE_PARTICLES};
+
+/// Entries of the force incidence lists per force.
+const FORCE_STRIDE: usize = MAX_FORCE_PARTICLES;
 use crate::math::{Mat3, Vec3};
 use crate::model::System;
 
@@ -42,7 +45,7 @@ pub struct ParallelAssembly {
     free: Vec<usize>,
     /// Per particle, the range of `force_incidence` of the forces touching it.
     force_start: Vec<usize>,
-    /// Entries 2 f + x: force f touches the particle as its particle x; increasing in f.
+    /// Entries 3 f + x ([`FORCE_STRIDE`]): force f touches the particle as its particle x; increasing in f.
     force_incidence: Vec<usize>,
     /// Per particle, the range of `constraint_incidence` of the constraints touching it.
     constraint_start: Vec<usize>,
@@ -183,13 +186,14 @@ impl SharedValues {
     }
 }
 
-/// Incidence lists: for each particle, entries 2 e + x of the elements e touching it (as their
+/// Incidence lists: for each particle, entries `stride` e + x of the elements e touching it (as their
 /// particle x), in increasing e. Fixed particles are left out when `free_only`.
 fn incidence<'a>(
     particles: usize,
     elements: impl Iterator<Item = &'a [usize]> + Clone,
     dof: &[usize],
     free_only: bool,
+    stride: usize,
 ) -> (Vec<usize>, Vec<usize>) {
     let keep = |p: usize| !free_only || dof[p] != NONE;
     let mut start = vec![0usize; particles + 1];
@@ -205,7 +209,7 @@ fn incidence<'a>(
     let mut entries = vec![0usize; start[particles]];
     for (e, parts) in elements.enumerate() {
         for (x, &p) in parts.iter().enumerate().filter(|&(_, &p)| keep(p)) {
-            entries[next[p]] = 2 * e + x;
+            entries[next[p]] = stride * e + x;
             next[p] += 1;
         }
     }
@@ -220,7 +224,9 @@ fn colour_chunks<'a>(
     elements: impl Iterator<Item = &'a [usize]> + Clone,
     dof: &[usize],
 ) -> (Vec<usize>, Vec<usize>) {
-    let (start, entries) = incidence(particles, elements.clone(), dof, true);
+    // Any stride serves: the colouring reads only which element an entry is.
+    let stride = MAX_FORCE_PARTICLES;
+    let (start, entries) = incidence(particles, elements.clone(), dof, true, stride);
     let chunks = elements.clone().count().div_ceil(CHUNK);
     let mut colours = vec![0usize; chunks];
     let mut taken: Vec<usize> = Vec::new();
@@ -231,7 +237,7 @@ fn colour_chunks<'a>(
         while let Some((_, ps)) = parts.next_if(|&(e, _)| e / CHUNK == k) {
             for &p in ps.iter().filter(|&&p| dof[p] != NONE) {
                 for &entry in &entries[start[p]..start[p + 1]] {
-                    let other = entry / 2 / CHUNK;
+                    let other = entry / stride / CHUNK;
                     if other < k {
                         taken.push(colours[other]);
                     }
@@ -272,10 +278,15 @@ impl ParallelAssembly {
         let free = (0..n).filter(|&i| dof[i] != NONE).collect();
         let forces = system.forces();
         let constraints = system.constraints();
-        let (force_start, force_incidence) =
-            incidence(n, forces.iter().map(|f| f.particles()), dof, true);
+        let (force_start, force_incidence) = incidence(
+            n,
+            forces.iter().map(|f| f.particles()),
+            dof,
+            true,
+            FORCE_STRIDE,
+        );
         let (constraint_start, constraint_incidence) =
-            incidence(n, constraints.iter().map(|c| c.particles()), dof, true);
+            incidence(n, constraints.iter().map(|c| c.particles()), dof, true, 2);
         let none: &[usize] = &[];
         let (force_colours, force_colour_start) = colour_chunks(
             n,
@@ -349,7 +360,7 @@ impl ParallelAssembly {
             .for_each(|(out, &i)| {
                 out.copy_from_slice(&row.rows(i));
                 for &e in &this.force_incidence[this.force_start[i]..this.force_start[i + 1]] {
-                    let fl = &this.forces[e / 2][e % 2];
+                    let fl = &this.forces[e / FORCE_STRIDE][e % FORCE_STRIDE];
                     for k in 0..3 {
                         out[k] -= sigma * fl[k];
                     }

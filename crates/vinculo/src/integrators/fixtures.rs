@@ -8,8 +8,8 @@ use crate::laws::{Law, VectorLaw};
 use crate::math::Vec3;
 use crate::model::System;
 
-/// A system with every constraint and force kind, fixed particles, added mass and
-/// time-dependent laws.
+/// A system with every constraint and force kind (a bending force among them, over three
+/// particles), fixed particles, added mass and time-dependent laws.
 pub(crate) fn every_kind() -> System {
     let mut s = System::new([0.1, -0.2, -9.81]);
     let a = s
@@ -40,6 +40,8 @@ pub(crate) fn every_kind() -> System {
     .unwrap();
     s.add_fixed_coordinate(d, 0, None).unwrap();
     s.add_spring_damper(c, d, 40.0, 1.5, Some(0.5)).unwrap();
+    // A three-particle element, over a fixed and two free particles.
+    s.add_bending(a, b, c, 0.3, None).unwrap();
     s.add_quadratic_drag(b, 0.8).unwrap();
     s.add_linear_drag(c, 0.3).unwrap();
     // Fluid forces with added mass (which enters the mass matrix) on a constrained particle.
