@@ -36,7 +36,7 @@ pub struct SimulationOptions {
     /// LU (tree-shaped graphs always get the tree elimination with `SparseSolver::Auto`).
     pub dense_limit: usize,
     /// Solver for larger systems: tree elimination when the constraint graph is a forest
-    /// (`Auto`), or always the general sparse LU. [`Solution::linear_solver`] names the one used.
+    /// (`Auto`), or always the general sparse LU. [`crate::Solution::linear_solver`] names the one used.
     pub sparse_solver: SparseSolver,
     /// Largest memory the stored states may take (bytes); larger runs are refused up front.
     pub max_output_bytes: f64,

@@ -1,5 +1,5 @@
 //! The one run loop: a running simulation that a caller advances, inspects, drives and
-//! snapshots; [`crate::simulate`] is a thin loop over it.
+//! snapshots; [`crate::simulate()`] is a thin loop over it.
 //!
 //! # Design
 //!
@@ -10,7 +10,7 @@
 //! step of the scheme on the chosen formulation ([`crate::integrators::Scheme::step`]), the
 //! retry of a modified-Newton step with a fresh matrix, the rejected-step bookkeeping, the
 //! stored output, the tension check and the observer. What differs between fixed and
-//! error-controlled runs is a step-controller object ([`Controller`]): it proposes the next step,
+//! error-controlled runs is a step-controller object (`Controller`): it proposes the next step,
 //! judges a converged step (fixed steps accept every one; the error control of
 //! `adaptive.rs` estimates its local error, `docs/theory/adaptive.md`) and answers a failed Newton
 //! solve with a smaller step or gives up.
@@ -466,7 +466,7 @@ impl Simulation<'_> {
     /// grid time, otherwise with a shortened step); error-controlled steps stop at the end of
     /// the step that reaches or passes `t` ([`Simulation::time`] says where). Stored output
     /// follows the options (`save_every`, output times); an intermediate stop stores nothing of
-    /// its own, so the stored states are those of one call to [`crate::simulate`].
+    /// its own, so the stored states are those of one call to [`crate::simulate()`].
     pub fn step_to(&mut self, t: f64) -> &std::result::Result<(), Error> {
         self.step_to_with_observer(t, &mut Silent)
     }

@@ -28,7 +28,7 @@ pub const NO_SLOT: Slot = Slot::MAX;
 /// Slots of a 3x3 block, row-major.
 pub type Block = [Slot; 9];
 
-/// Blocks [a][b] of a force's Jacobian between its touched particles.
+/// Blocks \[a\]\[b\] of a force's Jacobian between its touched particles.
 pub type ForceBlocks =
     [[Block; crate::forces::MAX_FORCE_PARTICLES]; crate::forces::MAX_FORCE_PARTICLES];
 

@@ -143,8 +143,8 @@ impl Predictors {
     }
 }
 
-/// One index-3 step of the scheme: the predictors p and w of q_{n+1} and v_{n+1} (see
-/// [`Predictors`]), the old accelerations, and the step's weights.
+/// One index-3 step of the scheme: the predictors p and w of q_{n+1} and v_{n+1} (module
+/// documentation), the old accelerations, and the step's weights.
 #[derive(Debug, Clone, Copy)]
 pub struct AlphaStep<'a> {
     p: &'a [Vec3],
