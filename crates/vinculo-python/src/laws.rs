@@ -77,6 +77,8 @@ impl PyLaw {
                 "Law.sine(amplitude={amplitude}, frequency={frequency}, phase={phase}, offset={offset}, ramp_time={ramp_time}, t_start={t_start})"
             ),
             Law::Tabulated(s) => format!("Law.tabulated(<spline on {:?}>)", s.domain()),
+            Law::PiecewiseLinear(_) => "Law(<piecewise linear>)".to_string(),
+            Law::Driven(_) => "Law(<driven>)".to_string(),
         }
     }
 }

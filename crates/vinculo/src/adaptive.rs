@@ -1,18 +1,20 @@
-//! The run loop with error-controlled steps ([`crate::step_control::StepControl::Adaptive`]).
+//! The error control of error-controlled runs ([`crate::step_control::StepControl::Adaptive`]):
+//! the step controller that the run loop (`run.rs`) consults when its steps are error-controlled
+//! (`docs/theory/adaptive.md`).
 //!
-//! Each attempt takes one step of the scheme from the last accepted state, estimates its local
-//! error ([`crate::integrators::error_estimate`]) and weighs it ([`crate::step_control`]): a step
-//! with err <= 1 is accepted, one above is rejected and retried with the controller's smaller
-//! step, one whose Newton iterations fail is retried with a quarter of its size (after one retry
-//! with a fresh matrix in modified Newton, as in the fixed-step loop). A step the controller
-//! would make smaller than h_min ends the run with [`Error::StepSizeTooSmall`] (or
-//! [`Error::NewtonFailed`] when Newton failed at h_min), keeping everything computed before.
+//! Each converged step's local error is estimated ([`crate::integrators::error_estimate`]) and
+//! weighed ([`crate::step_control`]): a step with err <= 1 is accepted, one above is rejected and
+//! retried with the PI controller's smaller step, one whose Newton iterations fail is retried with
+//! a quarter of its size (after one retry with a fresh matrix in modified Newton, as with fixed
+//! steps). A step the controller would make smaller than h_min ends the run with
+//! [`Error::StepSizeTooSmall`] (or [`Error::NewtonFailed`] when Newton failed at h_min), keeping
+//! everything computed before.
 //!
-//! Output: at the requested times ([`SimulationOptions::output_times`]), interpolated inside the
-//! accepted step that contains them ([`crate::dense_output`]), so the steps never bend to land on
-//! them; without requested times, the end of every accepted step (every `save_every`-th). An
-//! interpolated row carries the statistics of the step that contains it and the constraint
-//! violations of the interpolated state itself.
+//! Output: at the requested times ([`crate::SimulationOptions::output_times`]), interpolated
+//! inside the accepted step that contains them ([`crate::dense_output`]), so the steps never bend
+//! to land on them; without requested times, the end of every accepted step (every
+//! `save_every`-th). An interpolated row carries the statistics of the step that contains it and
+//! the constraint violations of the interpolated state itself.
 //!
 //! Generalised-alpha keeps its algorithmic accelerations a_n unchanged when the step size changes
 //! (the usual choice): a_n approximates the true accelerations at t_n + (alpha_m - alpha_f) h_old,
@@ -22,62 +24,160 @@
 //! `tests/test_adaptive.py`, where the error falls with the tolerance like a second-order scheme's).
 
 use crate::assembly::NONE;
-use crate::dense_output::StepEnds;
-use crate::error::Error;
-use crate::initial::{factor_saddle, scaled_velocity_violation, scaled_violation};
-use crate::integrators::error_estimate::sample_offset;
-use crate::integrators::{
-    AccelerationHistory, AlphaState, ErrorConstants, GeneralizedAlpha, GeneralizedTrapezoidal,
-    NewtonFailure, NewtonOptions, NewtonReport, Scheme, StabilizedWorkspace, StepWorkspace,
-};
+use crate::error::{Error, Result};
+use crate::initial::factor_saddle;
+use crate::integrators::{AccelerationHistory, ErrorConstants, Scheme, StepWorkspace};
 use crate::math::Vec3;
 use crate::model::System;
-use crate::simulate::{negative_tension, step_failure, Observer, SimulationOptions};
-use crate::solution::{Solution, StepStats};
 use crate::step_control::{AdaptiveOptions, ErrorWeights, PiController};
 
-/// What the loop needs besides the state: the model, the options and the run's scales.
-pub(crate) struct AdaptiveRun<'a> {
-    pub system: &'a System,
-    pub options: &'a SimulationOptions,
-    pub control: AdaptiveOptions,
-    /// Newton options with the tolerance already in metres.
-    pub newton: NewtonOptions,
-    pub weights: ErrorWeights,
-    pub tension_floor: f64,
-}
-
-/// The state at the start of the loop (the consistent initial state).
-pub(crate) struct StartState {
-    pub q: Vec<Vec3>,
-    pub v: Vec<Vec3>,
-    pub acceleration: Vec<Vec3>,
-    pub lambda: Vec<f64>,
-}
-
-/// One step of the scheme from (t, q, v), on the GGL formulation when `stabilized` is given;
-/// `alpha_state` is generalised-alpha's extra state.
-#[allow(clippy::too_many_arguments)]
-fn take_step(
+/// The error control's state (carried from step to step, copied by a snapshot) and its scratch
+/// arrays.
+#[derive(Debug, Clone)]
+pub(crate) struct ErrorControl {
     scheme: Scheme,
-    system: &System,
-    ws: &mut StepWorkspace,
-    stabilized: Option<&mut StabilizedWorkspace>,
-    t: f64,
-    q: &[Vec3],
-    v: &[Vec3],
-    alpha_state: &mut AlphaState,
+    control: AdaptiveOptions,
+    weights: ErrorWeights,
+    pi: PiController,
+    /// The next step size.
     h: f64,
-    newton: &NewtonOptions,
-) -> Result<NewtonReport, NewtonFailure> {
-    match (stabilized, scheme) {
-        (Some(ggl), _) => ggl.step(system, ws, scheme, t, q, v, alpha_state, h, newton),
-        (None, Scheme::GeneralizedTrapezoidal { alpha }) => {
-            GeneralizedTrapezoidal { alpha }.step(system, ws, t, q, v, h, newton)
+    constants: ErrorConstants,
+    /// Built at the first attempt, once a factorisation can project the initial accelerations.
+    history: AccelerationHistory,
+    /// Error norm of the step being judged.
+    err: f64,
+    free: Vec<bool>,
+    projection: Vec<f64>,
+    initial: Vec<Vec3>,
+    a_sample: Vec<Vec3>,
+    e_q: Vec<Vec3>,
+    e_v: Vec<Vec3>,
+    q_end: Vec<Vec3>,
+}
+
+impl ErrorControl {
+    /// The control of a run of `scheme` from `t0` with the consistent accelerations `acc`, first
+    /// step `dt`, on an index-3 system of `unknowns` unknowns.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn new(
+        system: &System,
+        scheme: Scheme,
+        control: AdaptiveOptions,
+        weights: ErrorWeights,
+        dt: f64,
+        t0: f64,
+        acc: &[Vec3],
+        unknowns: usize,
+    ) -> ErrorControl {
+        ErrorControl {
+            scheme,
+            control,
+            weights,
+            pi: PiController::new(scheme.order(), control.hold),
+            h: dt,
+            constants: scheme.error_constants(),
+            history: AccelerationHistory::new(t0, acc),
+            err: 0.0,
+            free: system.particles().iter().map(|p| !p.fixed).collect(),
+            projection: vec![0.0; unknowns],
+            initial: acc.to_vec(),
+            a_sample: acc.to_vec(),
+            e_q: acc.to_vec(),
+            e_v: acc.to_vec(),
+            q_end: vec![[0.0; 3]; acc.len()],
         }
-        (None, Scheme::GeneralizedAlpha { rho_inf }) => {
-            GeneralizedAlpha { rho_inf }.step(system, ws, t, q, v, alpha_state, h, newton)
+    }
+
+    /// The next step from `t` towards `stop`: stretched by up to 10 % rather than leave a
+    /// sliver for a last step; `Some(stop)` when it lands there.
+    pub(crate) fn propose(&self, t: f64, stop: f64) -> (f64, Option<f64>) {
+        let remaining = stop - t;
+        if remaining <= 1.1 * self.h {
+            (remaining, Some(stop))
+        } else {
+            (self.h, None)
         }
+    }
+
+    /// After Newton failed on a step of size `h`: true (with a smaller next step) unless `h` was
+    /// already the smallest allowed.
+    pub(crate) fn newton_failed(&mut self, h: f64) -> bool {
+        let proposal = self.pi.newton_failed(h);
+        if h > self.control.h_min {
+            self.h = proposal.max(self.control.h_min);
+            true
+        } else {
+            false
+        }
+    }
+
+    /// Judges a converged step of size `h` from (t, q, v) with end acceleration `acc_new` (the
+    /// end state in `ws.state`): `Ok(true)` when its weighted error is at most 1 (the history then
+    /// takes its sample), `Ok(false)` when it must be retried. `step` counts the accepted steps
+    /// before it; `stabilized` says the step was a GGL step (whose matrix is not the index-3 one
+    /// the projection needs).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn judge(
+        &mut self,
+        system: &System,
+        ws: &mut StepWorkspace,
+        stabilized: bool,
+        step: usize,
+        (t, h): (f64, f64),
+        (q, v, acc): (&[Vec3], &[Vec3], &[Vec3]),
+        acc_new: &[Vec3],
+    ) -> Result<bool> {
+        self.a_sample.copy_from_slice(acc_new);
+        if stabilized {
+            // The GGL step factorised its own matrix: the projection needs the index-3
+            // workspace's [M/m_ref, -s G^T; s G, 0] at the step's end.
+            self.q_end.copy_from_slice(&ws.state.q);
+            factor_saddle(system, ws, &self.q_end, t + h)?;
+        }
+        tangential(ws, &mut self.a_sample, &mut self.projection);
+        if step == 0 {
+            self.initial.copy_from_slice(acc);
+            tangential(ws, &mut self.initial, &mut self.projection);
+            self.history = AccelerationHistory::new(t, &self.initial);
+        }
+        let tau = t + self.scheme.sample_offset(h);
+        let (e_q, e_v) = (&mut self.e_q, &mut self.e_v);
+        self.history
+            .estimate(&self.constants, t, h, tau, &self.a_sample, e_q, e_v);
+        let (q_new, v_new) = (&ws.state.q, &ws.state.v);
+        self.err = self
+            .weights
+            .norm(h, &self.free, &self.e_q, &self.e_v, q, q_new, v, v_new);
+        if self.err.is_nan() || self.err > 1.0 {
+            return Ok(false);
+        }
+        self.history.push(tau, &self.a_sample, h);
+        Ok(true)
+    }
+
+    /// After a step of size `h` from `t` failed the error test: `Ok` with a smaller next step,
+    /// or the error when it would fall below h_min.
+    pub(crate) fn rejected(&mut self, t: f64, h: f64) -> Result<()> {
+        let (h_min, err) = (self.control.h_min, self.err);
+        let proposal = self.pi.rejected(h, err);
+        if proposal >= h_min || h > h_min {
+            self.h = proposal.max(h_min);
+            return Ok(());
+        }
+        Err(Error::StepSizeTooSmall {
+            t,
+            h: proposal,
+            h_min,
+            error: err,
+        })
+    }
+
+    /// After the step of size `h` was accepted: the next step.
+    pub(crate) fn accepted(&mut self, h: f64) {
+        self.h = self
+            .pi
+            .accepted(h, self.err)
+            .clamp(self.control.h_min, self.control.h_max);
     }
 }
 
@@ -101,249 +201,6 @@ fn tangential(ws: &mut StepWorkspace, a: &mut [Vec3], rhs: &mut [f64]) {
     for (i, &d) in ws.layout.dof.iter().enumerate() {
         for k in 0..3 {
             a[i][k] = if d != NONE { rhs[d + k] } else { 0.0 };
-        }
-    }
-}
-
-/// Stores a state with its violations and the statistics of the step that produced it.
-fn store(
-    sol: &mut Solution,
-    system: &System,
-    t: f64,
-    (q, v, lambda): (&[Vec3], &[Vec3], &[f64]),
-    stats: StepStats,
-) {
-    let position = scaled_violation(system, q, t).0;
-    let velocity = scaled_velocity_violation(system, q, v, t).0;
-    sol.push(t, q, v, lambda, position, velocity, stats);
-}
-
-/// Marches from `options.t_start` to `options.t_end` with error-controlled steps, appending to
-/// `sol` (which holds the initial state as its first row).
-pub(crate) fn march(
-    run: &AdaptiveRun,
-    ws: &mut StepWorkspace,
-    mut stabilized: Option<&mut StabilizedWorkspace>,
-    sol: &mut Solution,
-    start: StartState,
-    observer: &mut dyn Observer,
-) {
-    let (system, options, control) = (run.system, run.options, run.control);
-    let scheme = options.scheme;
-    let newton = &run.newton;
-    let StartState {
-        mut q,
-        mut v,
-        acceleration: mut acc,
-        mut lambda,
-    } = start;
-    let t0 = options.t_start;
-    let n = q.len();
-    let free: Vec<bool> = system.particles().iter().map(|p| !p.fixed).collect();
-    let constants = ErrorConstants::of(&scheme);
-    // Built at the first attempt, once a factorisation can project the initial accelerations.
-    let mut history = AccelerationHistory::new(t0, &acc);
-    let mut projection = vec![0.0; ws.layout.unknowns()];
-    let mut initial = acc.clone();
-    let mut controller = PiController::new(scheme.order(), control.hold);
-
-    // Requested output times: the initial row stays only when t_start is one of them.
-    let outputs: &[f64] = options.output_times.as_deref().unwrap_or(&[]);
-    let dense = options.output_times.is_some();
-    let mut next_output = 0;
-    if dense {
-        if outputs.first() == Some(&t0) {
-            next_output = 1;
-        } else {
-            sol.truncate(0);
-        }
-    }
-
-    let mut alpha_state = AlphaState::new(&acc);
-    let mut alpha_saved = alpha_state.clone();
-    let (mut q_new, mut v_new, mut lambda_new) = (q.clone(), v.clone(), lambda.clone());
-    let (mut a_sample, mut e_q, mut e_v) = (acc.clone(), acc.clone(), acc.clone());
-    let mut full = acc.clone();
-    let mut q_end = q.clone();
-    let (mut q_out, mut v_out, mut lambda_out) = (q.clone(), v.clone(), lambda.clone());
-
-    let mut t = t0;
-    let mut h = options.dt;
-    let mut step = 0usize;
-    let mut fresh_retry = false;
-    while t < options.t_end {
-        let remaining = options.t_end - t;
-        // Stretch a step by up to 10 % rather than leave a sliver of the run for a last step.
-        let last = remaining <= 1.1 * h;
-        let h_try = if last { remaining } else { h };
-        for i in 0..n {
-            for k in 0..3 {
-                ws.state.q[i][k] = q[i][k] + h_try * v[i][k] + 0.5 * h_try * h_try * acc[i][k];
-            }
-        }
-        ws.state.lambda.copy_from_slice(&lambda);
-        if !fresh_retry {
-            sol.steps_taken += 1;
-        }
-        let stale = newton.jacobian_reuse && ws.matrix.holds(scheme.matrix_key(h_try));
-        if matches!(scheme, Scheme::GeneralizedAlpha { .. }) {
-            alpha_saved
-                .acceleration
-                .copy_from_slice(&alpha_state.acceleration);
-            alpha_saved
-                .algorithmic
-                .copy_from_slice(&alpha_state.algorithmic);
-        }
-        let attempt = take_step(
-            scheme,
-            system,
-            ws,
-            stabilized.as_deref_mut(),
-            t,
-            &q,
-            &v,
-            &mut alpha_state,
-            h_try,
-            newton,
-        );
-        sol.factorisations = ws.matrix.factorisations;
-        fresh_retry = false;
-        // A failed user function stops the run at once (NaN terms would only fail again).
-        if let Some(e) = system.user_failure() {
-            sol.status = Err(e);
-            return;
-        }
-        let report = match attempt {
-            Ok(report) => report,
-            Err(_) if stale => {
-                ws.matrix.invalidate();
-                fresh_retry = true;
-                continue;
-            }
-            Err(failure) => {
-                sol.steps_rejected += 1;
-                let proposal = controller.newton_failed(h_try);
-                if h_try > control.h_min {
-                    h = proposal.max(control.h_min);
-                    continue;
-                }
-                sol.status = Err(step_failure(system, &ws.layout, failure, t, h_try));
-                return;
-            }
-        };
-
-        // The step's acceleration sample (kept whole for the next predictor) and its error.
-        match scheme {
-            Scheme::GeneralizedTrapezoidal { .. } => {
-                for i in 0..n {
-                    for k in 0..3 {
-                        a_sample[i][k] = (ws.state.v[i][k] - v[i][k]) / h_try;
-                    }
-                }
-            }
-            Scheme::GeneralizedAlpha { .. } => {
-                a_sample.copy_from_slice(&alpha_state.acceleration);
-            }
-        }
-        full.copy_from_slice(&a_sample);
-        if stabilized.is_some() {
-            // The GGL step factorised its own matrix: the projection needs the index-3
-            // workspace's [M/m_ref, -s G^T; s G, 0] at the step's end.
-            q_end.copy_from_slice(&ws.state.q);
-            if let Err(e) = factor_saddle(system, ws, &q_end, t + h_try) {
-                sol.status = Err(e);
-                return;
-            }
-        }
-        tangential(ws, &mut a_sample, &mut projection);
-        if step == 0 {
-            initial.copy_from_slice(&acc);
-            tangential(ws, &mut initial, &mut projection);
-            history = AccelerationHistory::new(t0, &initial);
-        }
-        let tau = t + sample_offset(&scheme, h_try);
-        history.estimate(&constants, t, h_try, tau, &a_sample, &mut e_q, &mut e_v);
-        let err = run
-            .weights
-            .norm(h_try, &free, &e_q, &e_v, &q, &ws.state.q, &v, &ws.state.v);
-        if err.is_nan() || err > 1.0 {
-            sol.steps_rejected += 1;
-            if matches!(scheme, Scheme::GeneralizedAlpha { .. }) {
-                alpha_state
-                    .acceleration
-                    .copy_from_slice(&alpha_saved.acceleration);
-                alpha_state
-                    .algorithmic
-                    .copy_from_slice(&alpha_saved.algorithmic);
-            }
-            let proposal = controller.rejected(h_try, err);
-            if proposal >= control.h_min || h_try > control.h_min {
-                h = proposal.max(control.h_min);
-                continue;
-            }
-            sol.status = Err(Error::StepSizeTooSmall {
-                t,
-                h: proposal,
-                h_min: control.h_min,
-                error: err,
-            });
-            return;
-        }
-
-        // Accepted.
-        history.push(tau, &a_sample, h_try);
-        acc.copy_from_slice(&full);
-        q_new.copy_from_slice(&ws.state.q);
-        v_new.copy_from_slice(&ws.state.v);
-        lambda_new.copy_from_slice(&ws.state.lambda);
-        let t_new = if last { options.t_end } else { t + h_try };
-        step += 1;
-        sol.accepted_step_sizes.push(h_try);
-        let stats = StepStats {
-            newton_iterations: report.iterations,
-            step_size: h_try,
-            residual_norm: report.residual,
-            increment_norm: report.increment,
-        };
-        let slack = negative_tension(system, &lambda_new, t_new, run.tension_floor);
-        if dense {
-            let ends = StepEnds {
-                t,
-                h: t_new - t,
-                q_0: &q,
-                v_0: &v,
-                lambda_0: &lambda,
-                q_1: &q_new,
-                v_1: &v_new,
-                lambda_1: &lambda_new,
-            };
-            while next_output < outputs.len() && outputs[next_output] <= t_new {
-                let t_out = outputs[next_output];
-                ends.interpolate(t_out, &mut q_out, &mut v_out, &mut lambda_out);
-                store(sol, system, t_out, (&q_out, &v_out, &lambda_out), stats);
-                next_output += 1;
-            }
-            // A run that stops here shows the state where it stopped.
-            if slack.is_some() && sol.times.last() != Some(&t_new) {
-                store(sol, system, t_new, (&q_new, &v_new, &lambda_new), stats);
-            }
-        } else if step % options.save_every == 0 || last || slack.is_some() {
-            store(sol, system, t_new, (&q_new, &v_new, &lambda_new), stats);
-        }
-        std::mem::swap(&mut q, &mut q_new);
-        std::mem::swap(&mut v, &mut v_new);
-        std::mem::swap(&mut lambda, &mut lambda_new);
-        t = t_new;
-        if let Some(e) = slack {
-            sol.status = Err(e);
-            return;
-        }
-        h = controller
-            .accepted(h_try, err)
-            .clamp(control.h_min, control.h_max);
-        if !observer.step(t, options.t_end) {
-            sol.status = Err(Error::Interrupted { t });
-            return;
         }
     }
 }

@@ -50,6 +50,8 @@ pub mod laws;
 pub mod linear;
 pub mod math;
 pub mod model;
+mod options;
+pub mod run;
 pub mod simulate;
 pub mod solution;
 pub mod step_control;
@@ -57,6 +59,7 @@ pub mod user;
 
 pub use error::{Error, Result};
 pub use linear::SparseSolver;
+pub use run::{Simulation, Snapshot};
 pub use simulate::{simulate, simulate_with_observer, Observer, SimulationOptions};
 pub use solution::{Solution, StepStats};
 pub use step_control::{AdaptiveOptions, StepControl};

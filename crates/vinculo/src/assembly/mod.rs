@@ -6,10 +6,12 @@
 
 mod parallel;
 mod pattern;
+mod serial;
 
 pub use parallel::{JacobianTerms, ParallelAssembly, ResidualTerms, MIN_TASK};
 pub use pattern::{Pattern, Storage};
 
+use crate::forces::MAX_FORCE_PARTICLES;
 use crate::model::System;
 
 /// Marks an absent unknown (a fixed particle has no coordinates among the unknowns).
@@ -25,6 +27,10 @@ pub const NO_SLOT: Slot = Slot::MAX;
 
 /// Slots of a 3x3 block, row-major.
 pub type Block = [Slot; 9];
+
+/// Blocks \[a\]\[b\] of a force's Jacobian between its touched particles.
+pub type ForceBlocks =
+    [[Block; crate::forces::MAX_FORCE_PARTICLES]; crate::forces::MAX_FORCE_PARTICLES];
 
 /// Where each element writes in the matrix.
 #[derive(Debug, Clone)]
@@ -46,7 +52,7 @@ pub struct Layout {
     /// Per constraint: slots of Phi_q (its row, columns of particle a).
     pub constraint_row: Vec<[[Slot; 3]; 2]>,
     /// Per force: blocks [a][b] of its Jacobian.
-    pub force_block: Vec<[[Block; 2]; 2]>,
+    pub force_block: Vec<ForceBlocks>,
 }
 
 impl Layout {
@@ -119,15 +125,7 @@ impl Layout {
         let pattern = Pattern::new(n, entries, n <= dense_limit);
         let slot = |row: usize, col: usize| pattern.slot32(row, col);
         let block_slots = |a: usize, b: usize| pattern.block_slots(a, b);
-        let pair_blocks = |parts: &[usize]| -> [[Block; 2]; 2] {
-            let mut out = [[[NO_SLOT; 9]; 2]; 2];
-            for (x, &a) in parts.iter().enumerate() {
-                for (y, &b) in parts.iter().enumerate() {
-                    out[x][y] = block_slots(dof[a], dof[b]);
-                }
-            }
-            out
-        };
+        let pair_blocks = |parts: &[usize]| element_blocks::<2>(parts, &dof, &block_slots);
         let particle_block = dof.iter().map(|&d| block_slots(d, d)).collect();
         let mut constraint_hessian = Vec::with_capacity(m);
         let mut constraint_column = Vec::with_capacity(m);
@@ -152,9 +150,9 @@ impl Layout {
             .iter()
             .map(|f| {
                 if f.has_jacobian() {
-                    pair_blocks(f.particles())
+                    element_blocks(f.particles(), &dof, &block_slots)
                 } else {
-                    [[[NO_SLOT; 9]; 2]; 2]
+                    [[[NO_SLOT; 9]; MAX_FORCE_PARTICLES]; MAX_FORCE_PARTICLES]
                 }
             })
             .collect();
@@ -198,7 +196,7 @@ impl Layout {
     /// block) and `s grad_row` into its row (the Phi_q block). The schemes differ only in where
     /// they evaluate the two gradients and the Hessian.
     #[allow(clippy::too_many_arguments)]
-    #[inline]
+    #[inline(always)]
     pub fn add_constraint_blocks(
         &self,
         values: &mut [f64],
@@ -264,6 +262,22 @@ impl Layout {
     }
 }
 
+/// The blocks [x][y] between an element's touched particles `parts` (at most N), absent past
+/// them.
+fn element_blocks<const N: usize>(
+    parts: &[usize],
+    dof: &[usize],
+    block_slots: &impl Fn(usize, usize) -> Block,
+) -> [[Block; N]; N] {
+    let mut out = [[[NO_SLOT; 9]; N]; N];
+    for (x, &a) in parts.iter().enumerate() {
+        for (y, &b) in parts.iter().enumerate() {
+            out[x][y] = block_slots(dof[a], dof[b]);
+        }
+    }
+    out
+}
+
 /// The first unknown of each particle, 3 per free particle in order (NONE for fixed ones), and
 /// the number of free particles.
 pub fn number_particles(system: &System) -> (Vec<usize>, usize) {
@@ -280,11 +294,40 @@ pub fn number_particles(system: &System) -> (Vec<usize>, usize) {
     (dof, free)
 }
 
+/// The start of each free particle's three residual rows: its scaled inertia and gravity terms
+/// (what a time rule contributes to the residual besides the elements).
+pub trait InertiaRows: Sync {
+    /// The three rows of particle `i`.
+    fn rows(&self, i: usize) -> crate::math::Vec3;
+}
+
 /// Adds `value` at `slot` unless the slot is absent.
 #[inline]
 pub fn add(values: &mut [f64], slot: Slot, value: f64) {
     if slot != NO_SLOT {
         values[slot as usize] += value;
+    }
+}
+
+/// Places a force's local Jacobians: `dq[x][y]` weighted by `wq` into `blocks_q[x][y]` and
+/// `dv[x][y]` weighted by `wv` into `blocks_v[x][y]`, for its `n` particles, through `add`
+/// (which adds a weighted 3x3 matrix into a block). The index-3 layout has one block per pair
+/// (`blocks_q` and `blocks_v` the same), the GGL layout one in the position and one in the
+/// velocity columns.
+#[inline]
+pub fn add_force_blocks(
+    n: usize,
+    blocks_q: &ForceBlocks,
+    blocks_v: &ForceBlocks,
+    (wq, dq): (f64, &crate::forces::Jacobian),
+    (wv, dv): (f64, &crate::forces::Jacobian),
+    mut add: impl FnMut(&Block, f64, &crate::math::Mat3),
+) {
+    for x in 0..n {
+        for y in 0..n {
+            add(&blocks_q[x][y], wq, &dq[x][y]);
+            add(&blocks_v[x][y], wv, &dv[x][y]);
+        }
     }
 }
 

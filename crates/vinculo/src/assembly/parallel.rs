@@ -21,9 +21,12 @@
 
 use rayon::prelude::*;
 
-use super::{Block, Layout, Slot, NONE, NO_SLOT};
+use super::{add_force_blocks, Block, InertiaRows, Layout, Slot, NONE, NO_SLOT};
 use crate::constraints::{Gradient, Hessian};
-use crate::forces::{Jacobian, Local};
+use crate::forces::{Jacobian, Local, MAX_FORCE_PARTICLES};
+
+/// Entries of the force incidence lists per force.
+const FORCE_STRIDE: usize = MAX_FORCE_PARTICLES;
 use crate::math::{Mat3, Vec3};
 use crate::model::System;
 
@@ -42,7 +45,7 @@ pub struct ParallelAssembly {
     free: Vec<usize>,
     /// Per particle, the range of `force_incidence` of the forces touching it.
     force_start: Vec<usize>,
-    /// Entries 2 f + x: force f touches the particle as its particle x; increasing in f.
+    /// Entries 3 f + x ([`FORCE_STRIDE`]): force f touches the particle as its particle x; increasing in f.
     force_incidence: Vec<usize>,
     /// Per particle, the range of `constraint_incidence` of the constraints touching it.
     constraint_start: Vec<usize>,
@@ -104,6 +107,21 @@ pub struct JacobianTerms<'a> {
     pub lambda: &'a [f64],
     /// Scale of each constraint row.
     pub scales: &'a [f64],
+}
+
+impl ResidualTerms<'_> {
+    /// True when the constraint rows are evaluated where the gradients are (the same positions
+    /// and time), so that one evaluation serves both.
+    pub fn same_point(&self) -> bool {
+        std::ptr::eq(self.q_eval, self.q_end) && self.t_eval.to_bits() == self.t_end.to_bits()
+    }
+}
+
+impl JacobianTerms<'_> {
+    /// True when the Phi_q rows are evaluated where the -Phi_q^T columns are.
+    pub fn same_point(&self) -> bool {
+        std::ptr::eq(self.q_eval, self.q_end) && self.t_eval.to_bits() == self.t_end.to_bits()
+    }
 }
 
 /// The matrix's value array shared by the tasks of one colour.
@@ -168,13 +186,14 @@ impl SharedValues {
     }
 }
 
-/// Incidence lists: for each particle, entries 2 e + x of the elements e touching it (as their
+/// Incidence lists: for each particle, entries `stride` e + x of the elements e touching it (as their
 /// particle x), in increasing e. Fixed particles are left out when `free_only`.
 fn incidence<'a>(
     particles: usize,
     elements: impl Iterator<Item = &'a [usize]> + Clone,
     dof: &[usize],
     free_only: bool,
+    stride: usize,
 ) -> (Vec<usize>, Vec<usize>) {
     let keep = |p: usize| !free_only || dof[p] != NONE;
     let mut start = vec![0usize; particles + 1];
@@ -190,7 +209,7 @@ fn incidence<'a>(
     let mut entries = vec![0usize; start[particles]];
     for (e, parts) in elements.enumerate() {
         for (x, &p) in parts.iter().enumerate().filter(|&(_, &p)| keep(p)) {
-            entries[next[p]] = 2 * e + x;
+            entries[next[p]] = stride * e + x;
             next[p] += 1;
         }
     }
@@ -205,7 +224,9 @@ fn colour_chunks<'a>(
     elements: impl Iterator<Item = &'a [usize]> + Clone,
     dof: &[usize],
 ) -> (Vec<usize>, Vec<usize>) {
-    let (start, entries) = incidence(particles, elements.clone(), dof, true);
+    // Any stride serves: the colouring reads only which element an entry is.
+    let stride = MAX_FORCE_PARTICLES;
+    let (start, entries) = incidence(particles, elements.clone(), dof, true, stride);
     let chunks = elements.clone().count().div_ceil(CHUNK);
     let mut colours = vec![0usize; chunks];
     let mut taken: Vec<usize> = Vec::new();
@@ -216,7 +237,7 @@ fn colour_chunks<'a>(
         while let Some((_, ps)) = parts.next_if(|&(e, _)| e / CHUNK == k) {
             for &p in ps.iter().filter(|&&p| dof[p] != NONE) {
                 for &entry in &entries[start[p]..start[p + 1]] {
-                    let other = entry / 2 / CHUNK;
+                    let other = entry / stride / CHUNK;
                     if other < k {
                         taken.push(colours[other]);
                     }
@@ -257,10 +278,15 @@ impl ParallelAssembly {
         let free = (0..n).filter(|&i| dof[i] != NONE).collect();
         let forces = system.forces();
         let constraints = system.constraints();
-        let (force_start, force_incidence) =
-            incidence(n, forces.iter().map(|f| f.particles()), dof, true);
+        let (force_start, force_incidence) = incidence(
+            n,
+            forces.iter().map(|f| f.particles()),
+            dof,
+            true,
+            FORCE_STRIDE,
+        );
         let (constraint_start, constraint_incidence) =
-            incidence(n, constraints.iter().map(|c| c.particles()), dof, true);
+            incidence(n, constraints.iter().map(|c| c.particles()), dof, true, 2);
         let none: &[usize] = &[];
         let (force_colours, force_colour_start) = colour_chunks(
             n,
@@ -295,7 +321,7 @@ impl ParallelAssembly {
         self.constraint_colour_start.len() - 1
     }
 
-    /// Writes the scaled residual: `row(i, k)` is the start of row k of particle i (its
+    /// Writes the scaled residual: `row.rows(i)` is the start of the three rows of particle i (its
     /// inertia and gravity terms), then forces and constraint gradients are subtracted and the
     /// constraint rows written, as in the serial loops and with the same result.
     pub fn residual(
@@ -304,7 +330,7 @@ impl ParallelAssembly {
         layout: &Layout,
         at: &ResidualTerms<'_>,
         r: &mut [f64],
-        row: impl Fn(usize, usize) -> f64 + Sync,
+        row: &impl InertiaRows,
     ) {
         let m3 = 3 * layout.free;
         let (dynamics, constraint_rows) = r.split_at_mut(m3);
@@ -332,11 +358,9 @@ impl ParallelAssembly {
             .zip(this.free.par_iter())
             .with_min_len(MIN_TASK)
             .for_each(|(out, &i)| {
-                for (k, o) in out.iter_mut().enumerate() {
-                    *o = row(i, k);
-                }
+                out.copy_from_slice(&row.rows(i));
                 for &e in &this.force_incidence[this.force_start[i]..this.force_start[i + 1]] {
-                    let fl = &this.forces[e / 2][e % 2];
+                    let fl = &this.forces[e / FORCE_STRIDE][e % FORCE_STRIDE];
                     for k in 0..3 {
                         out[k] -= sigma * fl[k];
                     }
@@ -387,24 +411,19 @@ impl ParallelAssembly {
                     let mut dq: Jacobian = Default::default();
                     let mut dv: Jacobian = Default::default();
                     f.add_jacobian(at.q_eval, at.v_eval, at.t_eval, &mut dq, &mut dv);
-                    let n = f.particles().len();
-                    for x in 0..n {
-                        for y in 0..n {
-                            let blk = &layout.force_block[fi][x][y];
-                            // SAFETY: rows of this chunk's free particles, which no other chunk
-                            // of this colour touches (see `SharedValues`).
-                            unsafe {
-                                shared.add_block(blk, at.force_dq, &dq[x][y]);
-                                shared.add_block(blk, at.force_dv, &dv[x][y]);
-                            }
-                        }
-                    }
+                    let blocks = &layout.force_block[fi];
+                    let (wq, wv) = ((at.force_dq, &dq), (at.force_dv, &dv));
+                    add_force_blocks(f.particles().len(), blocks, blocks, wq, wv, |b, s, m| {
+                        // SAFETY: the blocks of this force, in rows of this chunk's free
+                        // particles, which no other chunk of this colour touches (see
+                        // `SharedValues`).
+                        unsafe { shared.add_block(b, s, m) }
+                    });
                 }
             });
         }
         let constraints = system.constraints();
-        let same_point =
-            std::ptr::eq(at.q_eval, at.q_end) && at.t_eval.to_bits() == at.t_end.to_bits();
+        let same_point = at.same_point();
         for g in 0..self.constraint_colour_start.len() - 1 {
             let group = &self.constraint_colours
                 [self.constraint_colour_start[g]..self.constraint_colour_start[g + 1]];

@@ -73,13 +73,13 @@ impl Constraint {
     }
 
     /// Phi(q, t).
-    #[inline]
+    #[inline(always)]
     pub fn residual(&self, q: &[Vec3], t: f64) -> f64 {
         dispatch!(self, c => c.residual(q, t))
     }
 
     /// dPhi/dq for each touched particle.
-    #[inline]
+    #[inline(always)]
     pub fn gradient(&self, q: &[Vec3], t: f64) -> Gradient {
         dispatch!(self, c => c.gradient(q, t))
     }

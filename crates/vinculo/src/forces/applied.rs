@@ -19,7 +19,7 @@ impl AppliedForce {
     }
 
     pub(crate) fn force(&self, _q: &[Vec3], _v: &[Vec3], t: f64) -> Local {
-        [self.force.value(t), [0.0; 3]]
+        [self.force.value(t), [0.0; 3], [0.0; 3]]
     }
 
     pub(crate) fn add_jacobian(

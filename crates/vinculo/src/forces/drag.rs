@@ -22,7 +22,11 @@ impl LinearDrag {
     }
 
     pub(crate) fn force(&self, _q: &[Vec3], v: &[Vec3], _t: f64) -> Local {
-        [scale(-self.coefficient, v[self.particles[0]]), [0.0; 3]]
+        [
+            scale(-self.coefficient, v[self.particles[0]]),
+            [0.0; 3],
+            [0.0; 3],
+        ]
     }
 
     pub(crate) fn add_jacobian(
@@ -53,7 +57,7 @@ impl QuadraticDrag {
 
     pub(crate) fn force(&self, _q: &[Vec3], v: &[Vec3], _t: f64) -> Local {
         let u = v[self.particles[0]];
-        [scale(-self.coefficient * norm(u), u), [0.0; 3]]
+        [scale(-self.coefficient * norm(u), u), [0.0; 3], [0.0; 3]]
     }
 
     pub(crate) fn add_jacobian(

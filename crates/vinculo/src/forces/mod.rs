@@ -10,18 +10,20 @@
 //! - `added_mass()`: mass added to a particle's inertia (fluid elements only).
 //!
 //! Uniform gravity acts on every particle and lives in the [`System`](crate::model::System) itself.
-//! The residual of the dynamics uses F = -f (formulation.md), so the assembler subtracts these.
+//! The residual of the dynamics uses F = -f (`docs/theory/formulation.md`), so the assembler subtracts these.
 //!
 //! [`Force::User`] elements belong to a group whose forces a user function computes for all its
 //! elements at once ([`user`]).
 
 mod applied;
+mod bending;
 mod drag;
 mod morison;
 mod spring_damper;
 pub mod user;
 
 pub use applied::AppliedForce;
+pub use bending::Bending;
 pub use drag::{LinearDrag, QuadraticDrag};
 pub use morison::{Morison, MorisonSpec};
 pub use spring_damper::SpringDamper;
@@ -29,10 +31,12 @@ pub use user::{ForceGroup, UserForce, UserForces};
 
 use crate::math::{Mat3, Vec3};
 
-/// Forces on the touched particles.
-pub type Local = [Vec3; 2];
+/// Most particles a force kind acts on (a bending force acts on three).
+pub const MAX_FORCE_PARTICLES: usize = 3;
+/// Forces on the touched particles (entries past the force's own particles are zero).
+pub type Local = [Vec3; MAX_FORCE_PARTICLES];
 /// Jacobian blocks [p][r] = df_p/dx_r.
-pub type Jacobian = [[Mat3; 2]; 2];
+pub type Jacobian = [[Mat3; MAX_FORCE_PARTICLES]; MAX_FORCE_PARTICLES];
 
 /// Every built-in force kind, dispatched statically.
 #[derive(Debug, Clone, PartialEq)]
@@ -47,6 +51,8 @@ pub enum Force {
     QuadraticDrag(QuadraticDrag),
     /// Buoyancy, Froude-Krylov, added mass and drag of a fluid in rigid motion.
     Morison(Box<Morison>),
+    /// Bending stiffness at the middle of three consecutive particles.
+    Bending(Bending),
     /// One element of a group computed by a user function.
     User(UserForce),
 }
@@ -59,6 +65,7 @@ macro_rules! dispatch {
             Force::LinearDrag($f) => $e,
             Force::QuadraticDrag($f) => $e,
             Force::Morison($f) => $e,
+            Force::Bending($f) => $e,
             Force::User($f) => $e,
         }
     };
@@ -94,6 +101,7 @@ impl Force {
     pub fn potential(&self, q: &[Vec3]) -> f64 {
         match self {
             Force::SpringDamper(f) => f.potential(q),
+            Force::Bending(f) => f.potential(q),
             _ => 0.0,
         }
     }
@@ -132,6 +140,7 @@ impl Force {
             Force::LinearDrag(_) => format!("linear drag #{index} (particle {})", p[0]),
             Force::QuadraticDrag(_) => format!("quadratic drag #{index} (particle {})", p[0]),
             Force::Morison(_) => format!("fluid forces #{index} (particle {})", p[0]),
+            Force::Bending(_) => format!("bending #{index} (particles {p:?})"),
             Force::User(f) => format!(
                 "user force '{}' element {} #{index} (particles {p:?})",
                 f.group.name, f.element

@@ -88,7 +88,7 @@ impl Morison {
         let f = std::array::from_fn(|k| {
             mf * (a[k] - self.gravity[k]) + self.added_mass() * a[k] + drag[k]
         });
-        [f, [0.0; 3]]
+        [f, [0.0; 3], [0.0; 3]]
     }
 
     pub(crate) fn add_jacobian(

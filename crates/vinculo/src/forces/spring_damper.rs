@@ -43,7 +43,7 @@ impl SpringDamper {
 
     pub(crate) fn force(&self, q: &[Vec3], v: &[Vec3], _t: f64) -> Local {
         let (e, _, _, tension) = self.axial(q, v);
-        [scale(-tension, e), scale(tension, e)]
+        [scale(-tension, e), scale(tension, e), [0.0; 3]]
     }
 
     pub(crate) fn add_jacobian(

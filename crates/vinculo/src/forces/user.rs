@@ -20,7 +20,7 @@
 //!
 //! See [`crate::user`] for the batching, caching and failure rules.
 
-use super::{Jacobian, Local};
+use super::{Jacobian, Local, MAX_FORCE_PARTICLES};
 use crate::math::Vec3;
 use crate::user::{forward_steps, CallCount, GroupState, UserFailure};
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -252,7 +252,7 @@ impl UserForce {
             t,
             |st, qg, vg| g.call_force(st, t, qg, vg),
             |f| {
-                let mut out: Local = [[0.0; 3]; 2];
+                let mut out: Local = [[0.0; 3]; MAX_FORCE_PARTICLES];
                 for p in 0..g.arity {
                     out[p].copy_from_slice(&f[3 * p..3 * p + 3]);
                 }

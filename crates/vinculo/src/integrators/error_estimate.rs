@@ -102,37 +102,17 @@ pub struct ErrorConstants {
 }
 
 impl ErrorConstants {
-    /// The constants of `scheme`.
+    /// The constants of `scheme` ([`super::TimeRule::error_constants`]).
     pub fn of(scheme: &Scheme) -> ErrorConstants {
-        match *scheme {
-            Scheme::GeneralizedTrapezoidal { alpha } => ErrorConstants {
-                q2: alpha - 0.5,
-                q3: alpha * alpha - 1.0 / 6.0,
-                v2: alpha - 0.5,
-                v3: alpha * alpha - 1.0 / 6.0,
-            },
-            Scheme::GeneralizedAlpha { rho_inf } => {
-                let k = super::GeneralizedAlpha { rho_inf }.coefficients();
-                let delta = k.alpha_m - k.alpha_f;
-                let kappa = 0.5 * (1.0 - k.alpha_f) - (1.0 - k.alpha_m) * (0.5 + delta);
-                ErrorConstants {
-                    q2: 0.0,
-                    q3: k.beta + 0.5 * delta - 1.0 / 6.0,
-                    v2: 0.0,
-                    v3: kappa + k.gamma * (0.5 + delta) - 1.0 / 6.0,
-                }
-            }
-        }
+        scheme.error_constants()
     }
 }
 
 /// Where, after t_n, a step of size `h` of `scheme` leaves its acceleration sample: t_n + alpha h
-/// for the trapezoidal rules (the mean acceleration), t_n + h for generalised-alpha.
+/// for the trapezoidal rules (the mean acceleration), t_n + h for generalised-alpha
+/// ([`super::TimeRule::sample_offset`]).
 pub fn sample_offset(scheme: &Scheme, h: f64) -> f64 {
-    match *scheme {
-        Scheme::GeneralizedTrapezoidal { alpha } => alpha * h,
-        Scheme::GeneralizedAlpha { .. } => h,
-    }
+    scheme.sample_offset(h)
 }
 
 /// The acceleration samples of the accepted steps, smoothed (module documentation).
@@ -226,7 +206,8 @@ impl AccelerationHistory {
 mod tests {
     use super::*;
     use crate::integrators::{
-        AlphaState, GeneralizedAlpha, GeneralizedTrapezoidal, NewtonOptions, StepWorkspace,
+        index3_step, GeneralizedAlpha, GeneralizedTrapezoidal, NewtonOptions, RuleState,
+        StepWorkspace,
     };
     use crate::laws::VectorLaw;
     use crate::model::System;
@@ -306,14 +287,16 @@ mod tests {
                 let kappa = 0.5 * (1.0 - k.alpha_f) - (1.0 - k.alpha_m) * (0.5 + delta);
                 // The algorithmic acceleration of the exact motion (module documentation).
                 let a = e[2] + delta * h * e[3] + kappa * h * h * e[4];
-                let mut alpha_state = AlphaState::new(&state(a));
+                let mut alpha_state = RuleState::new(&state(a));
                 alpha_state.acceleration = state(e[2]);
-                ga.step(
+                let (q, v) = (&q_n, &v_n);
+                index3_step(
+                    ga,
                     &system,
                     &mut ws,
                     t_n,
-                    &q_n,
-                    &v_n,
+                    q,
+                    v,
                     &mut alpha_state,
                     h,
                     &newton,

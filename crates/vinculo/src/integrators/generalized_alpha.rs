@@ -1,5 +1,7 @@
 //! The generalised-alpha scheme for index-3 constrained systems, in the form of Arnold and Brüls
-//! (Multibody System Dynamics 18 (2007) 185-202).
+//! (Multibody System Dynamics 18 (2007) 185-202; `docs/theory/time-rules.md`): its coefficients
+//! and state update. The step problems that use them are `step_problem.rs` (index-3) and
+//! `stabilized.rs` (GGL).
 //!
 //! Parameters from the spectral radius at infinite frequency rho_inf in [0, 1] (1: no numerical
 //! damping, 0: the high frequencies are annihilated in one step):
@@ -19,7 +21,7 @@
 //! ```
 //!
 //! (M here is the inertia, gravity acts on the mass alone; the sign of the multiplier term
-//! follows formulation.md) together with
+//! follows `docs/theory/formulation.md`) together with
 //!
 //! ```text
 //! (1 - alpha_m) a_{n+1} + alpha_m a_n = (1 - alpha_f) qdd_{n+1} + alpha_f qdd_n
@@ -51,22 +53,22 @@
 //! dR_con/dq      = Phi_q(q)
 //! ```
 //!
-//! Scaling as in the trapezoidal rule ([`super::StepProblem`]): dynamics rows are multiplied by
+//! Scaling as in the trapezoidal rule (`trapezoidal.rs`): dynamics rows are multiplied by
 //! sigma = 1/(c m_ref), so that the mass block is M/m_ref, constraint row k by s_k, and
 //! multiplier k is solved for in the unit lambda_k sigma / s_k. The scaled matrix has the same
 //! pattern `[M/m_ref + O(h^2), -s G^T; s G, 0]` as the trapezoidal rule's, so the tree, dense and
 //! sparse solvers serve both.
+//!
+//! In the GGL form (`docs/theory/ggl.md`), eliminating the algorithmic acceleration
+//! a_{n+1} = (v - v_n - h (1 - gamma) a_n)/(gamma h) gives kappa = beta h / gamma,
+//! b = q_n + h v_n + h^2 (1/2 - beta) a_n - kappa (v_n + h (1 - gamma) a_n),
+//! c_v = (1 - alpha_m)/((1 - alpha_f) gamma h),
+//! c = (alpha_m a_n - alpha_f qdd_n - (1 - alpha_m)(v_n + h (1 - gamma) a_n)/(gamma h))/(1 - alpha_f),
+//! w = 1 (everything at t_{n+1}).
 
-use super::newton::{self, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport};
-use super::trapezoidal::{StepBuffers, StepWorkspace};
-use rayon::prelude::*;
-
-use crate::assembly::{
-    add_block, JacobianTerms, Layout, ParallelAssembly, ResidualTerms, MIN_TASK, NONE,
-};
-use crate::forces::Jacobian;
-use crate::math::{Mat3, Vec3};
-use crate::model::System;
+use super::error_estimate::ErrorConstants;
+use super::rule::{GglCoefficients, Index3Rule, RuleState, StepPoint, TimeRule};
+use crate::math::Vec3;
 
 /// The scheme, given by its spectral radius at infinite frequency rho_inf in [0, 1].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -88,29 +90,7 @@ pub struct AlphaCoefficients {
     pub beta: f64,
 }
 
-/// The scheme's state besides positions and velocities.
-#[derive(Debug, Clone)]
-pub struct AlphaState {
-    /// True accelerations qdd_n.
-    pub acceleration: Vec<Vec3>,
-    /// Algorithmic accelerations a_n.
-    pub algorithmic: Vec<Vec3>,
-    /// Per step: the parts of q_{n+1} and v_{n+1} known before the step (see [`Predictors`]).
-    predicted_q: Vec<Vec3>,
-    predicted_v: Vec<Vec3>,
-}
-
-impl AlphaState {
-    /// The state at the start of a run: a_0 = qdd_0 = the consistent accelerations.
-    pub fn new(accelerations: &[Vec3]) -> AlphaState {
-        AlphaState {
-            acceleration: accelerations.to_vec(),
-            algorithmic: accelerations.to_vec(),
-            predicted_q: vec![[0.0; 3]; accelerations.len()],
-            predicted_v: vec![[0.0; 3]; accelerations.len()],
-        }
-    }
-
+impl RuleState {
     /// Computes the predictors p and w of a step of size `h` from (q_n, v_n) and a_n.
     fn predict(&mut self, k: &AlphaCoefficients, h: f64, q_n: &[Vec3], v_n: &[Vec3]) {
         let (hh, half) = (h * h, 0.5 - k.beta);
@@ -161,21 +141,66 @@ impl Predictors {
         let v: Vec3 = std::array::from_fn(|x| w[x] + self.h_gamma * a[x]);
         (a, v)
     }
+}
 
-    /// The scaled inertia-and-gravity row of one coordinate, sigma (M qdd_{n+1} - m g).
+/// One index-3 step of the scheme: the predictors p and w of q_{n+1} and v_{n+1} (module
+/// documentation), the old accelerations, and the step's weights.
+#[derive(Debug, Clone, Copy)]
+pub struct AlphaStep<'a> {
+    p: &'a [Vec3],
+    w: &'a [Vec3],
+    a_n: &'a [Vec3],
+    qdd_n: &'a [Vec3],
+    known: Predictors,
+    /// d(qdd_{n+1})/dq = (1 - alpha_m)/((1 - alpha_f) beta h^2).
+    c: f64,
+    /// d(v_{n+1})/dq = gamma/(beta h).
+    dv_dq: f64,
+    point: StepPoint,
+}
+
+impl Index3Rule for AlphaStep<'_> {
+    const AT_END: bool = true;
+
+    fn point(&self) -> StepPoint {
+        self.point
+    }
+
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
+    fn kinematics(&self, i: usize, q: &Vec3) -> (Vec3, Vec3, Vec3) {
+        let v = self.known.kinematics(q, &self.p[i], &self.w[i]).1;
+        (v, *q, v)
+    }
+
+    #[inline(always)]
     fn inertia_row(
         &self,
-        sigma: f64,
+        i: usize,
+        q: &Vec3,
+        _v: &Vec3,
         inertia: f64,
         mass: f64,
-        g: f64,
-        a: f64,
-        a_n: f64,
-        qdd_n: f64,
-    ) -> f64 {
-        sigma * (inertia * (self.c_a * a + self.c_m * a_n - self.c_f * qdd_n) - mass * g)
+        g: &Vec3,
+    ) -> Vec3 {
+        let known = &self.known;
+        let (p, a_n, qdd_n) = (&self.p[i], &self.a_n[i], &self.qdd_n[i]);
+        let sigma = self.point.sigma;
+        std::array::from_fn(|k| {
+            let a = (q[k] - p[k]) * known.inv_beta_h2;
+            let inertial = known.c_a * a + known.c_m * a_n[k] - known.c_f * qdd_n[k];
+            sigma * (inertia * inertial - mass * g[k])
+        })
+    }
+
+    /// sigma c M = M/m_ref: the scaled mass block.
+    #[inline(always)]
+    fn mass_diagonal(&self, inertia: f64) -> f64 {
+        self.point.sigma * self.c * inertia
+    }
+
+    fn weights(&self) -> (f64, f64, f64) {
+        let sigma = self.point.sigma;
+        (-sigma, -sigma * self.dv_dq, -sigma)
     }
 }
 
@@ -194,346 +219,139 @@ impl GeneralizedAlpha {
             beta,
         }
     }
+}
 
-    /// Order of accuracy of the positions (2 for every rho_inf).
-    pub fn order(&self) -> usize {
+impl TimeRule for GeneralizedAlpha {
+    type Step<'a> = AlphaStep<'a>;
+
+    /// 2 for every rho_inf.
+    fn order(&self) -> usize {
         2
     }
 
-    /// What identifies the iteration matrix of a step of size `h` (for its reuse).
-    pub fn matrix_key(&self, h: f64) -> [f64; 2] {
+    fn matrix_key(&self, h: f64) -> [f64; 2] {
         [h, self.rho_inf]
     }
 
-    /// Takes one step of size `h` from (t_n, q_n, v_n, state). The caller sets the predictor in
-    /// `ws.state.q` and `ws.state.lambda`; on success they hold q_{n+1} and lambda_{n+1},
-    /// `ws.state.v` holds v_{n+1} and `state` holds qdd_{n+1} and a_{n+1}. On failure `state`
-    /// is unchanged.
-    #[allow(clippy::too_many_arguments)]
-    pub fn step(
+    fn error_constants(&self) -> ErrorConstants {
+        let k = self.coefficients();
+        let delta = k.alpha_m - k.alpha_f;
+        let kappa = 0.5 * (1.0 - k.alpha_f) - (1.0 - k.alpha_m) * (0.5 + delta);
+        ErrorConstants {
+            q2: 0.0,
+            q3: k.beta + 0.5 * delta - 1.0 / 6.0,
+            v2: 0.0,
+            v3: kappa + k.gamma * (0.5 + delta) - 1.0 / 6.0,
+        }
+    }
+
+    /// t_n + h: the true acceleration of the step's end.
+    fn sample_offset(&self, h: f64) -> f64 {
+        h
+    }
+
+    fn index3<'a>(
         &self,
-        system: &System,
-        ws: &mut StepWorkspace,
+        state: &'a mut RuleState,
         t_n: f64,
-        q_n: &[Vec3],
-        v_n: &[Vec3],
-        state: &mut AlphaState,
+        q_n: &'a [Vec3],
+        v_n: &'a [Vec3],
         h: f64,
-        options: &NewtonOptions,
-    ) -> Result<NewtonReport, NewtonFailure> {
-        let (mut problem, work) = self.problem(system, ws, state, t_n, q_n, v_n, h);
-        let known = problem.known;
-        let report = newton::solve(&mut problem, work, self.matrix_key(h), options)?;
-        let b = &mut ws.state;
-        for i in 0..b.q.len() {
-            let (a, v) = known.kinematics(&b.q[i], &state.predicted_q[i], &state.predicted_v[i]);
-            b.v[i] = v;
+        mass_ref: f64,
+    ) -> AlphaStep<'a> {
+        let k = self.coefficients();
+        let c = (1.0 - k.alpha_m) / ((1.0 - k.alpha_f) * k.beta * h * h);
+        state.predict(&k, h, q_n, v_n);
+        let state = &*state;
+        AlphaStep {
+            p: &state.predicted_q,
+            w: &state.predicted_v,
+            a_n: &state.algorithmic,
+            qdd_n: &state.acceleration,
+            known: Predictors::new(&k, h),
+            c,
+            dv_dq: k.gamma / (k.beta * h),
+            point: StepPoint {
+                t_eval: t_n + h,
+                t_end: t_n + h,
+                sigma: 1.0 / (c * mass_ref),
+            },
+        }
+    }
+
+    /// qdd_{n+1} and a_{n+1} from q_{n+1} and the step's predictors.
+    fn advance(&self, state: &mut RuleState, h: f64, q: &[Vec3]) {
+        let known = Predictors::new(&self.coefficients(), h);
+        for i in 0..q.len() {
+            let (a, _) = known.kinematics(&q[i], &state.predicted_q[i], &state.predicted_v[i]);
             for x in 0..3 {
                 state.acceleration[i][x] = known.c_a * a[x] + known.c_m * state.algorithmic[i][x]
                     - known.c_f * state.acceleration[i][x];
             }
             state.algorithmic[i] = a;
         }
-        Ok(report)
     }
 
-    /// The nonlinear problem of a step of size `h` from (t_n, q_n, v_n, state), with the
-    /// predictors computed into `state`, and the linear solver's share of the workspace.
-    #[allow(clippy::too_many_arguments)]
-    fn problem<'a>(
+    fn ggl(
         &self,
-        system: &'a System,
-        ws: &'a mut StepWorkspace,
-        state: &'a mut AlphaState,
-        t_n: f64,
+        state: &RuleState,
+        h: f64,
         q_n: &[Vec3],
         v_n: &[Vec3],
-        h: f64,
-    ) -> (AlphaStepProblem<'a>, LinearWork<'a>) {
+        base_q: &mut [Vec3],
+        base_a: &mut [Vec3],
+    ) -> GglCoefficients {
         let k = self.coefficients();
-        let c = (1.0 - k.alpha_m) / ((1.0 - k.alpha_f) * k.beta * h * h);
-        state.predict(&k, h, q_n, v_n);
-        let state = &*state;
-        let problem = AlphaStepProblem {
-            system,
-            layout: &ws.layout,
-            buffers: &mut ws.state,
-            scales: &ws.scales,
-            inertia: &ws.inertia,
-            parallel: ws.parallel.as_mut(),
-            p: &state.predicted_q,
-            w: &state.predicted_v,
-            a_n: &state.algorithmic,
-            qdd_n: &state.acceleration,
-            t_n,
-            h,
-            k,
-            known: Predictors::new(&k, h),
-            sigma: 1.0 / (c * ws.mass_ref),
-        };
-        let work = LinearWork {
-            solver: ws.solver.as_mut(),
-            values: &mut ws.values,
-            r: &mut ws.r,
-            matrix: &mut ws.matrix,
-        };
-        (problem, work)
-    }
-}
-
-/// One generalised-alpha step's nonlinear problem.
-pub struct AlphaStepProblem<'a> {
-    system: &'a System,
-    layout: &'a Layout,
-    buffers: &'a mut StepBuffers,
-    scales: &'a [f64],
-    inertia: &'a [f64],
-    parallel: Option<&'a mut ParallelAssembly>,
-    /// The predictors p and w of q_{n+1} and v_{n+1} (see [`Predictors`]).
-    p: &'a [Vec3],
-    w: &'a [Vec3],
-    a_n: &'a [Vec3],
-    qdd_n: &'a [Vec3],
-    t_n: f64,
-    h: f64,
-    k: AlphaCoefficients,
-    known: Predictors,
-    sigma: f64,
-}
-
-impl AlphaStepProblem<'_> {
-    /// The residual on rayon's thread pool (same result as the serial loops, bit for bit).
-    fn residual_parallel(&mut self, r: &mut [f64]) {
-        let (h, sigma, known) = (self.h, self.sigma, self.known);
-        let (p, w, a_n, qdd_n, inertia) = (self.p, self.w, self.a_n, self.qdd_n, self.inertia);
-        let (system, layout) = (self.system, self.layout);
-        let b = &mut *self.buffers;
-        b.q.par_iter()
-            .zip(b.v.par_iter_mut())
-            .zip(p.par_iter().zip(w.par_iter()))
-            .with_min_len(MIN_TASK)
-            .for_each(|((q, v), (p, w))| *v = known.kinematics(q, p, w).1);
-        let b = &*self.buffers;
-        let g = system.gravity();
-        let particles = system.particles();
-        let t1 = self.t_n + h;
-        let terms = ResidualTerms {
-            q_eval: &b.q,
-            v_eval: &b.v,
-            t_eval: t1,
-            q_end: &b.q,
-            t_end: t1,
-            sigma,
-            lambda: &b.lambda,
-            scales: self.scales,
-        };
-        let parallel = self.parallel.as_deref_mut().expect("parallel assembly");
-        parallel.residual(system, layout, &terms, r, |i, x| {
-            let a = (b.q[i][x] - p[i][x]) * known.inv_beta_h2;
-            let mass = particles[i].mass;
-            known.inertia_row(sigma, inertia[i], mass, g[x], a, a_n[i][x], qdd_n[i][x])
-        });
-    }
-
-    /// The Jacobian on rayon's thread pool (equal to the serial one to round-off).
-    fn jacobian_parallel(&mut self, values: &mut [f64]) {
-        let (h, sigma, k, inertia) = (self.h, self.sigma, self.k, self.inertia);
-        let c = (1.0 - k.alpha_m) / ((1.0 - k.alpha_f) * k.beta * h * h);
-        let b = &*self.buffers;
-        let t1 = self.t_n + h;
-        let terms = JacobianTerms {
-            q_eval: &b.q,
-            v_eval: &b.v,
-            t_eval: t1,
-            q_end: &b.q,
-            t_end: t1,
-            force_dq: -sigma,
-            force_dv: -sigma * (k.gamma / (k.beta * h)),
-            hessian: -sigma,
-            lambda: &b.lambda,
-            scales: self.scales,
-        };
-        let parallel = self.parallel.as_deref().expect("parallel assembly");
-        parallel.jacobian(self.system, self.layout, &terms, values, |i| {
-            sigma * c * inertia[i]
-        });
-    }
-}
-
-impl NewtonProblem for AlphaStepProblem<'_> {
-    fn residual(&mut self, r: &mut [f64]) {
-        if self.parallel.is_some() {
-            return self.residual_parallel(r);
-        }
-        let (system, layout, sigma, known) = (self.system, self.layout, self.sigma, self.known);
-        let t1 = self.t_n + self.h;
-        let g = system.gravity();
-        let b = &mut *self.buffers;
-        for (i, p) in system.particles().iter().enumerate() {
-            let (a, v) = known.kinematics(&b.q[i], &self.p[i], &self.w[i]);
-            b.v[i] = v;
-            let d = layout.dof[i];
-            if d != NONE {
-                let (a_n, qdd_n) = (self.a_n[i], self.qdd_n[i]);
-                for x in 0..3 {
-                    r[d + x] = known.inertia_row(
-                        sigma,
-                        self.inertia[i],
-                        p.mass,
-                        g[x],
-                        a[x],
-                        a_n[x],
-                        qdd_n[x],
-                    );
-                }
+        let kappa = k.beta * h / k.gamma;
+        for i in 0..q_n.len() {
+            for x in 0..3 {
+                let (a_n, qdd_n) = (state.algorithmic[i][x], state.acceleration[i][x]);
+                let old = v_n[i][x] + h * (1.0 - k.gamma) * a_n;
+                base_q[i][x] =
+                    q_n[i][x] + h * v_n[i][x] + h * h * (0.5 - k.beta) * a_n - kappa * old;
+                base_a[i][x] =
+                    (k.alpha_m * a_n - k.alpha_f * qdd_n - (1.0 - k.alpha_m) * old / (k.gamma * h))
+                        / (1.0 - k.alpha_f);
             }
         }
-        let b = &*self.buffers;
-        for f in system.forces() {
-            let fl = f.force(&b.q, &b.v, t1);
-            for (x, &p) in f.particles().iter().enumerate() {
-                let d = layout.dof[p];
-                if d != NONE {
-                    for y in 0..3 {
-                        r[d + y] -= sigma * fl[x][y];
-                    }
-                }
-            }
-        }
-        let m3 = 3 * layout.free;
-        for (c, con) in system.constraints().iter().enumerate() {
-            let (phi, grad) = con.residual_and_gradient(&b.q, t1);
-            let weight = sigma * b.lambda[c];
-            for (x, &p) in con.particles().iter().enumerate() {
-                let d = layout.dof[p];
-                if d != NONE {
-                    let row = &mut r[d..d + 3];
-                    for y in 0..3 {
-                        row[y] -= weight * grad[x][y];
-                    }
-                }
-            }
-            r[m3 + c] = self.scales[c] * phi;
+        GglCoefficients {
+            kappa,
+            c_v: (1.0 - k.alpha_m) / ((1.0 - k.alpha_f) * k.gamma * h),
+            w: 1.0,
         }
     }
 
-    fn jacobian(&mut self, values: &mut [f64]) {
-        if self.parallel.is_some() {
-            return self.jacobian_parallel(values);
-        }
-        let (system, layout, h, sigma, k) = (self.system, self.layout, self.h, self.sigma, self.k);
-        let t1 = self.t_n + h;
-        let b = &*self.buffers;
-        // sigma c = 1/m_ref: the scaled mass block is M/m_ref.
-        let c = (1.0 - k.alpha_m) / ((1.0 - k.alpha_f) * k.beta * h * h);
-        let dv_dq = k.gamma / (k.beta * h);
-        for i in 0..system.particles().len() {
-            layout.add_to_particle_diagonal(values, i, sigma * c * self.inertia[i]);
-        }
-        for (fi, f) in system.forces().iter().enumerate() {
-            if !f.has_jacobian() {
-                continue;
+    /// a_{n+1} = (v - v_n - h (1 - gamma) a_n)/(gamma h), then qdd_{n+1}.
+    fn advance_ggl(&self, state: &mut RuleState, h: f64, v_n: &[Vec3], v: &[Vec3]) {
+        let k = self.coefficients();
+        for (i, v) in v.iter().enumerate() {
+            for x in 0..3 {
+                let a_n = state.algorithmic[i][x];
+                let a = (v[x] - v_n[i][x] - h * (1.0 - k.gamma) * a_n) / (k.gamma * h);
+                state.acceleration[i][x] = ((1.0 - k.alpha_m) * a + k.alpha_m * a_n
+                    - k.alpha_f * state.acceleration[i][x])
+                    / (1.0 - k.alpha_f);
+                state.algorithmic[i][x] = a;
             }
-            let mut dq: Jacobian = Default::default();
-            let mut dv: Jacobian = Default::default();
-            f.add_jacobian(&b.q, &b.v, t1, &mut dq, &mut dv);
-            let n = f.particles().len();
-            for x in 0..n {
-                for y in 0..n {
-                    let blk = &layout.force_block[fi][x][y];
-                    add_block(values, blk, -sigma, &dq[x][y]);
-                    add_block(values, blk, -sigma * dv_dq, &dv[x][y]);
-                }
-            }
-        }
-        for (ci, con) in system.constraints().iter().enumerate() {
-            let n = con.particles().len();
-            let mut hess: [[Mat3; 2]; 2] = Default::default();
-            con.add_hessian(&b.q, t1, -sigma * b.lambda[ci], &mut hess);
-            let grad = con.gradient(&b.q, t1);
-            layout.add_constraint_blocks(values, ci, n, &hess, self.scales[ci], &grad, &grad);
         }
     }
 
-    fn update(&mut self, dx: &[f64]) {
-        let b = &mut *self.buffers;
-        self.layout
-            .apply_increment(&mut b.q, &mut b.lambda, dx, self.scales, self.sigma);
+    /// The true acceleration qdd_{n+1}.
+    fn end_acceleration(
+        &self,
+        state: &RuleState,
+        _h: f64,
+        _v_n: &[Vec3],
+        _v: &[Vec3],
+        out: &mut [Vec3],
+    ) {
+        out.copy_from_slice(&state.acceleration);
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrators::trapezoidal::tests::{
-        assert_jacobian_matches, assert_same_assembly, chain, cloth, every_kind, perturbed_iterate,
-        wiggled_iterate,
-    };
-    use crate::linear::SparseSolver;
-
-    /// The assembled Jacobian equals finite differences of the assembled residual, for every
-    /// constraint and force kind, non-zero old accelerations and multipliers, over the range of
-    /// rho_inf.
-    #[test]
-    fn jacobian_matches_finite_differences_of_the_residual() {
-        let s = every_kind();
-        for rho_inf in [0.0, 0.6, 1.0] {
-            for dense_limit in [0, 1000] {
-                let mut ws = StepWorkspace::with_solver(&s, dense_limit, SparseSolver::SparseLu);
-                let q_n = s.initial_positions();
-                let v_n = s.initial_velocities();
-                let a_n: Vec<Vec3> = (0..q_n.len())
-                    .map(|i| [0.3 * i as f64, -1.0, 0.2])
-                    .collect();
-                let qdd_n: Vec<Vec3> = (0..q_n.len())
-                    .map(|i| [-0.1, 0.4 * i as f64, 0.7])
-                    .collect();
-                let mut state = AlphaState::new(&a_n);
-                state.acceleration = qdd_n;
-                perturbed_iterate(&mut ws, &q_n);
-                let layout = ws.layout.clone();
-                let scheme = GeneralizedAlpha { rho_inf };
-                let (mut problem, _) =
-                    scheme.problem(&s, &mut ws, &mut state, 0.3, &q_n, &v_n, 0.01);
-                assert_jacobian_matches(&mut problem, &layout);
-            }
-        }
-    }
-
-    /// Parallel assembly (forced by a zero threshold) gives the serial residual and Jacobian.
-    #[test]
-    fn parallel_assembly_matches_serial() {
-        for s in [every_kind(), chain(5_000), cloth(50)] {
-            let q_n = s.initial_positions();
-            let v_n = s.initial_velocities();
-            let a_n: Vec<Vec3> = (0..q_n.len())
-                .map(|i| [0.3, -1.0, 0.01 * i as f64])
-                .collect();
-            let qdd_n: Vec<Vec3> = (0..q_n.len())
-                .map(|i| [-0.1, 0.4, 0.7 / (1.0 + i as f64)])
-                .collect();
-            let mut start = AlphaState::new(&a_n);
-            start.acceleration = qdd_n;
-            let assemble = |parallel: bool| {
-                let mut ws = StepWorkspace::new(&s, 48);
-                if parallel {
-                    ws.assemble_in_parallel_from(&s, 0);
-                }
-                wiggled_iterate(&mut ws, &q_n);
-                let (unknowns, nnz) = (ws.layout.unknowns(), ws.layout.pattern.nnz());
-                let mut state = start.clone();
-                let scheme = GeneralizedAlpha { rho_inf: 0.6 };
-                let (mut problem, _) =
-                    scheme.problem(&s, &mut ws, &mut state, 0.3, &q_n, &v_n, 0.01);
-                let mut r = vec![0.0; unknowns];
-                let mut values = vec![0.0; nnz];
-                problem.residual(&mut r);
-                problem.jacobian(&mut values);
-                (r, values)
-            };
-            assert_same_assembly(&assemble(false), &assemble(true));
-        }
-    }
 
     /// The coefficients of Arnold and Brüls (2007), eqs. for rho_inf = 1 (the trapezoidal-like
     /// Newmark scheme, gamma = 1/2, beta = 1/4) and rho_inf = 0 (alpha_m = -1, gamma = 3/2,

@@ -1,23 +1,40 @@
-//! Time integration: the generalised trapezoidal rule (paper eq. 24), the generalised-alpha
-//! scheme of Arnold and Brüls, and the Newton loop they share; each on the index-3 DAE or on the
-//! stabilised index-2 (GGL) formulation ([`Formulation`]).
+//! Time integration: the time rules (the generalised trapezoidal rule of paper eq. 24 with
+//! backward Euler as its alpha = 1 case, the generalised-alpha scheme of Arnold and Brüls), each
+//! a small object behind one contract ([`TimeRule`], `rule.rs`); the one index-3 step problem
+//! ([`StepProblem`]) and the one GGL step problem ([`StabilizedWorkspace`]) written once for
+//! every rule; and the Newton loop they share. The equations discretised are chosen by
+//! [`Formulation`].
+//!
+//! A new rule is one file implementing [`TimeRule`] and one registration: a variant of
+//! [`Scheme`] and its arm in `with_rule!` below, the only `match` on the scheme.
 
 pub mod error_estimate;
+#[cfg(test)]
+pub(crate) mod fixtures;
 mod generalized_alpha;
 pub mod newton;
+mod rule;
 mod stabilized;
 mod stabilized_layout;
+mod step_problem;
 mod trapezoidal;
+mod workspace;
 
 pub use error_estimate::{AccelerationHistory, ErrorConstants};
-pub use generalized_alpha::{AlphaCoefficients, AlphaState, GeneralizedAlpha};
+pub use generalized_alpha::{AlphaCoefficients, AlphaStep, GeneralizedAlpha};
 
 pub use newton::{
     IterationMatrix, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport,
 };
+pub use rule::{GglCoefficients, Index3Rule, RuleState, StepPoint, TimeRule};
 pub use stabilized::{phi_qt, Formulation, StabilizedWorkspace};
 pub use stabilized_layout::StabilizedLayout;
-pub use trapezoidal::{GeneralizedTrapezoidal, StepProblem, StepWorkspace};
+pub use step_problem::{index3_step, StepProblem};
+pub use trapezoidal::{GeneralizedTrapezoidal, TrapezoidalStep};
+pub use workspace::{StepBuffers, StepWorkspace, RELEASE_PATTERN_ABOVE};
+
+use crate::math::Vec3;
+use crate::model::System;
 
 /// The time discretisation of a run, chosen by name.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -35,6 +52,25 @@ pub enum Scheme {
         rho_inf: f64,
     },
 }
+
+/// Evaluates `$body` with `$rule` bound to the [`TimeRule`] object of the scheme `$scheme`
+/// (statically dispatched: the body is compiled once per rule). The registry of the rules.
+macro_rules! with_rule {
+    ($scheme:expr, $rule:ident => $body:expr) => {
+        match $scheme {
+            $crate::integrators::Scheme::GeneralizedTrapezoidal { alpha } => {
+                let $rule = $crate::integrators::GeneralizedTrapezoidal { alpha };
+                $body
+            }
+            $crate::integrators::Scheme::GeneralizedAlpha { rho_inf } => {
+                let $rule = $crate::integrators::GeneralizedAlpha { rho_inf };
+                $body
+            }
+        }
+    };
+}
+#[cfg(test)]
+pub(crate) use with_rule;
 
 impl Default for Scheme {
     fn default() -> Self {
@@ -55,19 +91,80 @@ impl Scheme {
 
     /// Order of accuracy of the positions.
     pub fn order(&self) -> usize {
-        match *self {
-            Scheme::GeneralizedTrapezoidal { alpha } => GeneralizedTrapezoidal { alpha }.order(),
-            Scheme::GeneralizedAlpha { rho_inf } => GeneralizedAlpha { rho_inf }.order(),
-        }
+        with_rule!(*self, rule => rule.order())
     }
 
     /// What identifies the iteration matrix of a step of size `h` (for its reuse).
     pub fn matrix_key(&self, h: f64) -> [f64; 2] {
-        match *self {
-            Scheme::GeneralizedTrapezoidal { alpha } => {
-                GeneralizedTrapezoidal { alpha }.matrix_key(h)
-            }
-            Scheme::GeneralizedAlpha { rho_inf } => GeneralizedAlpha { rho_inf }.matrix_key(h),
-        }
+        with_rule!(*self, rule => rule.matrix_key(h))
+    }
+
+    /// The constants of the local-error estimate.
+    pub fn error_constants(&self) -> ErrorConstants {
+        with_rule!(*self, rule => rule.error_constants())
+    }
+
+    /// Where, after t_n, a step of size `h` leaves its acceleration sample.
+    pub fn sample_offset(&self, h: f64) -> f64 {
+        with_rule!(*self, rule => rule.sample_offset(h))
+    }
+
+    /// The rule's state at the start of a run with the consistent accelerations `acc`.
+    pub fn initial_state(&self, acc: &[Vec3]) -> RuleState {
+        with_rule!(*self, rule => rule.initial_state(acc))
+    }
+
+    /// Takes one step of size `h` from (t_n, q_n, v_n, `state`): on the GGL formulation when
+    /// `stabilized` is given, on the index-3 DAE otherwise ([`index3_step`],
+    /// [`StabilizedWorkspace::step`] say what the buffers hold before and after).
+    #[allow(clippy::too_many_arguments)]
+    pub fn step(
+        &self,
+        system: &System,
+        ws: &mut StepWorkspace,
+        stabilized: Option<&mut StabilizedWorkspace>,
+        t_n: f64,
+        q_n: &[Vec3],
+        v_n: &[Vec3],
+        state: &mut RuleState,
+        h: f64,
+        options: &NewtonOptions,
+    ) -> Result<NewtonReport, NewtonFailure> {
+        with_rule!(*self, rule => match stabilized {
+            Some(ggl) => ggl.step(system, ws, rule, t_n, q_n, v_n, state, h, options),
+            None => index3_step(rule, system, ws, t_n, q_n, v_n, state, h, options),
+        })
+    }
+
+    /// The acceleration of a converged step of size `h` from v_n to v_{n+1} = `v` (the rule's
+    /// `state` already advanced), into `out`: the run loop's predictor and error sample.
+    pub fn end_acceleration(
+        &self,
+        state: &RuleState,
+        h: f64,
+        v_n: &[Vec3],
+        v: &[Vec3],
+        out: &mut [Vec3],
+    ) {
+        with_rule!(*self, rule => rule.end_acceleration(state, h, v_n, v, out))
+    }
+}
+
+impl GeneralizedTrapezoidal {
+    /// Takes one index-3 step of size `h` from (t_n, q_n, v_n) ([`index3_step`]; the rule
+    /// carries no state of its own).
+    #[allow(clippy::too_many_arguments)]
+    pub fn step(
+        &self,
+        system: &System,
+        ws: &mut StepWorkspace,
+        t_n: f64,
+        q_n: &[Vec3],
+        v_n: &[Vec3],
+        h: f64,
+        options: &NewtonOptions,
+    ) -> Result<NewtonReport, NewtonFailure> {
+        let mut none = RuleState::new(&[]);
+        index3_step(*self, system, ws, t_n, q_n, v_n, &mut none, h, options)
     }
 }

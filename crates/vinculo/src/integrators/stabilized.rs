@@ -3,7 +3,7 @@
 //!
 //! # The equations
 //!
-//! The index-3 DAE (formulation.md) enforces the constraints on positions only; its velocities
+//! The index-3 DAE (`docs/theory/formulation.md`) enforces the constraints on positions only; its velocities
 //! satisfy Phi' = G v + Phi_t = 0 (G = Phi_q) only to the order of the scheme. GGL adds the
 //! velocity constraints with a second multiplier mu that acts on the kinematics:
 //!
@@ -22,8 +22,8 @@
 //!
 //! # The discretisation
 //!
-//! Both time rules write the step from (t_n, q_n, v_n) to q = q_{n+1}, v = v_{n+1} in one common
-//! form, linear in v:
+//! Every time rule writes the step from (t_n, q_n, v_n) to q = q_{n+1}, v = v_{n+1} in one common
+//! form, linear in v (`docs/theory/ggl.md`):
 //!
 //! ```text
 //! q    = b + kappa v + G(q, t_{n+1})^T mu          (kinematics)
@@ -31,18 +31,11 @@
 //! q_e = (1 - w) q_n + w q,  v_e = (1 - w) v_n + w v,  t_e = t_n + w h   (evaluation point)
 //! ```
 //!
-//! - generalised trapezoidal rule, alpha in [1/2, 1]: kappa = alpha h, b = q_n + (1 - alpha) h v_n,
-//!   c_v = 1/h, c = -v_n/h, w = alpha; with mu = 0, v_e = (q - q_n)/h and the step is the
-//!   index-3 one of [`super::StepProblem`];
-//! - generalised-alpha (the stabilised index-2 form of Arnold and Brüls, with the coefficients
-//!   alpha_m, alpha_f, gamma, beta of [`super::GeneralizedAlpha`]): eliminating the algorithmic
-//!   acceleration a_{n+1} = (v - v_n - h (1 - gamma) a_n)/(gamma h) from
-//!   `q = q_n + h v_n + h^2 (1/2 - beta) a_n + h^2 beta a_{n+1} + G^T mu` and
-//!   `(1 - alpha_m) a_{n+1} + alpha_m a_n = (1 - alpha_f) qdd + alpha_f qdd_n` gives
-//!   kappa = beta h / gamma, b = q_n + h v_n + h^2 (1/2 - beta) a_n - kappa (v_n + h (1 - gamma) a_n),
-//!   c_v = (1 - alpha_m)/((1 - alpha_f) gamma h),
-//!   c = (alpha_m a_n - alpha_f qdd_n - (1 - alpha_m)(v_n + h (1 - gamma) a_n)/(gamma h))/(1 - alpha_f),
-//!   w = 1 (everything at t_{n+1}).
+//! The rule gives kappa, c_v, w, b and c ([`TimeRule::ggl`]; the formulas of each rule are in its
+//! own file, `trapezoidal.rs` and `generalized_alpha.rs`), and updates its state from v_{n+1}
+//! after the step ([`TimeRule::advance_ggl`]). This file is the one GGL step problem,
+//! written once for every rule: with mu = 0 and the trapezoidal rule, v_e = (q - q_n)/h and the
+//! step is the index-3 one of `step_problem.rs`.
 //!
 //! Newton runs on (q, v, lambda, mu) with the residual
 //!
@@ -104,11 +97,11 @@
 //! the dense LU, others the general sparse LU, analysed once per run.
 
 use super::newton::{self, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport};
+use super::rule::{RuleState, TimeRule};
 use super::stabilized_layout::StabilizedLayout;
-use super::trapezoidal::{StepBuffers, StepWorkspace};
-use super::{AlphaState, GeneralizedAlpha, Scheme};
+use super::workspace::{StepBuffers, StepWorkspace};
 
-use crate::assembly::{add, add_block, NONE};
+use crate::assembly::{add, add_block, add_force_blocks, NONE};
 use crate::constraints::{Constraint, Gradient, Hessian};
 use crate::forces::Jacobian;
 use crate::linear::{for_layout, LinearSolver, SparseSolver};
@@ -190,79 +183,51 @@ impl StabilizedWorkspace {
         }
     }
 
-    /// The coefficients of a step of `scheme` of size `h` from (t_n, q_n, v_n, `alpha`), with
+    /// The coefficients of a step of `rule` of size `h` from (t_n, q_n, v_n, `state`), with
     /// b and c in `base_q` and `base_a`.
     #[allow(clippy::too_many_arguments)]
-    fn prepare(
+    fn prepare<T: TimeRule>(
         &mut self,
-        scheme: Scheme,
+        rule: T,
         mass_ref: f64,
         t_n: f64,
         q_n: &[Vec3],
         v_n: &[Vec3],
-        alpha: &AlphaState,
+        state: &RuleState,
         h: f64,
     ) -> StepRule {
-        let (kappa, c_v, w) = match scheme {
-            Scheme::GeneralizedTrapezoidal { alpha: a } => {
-                for i in 0..q_n.len() {
-                    for x in 0..3 {
-                        self.base_q[i][x] = q_n[i][x] + (1.0 - a) * h * v_n[i][x];
-                        self.base_a[i][x] = -v_n[i][x] / h;
-                    }
-                }
-                (a * h, 1.0 / h, a)
-            }
-            Scheme::GeneralizedAlpha { rho_inf } => {
-                let k = GeneralizedAlpha { rho_inf }.coefficients();
-                let kappa = k.beta * h / k.gamma;
-                for i in 0..q_n.len() {
-                    for x in 0..3 {
-                        let (a_n, qdd_n) = (alpha.algorithmic[i][x], alpha.acceleration[i][x]);
-                        let old = v_n[i][x] + h * (1.0 - k.gamma) * a_n;
-                        self.base_q[i][x] =
-                            q_n[i][x] + h * v_n[i][x] + h * h * (0.5 - k.beta) * a_n - kappa * old;
-                        self.base_a[i][x] = (k.alpha_m * a_n
-                            - k.alpha_f * qdd_n
-                            - (1.0 - k.alpha_m) * old / (k.gamma * h))
-                            / (1.0 - k.alpha_f);
-                    }
-                }
-                let c_v = (1.0 - k.alpha_m) / ((1.0 - k.alpha_f) * k.gamma * h);
-                (kappa, c_v, 1.0)
-            }
-        };
+        let k = rule.ggl(state, h, q_n, v_n, &mut self.base_q, &mut self.base_a);
         StepRule {
-            kappa,
-            c_v,
-            w,
-            t_eval: t_n + w * h,
+            kappa: k.kappa,
+            c_v: k.c_v,
+            w: k.w,
+            t_eval: t_n + k.w * h,
             t_end: t_n + h,
-            sigma: kappa / (c_v * mass_ref),
+            sigma: k.kappa / (k.c_v * mass_ref),
         }
     }
 
-    /// Takes one GGL step of `scheme` of size `h` from (t_n, q_n, v_n; for generalised-alpha also
-    /// `alpha`). The caller sets the predictor in `ws.state.q` and `ws.state.lambda`; the
-    /// velocities start from the kinematics with mu = 0. On success `ws.state` holds q_{n+1},
-    /// v_{n+1} and lambda_{n+1}, `self.mu` the velocity multipliers and, for generalised-alpha,
-    /// `alpha` the new accelerations; on failure `alpha` is unchanged. `ws.matrix` tracks this
+    /// Takes one GGL step of `rule` of size `h` from (t_n, q_n, v_n, `state`). The caller sets
+    /// the predictor in `ws.state.q` and `ws.state.lambda`; the velocities start from the
+    /// kinematics with mu = 0. On success `ws.state` holds q_{n+1}, v_{n+1} and lambda_{n+1},
+    /// `self.mu` the velocity multipliers and `state` the rule's new state; on failure `state`
+    /// is unchanged. `ws.matrix` tracks this
     /// solver's factorisation for modified Newton; failures name equations in the index-3
     /// numbering of `ws.layout` ([`StabilizedLayout::index3_equation`]).
     #[allow(clippy::too_many_arguments)]
-    pub fn step(
+    pub fn step<T: TimeRule>(
         &mut self,
         system: &System,
         ws: &mut StepWorkspace,
-        scheme: Scheme,
+        time_rule: T,
         t_n: f64,
         q_n: &[Vec3],
         v_n: &[Vec3],
-        alpha: &mut AlphaState,
+        state: &mut RuleState,
         h: f64,
         options: &NewtonOptions,
     ) -> Result<NewtonReport, NewtonFailure> {
-        let rule = self.prepare(scheme, ws.mass_ref, t_n, q_n, v_n, alpha, h);
+        let rule = self.prepare(time_rule, ws.mass_ref, t_n, q_n, v_n, state, h);
         for (v, (q, b)) in ws
             .state
             .v
@@ -297,7 +262,7 @@ impl StabilizedWorkspace {
             matrix: &mut ws.matrix,
         };
         let layout = &self.layout;
-        let report = newton::solve(&mut problem, work, scheme.matrix_key(h), options).map_err(
+        let report = newton::solve(&mut problem, work, time_rule.matrix_key(h), options).map_err(
             |failure| match failure {
                 NewtonFailure::NotConverged {
                     iterations,
@@ -314,19 +279,7 @@ impl StabilizedWorkspace {
                 }
             },
         )?;
-        if let Scheme::GeneralizedAlpha { rho_inf } = scheme {
-            let k = GeneralizedAlpha { rho_inf }.coefficients();
-            for (i, v) in ws.state.v.iter().enumerate() {
-                for x in 0..3 {
-                    let a_n = alpha.algorithmic[i][x];
-                    let a = (v[x] - v_n[i][x] - h * (1.0 - k.gamma) * a_n) / (k.gamma * h);
-                    alpha.acceleration[i][x] = ((1.0 - k.alpha_m) * a + k.alpha_m * a_n
-                        - k.alpha_f * alpha.acceleration[i][x])
-                        / (1.0 - k.alpha_f);
-                    alpha.algorithmic[i][x] = a;
-                }
-            }
-        }
+        time_rule.advance_ggl(state, h, v_n, &ws.state.v);
         Ok(report)
     }
 }
@@ -444,19 +397,16 @@ impl NewtonProblem for StabilizedProblem<'_> {
             let mut dq: Jacobian = Default::default();
             let mut dv: Jacobian = Default::default();
             f.add_jacobian(self.q_eval, self.v_eval, rule.t_eval, &mut dq, &mut dv);
-            let n = f.particles().len();
-            for x in 0..n {
-                for y in 0..n {
-                    add_block(
-                        values,
-                        &layout.force_q[fi][x][y],
-                        -rule.sigma * rule.w,
-                        &dq[x][y],
-                    );
-                    let sv = -rule.sigma * rule.w / rule.kappa;
-                    add_block(values, &layout.force_v[fi][x][y], sv, &dv[x][y]);
-                }
-            }
+            let (wq, wv) = (-rule.sigma * rule.w, -rule.sigma * rule.w / rule.kappa);
+            let (blocks_q, blocks_v) = (&layout.force_q[fi], &layout.force_v[fi]);
+            add_force_blocks(
+                f.particles().len(),
+                blocks_q,
+                blocks_v,
+                (wq, &dq),
+                (wv, &dv),
+                |b, s, m| add_block(values, b, s, m),
+            );
         }
         for (c, con) in system.constraints().iter().enumerate() {
             let parts = con.particles();
@@ -526,9 +476,10 @@ impl NewtonProblem for StabilizedProblem<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrators::trapezoidal::tests::{
+    use crate::integrators::fixtures::{
         assert_pattern_jacobian_matches, every_kind, perturbed_iterate,
     };
+    use crate::integrators::Scheme;
 
     /// The assembled Jacobian equals central finite differences of the assembled residual, for
     /// every constraint kind (a moving point, so Phi_t and Phi_qt are not zero) and force kind
@@ -550,10 +501,13 @@ mod tests {
                 let mut ws = StepWorkspace::with_solver(&s, 0, SparseSolver::SparseLu);
                 let mut ggl = StabilizedWorkspace::new(&s, dense_limit);
                 let algorithmic: Vec<Vec3> = q_n.iter().map(|x| [0.2, x[2], -x[0]]).collect();
-                let mut alpha = AlphaState::new(&algorithmic);
+                let mut alpha = RuleState::new(&algorithmic);
                 alpha.acceleration = q_n.iter().map(|x| [x[1], -x[0], 0.3]).collect();
                 let h = 0.01;
-                let rule = ggl.prepare(scheme, ws.mass_ref, 0.3, &q_n, &v_n, &alpha, h);
+                let mass_ref = ws.mass_ref;
+                let rule = crate::integrators::with_rule!(scheme, r => {
+                    ggl.prepare(r, mass_ref, 0.3, &q_n, &v_n, &alpha, h)
+                });
                 perturbed_iterate(&mut ws, &q_n);
                 for (i, v) in ws.state.v.iter_mut().enumerate() {
                     *v = [0.3 * i as f64, -0.2, 0.1 + v_n[i][0]];

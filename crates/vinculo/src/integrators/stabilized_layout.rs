@@ -29,7 +29,8 @@
 //! kinematics, which would bring G G^T and f_v G^T fill between neighbouring elements) keeps
 //! every block local.
 
-use crate::assembly::{number_particles, Block, Pattern, Slot, NONE, NO_SLOT};
+use crate::assembly::{number_particles, Block, ForceBlocks, Pattern, Slot, NONE, NO_SLOT};
+use crate::forces::MAX_FORCE_PARTICLES;
 use crate::model::System;
 
 /// Slots of a constraint's 3-vector row or column, per touched particle.
@@ -70,9 +71,9 @@ pub struct StabilizedLayout {
     /// Per constraint: its velocity row, velocity columns of its particles.
     pub velocity_row_v: Vec<Strip>,
     /// Per force: dynamic rows, position columns.
-    pub force_q: Vec<PairBlocks>,
+    pub force_q: Vec<ForceBlocks>,
     /// Per force: dynamic rows, velocity columns.
-    pub force_v: Vec<PairBlocks>,
+    pub force_v: Vec<ForceBlocks>,
 }
 
 impl StabilizedLayout {
@@ -185,7 +186,16 @@ impl StabilizedLayout {
             .collect();
         let cons = system.constraints();
         let forces = system.forces();
-        let no_blocks = [[[NO_SLOT; 9]; 2]; 2];
+        let no_blocks = [[[NO_SLOT; 9]; MAX_FORCE_PARTICLES]; MAX_FORCE_PARTICLES];
+        let force_blocks = |parts: &[usize], row: usize, col: usize| -> ForceBlocks {
+            let mut out = no_blocks;
+            for (x, &a) in parts.iter().enumerate() {
+                for (y, &b) in parts.iter().enumerate() {
+                    out[x][y] = block_slots(shift(dof[a], row), shift(dof[b], col));
+                }
+            }
+            out
+        };
         StabilizedLayout {
             kinematic_q,
             kinematic_v,
@@ -227,7 +237,7 @@ impl StabilizedLayout {
                 .iter()
                 .map(|f| {
                     if f.has_jacobian() {
-                        pair_blocks(f.particles(), vel, 0)
+                        force_blocks(f.particles(), vel, 0)
                     } else {
                         no_blocks
                     }
@@ -237,7 +247,7 @@ impl StabilizedLayout {
                 .iter()
                 .map(|f| {
                     if f.has_jacobian() {
-                        pair_blocks(f.particles(), vel, vel)
+                        force_blocks(f.particles(), vel, vel)
                     } else {
                         no_blocks
                     }
@@ -274,7 +284,7 @@ impl StabilizedLayout {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrators::trapezoidal::tests::every_kind;
+    use crate::integrators::fixtures::every_kind;
 
     /// Every slot is in the pattern (a missing entry panics in `Pattern::slot`), and the pattern
     /// has exactly the structural entries counted by hand for a pendulum (1 free particle, one

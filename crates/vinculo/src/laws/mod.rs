@@ -2,8 +2,10 @@
 //! core itself together with their first and second derivatives so that constraints can supply
 //! Phi_t and the acceleration terms exactly.
 
+mod piecewise;
 mod spline;
 
+pub use piecewise::{DrivenLaw, PiecewiseLinear};
 pub use spline::CubicSpline;
 
 use crate::error::{finite, non_negative, Error, Result};
@@ -38,6 +40,11 @@ pub enum Law {
     /// Natural cubic spline through tabulated samples (C2). Runs must stay within the sample range
     /// ([`Law::domain`]); evaluated outside it, the spline continues along its end tangents.
     Tabulated(CubicSpline),
+    /// Linear interpolation through tabulated knots (C0; left-continuous first derivative, see
+    /// [`PiecewiseLinear`]), constant outside them.
+    PiecewiseLinear(PiecewiseLinear),
+    /// A piecewise-linear law whose knots are set while the run is stepped ([`DrivenLaw`]).
+    Driven(DrivenLaw),
 }
 
 /// (value, first derivative, second derivative)
@@ -88,6 +95,11 @@ impl Law {
         Ok(Law::Tabulated(CubicSpline::new(times, values)?))
     }
 
+    /// Linear interpolation through knots, validated (see [`PiecewiseLinear`]).
+    pub fn piecewise_linear(times: Vec<f64>, values: Vec<f64>) -> Result<Law> {
+        Ok(Law::PiecewiseLinear(PiecewiseLinear::new(times, values)?))
+    }
+
     /// Value at `t`.
     #[inline]
     pub fn value(&self, t: f64) -> f64 {
@@ -128,6 +140,8 @@ impl Law {
                 )
             }
             Law::Tabulated(spline) => spline.eval(t),
+            Law::PiecewiseLinear(table) => table.eval(t),
+            Law::Driven(driven) => driven.eval(t),
         }
     }
 

@@ -4,7 +4,7 @@ use super::particle::{ConstraintId, ForceId, Particle, ParticleId};
 use crate::constraints::{Constraint, Distance, FixedCoordinate, Plane, PointDistance};
 use crate::error::{finite_vector, non_negative, positive, Error, Result};
 use crate::forces::{
-    AppliedForce, Force, LinearDrag, Morison, MorisonSpec, QuadraticDrag, SpringDamper,
+    AppliedForce, Bending, Force, LinearDrag, Morison, MorisonSpec, QuadraticDrag, SpringDamper,
 };
 use crate::laws::{Law, VectorLaw};
 use crate::math::{dot, norm, sub, Vec3};
@@ -197,6 +197,40 @@ impl System {
             axis,
             value,
         }))
+    }
+
+    /// Adds bending stiffness at the middle particle `b` of three consecutive particles
+    /// (a, b, c) of a line: the energy EI/(2 l^3) |q_a - 2 q_b + q_c|^2 of a beam of bending
+    /// stiffness `ei` (N m^2) with node spacing `spacing` (m; `None`: the mean of the current
+    /// distances a-b and b-c). See [`crate::forces::Bending`].
+    pub fn add_bending(
+        &mut self,
+        a: ParticleId,
+        b: ParticleId,
+        c: ParticleId,
+        ei: f64,
+        spacing: Option<f64>,
+    ) -> Result<ForceId> {
+        let (i, j, k) = (self.check(a)?, self.check(b)?, self.check(c)?);
+        let index = self.forces.len();
+        if let Some(p) = [(i, j), (j, k), (i, k)].iter().find(|(x, y)| x == y) {
+            return Err(Error::SameParticle {
+                what: format!("bending #{index} (give three different particles)"),
+                particle: p.0,
+            });
+        }
+        let ei = non_negative(format!("bending stiffness EI of bending #{index}"), ei)?;
+        let at = |x: usize| self.particles[x].position;
+        let current = 0.5 * (norm(sub(at(i), at(j))) + norm(sub(at(j), at(k))));
+        let spacing = positive(
+            format!("node spacing of bending #{index}"),
+            spacing.unwrap_or(current),
+        )?;
+        self.forces.push(Force::Bending(Bending {
+            particles: [i, j, k],
+            stiffness: ei / spacing.powi(3),
+        }));
+        Ok(ForceId(index))
     }
 
     /// Spring (stiffness k, rest length L0; None: the current distance) with a parallel dashpot c.

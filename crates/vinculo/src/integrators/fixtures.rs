@@ -1,0 +1,220 @@
+//! Models, iterates and checks shared by the tests of the step problems (index-3 and GGL) and
+//! of the time rules.
+
+use super::newton::NewtonProblem;
+use super::StepWorkspace;
+use crate::assembly::Layout;
+use crate::laws::{Law, VectorLaw};
+use crate::math::Vec3;
+use crate::model::System;
+
+/// A system with every constraint and force kind (a bending force among them, over three
+/// particles), fixed particles, added mass and time-dependent laws.
+pub(crate) fn every_kind() -> System {
+    let mut s = System::new([0.1, -0.2, -9.81]);
+    let a = s
+        .add_particle(1.0, [0.0, 0.0, 0.0], [0.0; 3], true)
+        .unwrap();
+    let b = s
+        .add_particle(0.7, [0.5, 0.1, -0.2], [0.3, 0.1, 0.0], false)
+        .unwrap();
+    let c = s
+        .add_particle(1.3, [0.9, -0.1, -0.4], [-0.2, 0.4, 0.1], false)
+        .unwrap();
+    let d = s
+        .add_particle(0.4, [0.2, 0.6, 0.1], [0.0, -0.3, 0.5], false)
+        .unwrap();
+    s.add_distance(a, b, None).unwrap();
+    s.add_distance(b, c, None).unwrap();
+    let point = VectorLaw([
+        Law::sine(0.1, 0.7, 0.0, 0.0, 0.0, 0.0).unwrap(),
+        Law::Constant(0.6),
+        Law::Constant(0.5),
+    ]);
+    s.add_distance_to_point(d, point, None).unwrap();
+    s.add_plane(
+        c,
+        VectorLaw::constant([0.0, 0.3, 1.0]),
+        VectorLaw::constant([0.9, -0.1, -0.4]),
+    )
+    .unwrap();
+    s.add_fixed_coordinate(d, 0, None).unwrap();
+    s.add_spring_damper(c, d, 40.0, 1.5, Some(0.5)).unwrap();
+    // A three-particle element, over a fixed and two free particles.
+    s.add_bending(a, b, c, 0.3, None).unwrap();
+    s.add_quadratic_drag(b, 0.8).unwrap();
+    s.add_linear_drag(c, 0.3).unwrap();
+    // Fluid forces with added mass (which enters the mass matrix) on a constrained particle.
+    s.add_morison(
+        b,
+        crate::forces::MorisonSpec {
+            density: 1000.0,
+            volume: 2e-4,
+            area: 0.01,
+            drag_coefficient: 0.4,
+            added_mass_coefficient: 0.5,
+            fluid: VectorLaw([
+                Law::sine(0.05, 0.9, 0.0, 0.0, 0.5, 0.0).unwrap(),
+                Law::Constant(0.0),
+                Law::Constant(0.0),
+            ]),
+        },
+    )
+    .unwrap();
+    s.add_force(
+        d,
+        VectorLaw([
+            Law::Constant(1.0),
+            Law::sine(2.0, 1.0, 0.0, 0.0, 0.0, 0.0).unwrap(),
+            Law::Constant(0.0),
+        ]),
+    )
+    .unwrap();
+
+    s
+}
+
+/// Asserts that the problem's assembled Jacobian equals central finite differences of its
+/// residual, column by column, at the current iterate (which it leaves unchanged).
+pub(crate) fn assert_jacobian_matches(problem: &mut impl NewtonProblem, layout: &Layout) {
+    assert_pattern_jacobian_matches(problem, &layout.pattern);
+}
+
+/// [`assert_jacobian_matches`] for any problem whose matrix has the given pattern.
+pub(crate) fn assert_pattern_jacobian_matches(
+    problem: &mut impl NewtonProblem,
+    pattern: &crate::assembly::Pattern,
+) {
+    let n = pattern.n;
+    let mut r = vec![0.0; n];
+    problem.residual(&mut r); // refreshes the evaluation point
+    let mut values = vec![0.0; pattern.nnz()];
+    problem.jacobian(&mut values);
+    let mut dense = vec![vec![0.0; n]; n];
+    for col in 0..n {
+        for k in pattern.col_ptr[col]..pattern.col_ptr[col + 1] {
+            dense[pattern.row_idx[k]][col] += values[k];
+        }
+    }
+    let eps = 1e-7;
+    for col in 0..n {
+        let mut dx = vec![0.0; n];
+        dx[col] = -eps; // update() subtracts
+        let mut rp = vec![0.0; n];
+        let mut rm = vec![0.0; n];
+        problem.update(&dx);
+        problem.residual(&mut rp);
+        dx[col] = 2.0 * eps;
+        problem.update(&dx);
+        problem.residual(&mut rm);
+        dx[col] = -eps;
+        problem.update(&dx);
+        for row in 0..n {
+            let fd = (rp[row] - rm[row]) / (2.0 * eps);
+            assert!(
+                (fd - dense[row][col]).abs() < 1e-6 * (1.0 + fd.abs()),
+                "J[{row}][{col}] = {} but finite differences give {fd}",
+                dense[row][col]
+            );
+        }
+    }
+}
+
+/// A perturbed iterate off the constraints, and non-zero multipliers.
+pub(crate) fn perturbed_iterate(ws: &mut StepWorkspace, q_n: &[Vec3]) {
+    ws.state.q = q_n
+        .iter()
+        .enumerate()
+        .map(|(i, x)| {
+            if i == 0 {
+                *x
+            } else {
+                [x[0] + 0.01, x[1] - 0.02 * i as f64, x[2] + 0.005]
+            }
+        })
+        .collect();
+    ws.state.lambda = vec![0.8, -1.2, 0.5, 2.0, -0.7];
+}
+
+/// A horizontal chain of `n` point masses (0.1 m links, 0.1 kg) from a fixed anchor.
+pub(crate) fn chain(n: usize) -> System {
+    let mut s = System::new([0.0, 0.0, -9.81]);
+    let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
+    for i in 1..=n {
+        let p = s
+            .add_particle(0.1, [0.1 * i as f64, 0.0, 0.0], [0.0; 3], false)
+            .unwrap();
+        s.add_distance(prev, p, None).unwrap();
+        prev = p;
+    }
+    s
+}
+
+/// An `n` x `n` cloth: a square grid of point masses hung from its two top corners, linked
+/// to their row and column neighbours by distance constraints (a constraint graph full of
+/// loops) and along the diagonals by spring-dampers (two-particle forces), with drag on
+/// every particle (one-particle forces).
+pub(crate) fn cloth(n: usize) -> System {
+    let mut s = System::new([0.0, 0.0, -9.81]);
+    let mut id = Vec::with_capacity(n * n);
+    for j in 0..n {
+        for i in 0..n {
+            let fixed = j == 0 && (i == 0 || i == n - 1);
+            let x = [0.1 * i as f64, 0.01 * (i * j % 7) as f64, -0.1 * j as f64];
+            id.push(s.add_particle(0.05, x, [0.0, 0.2, 0.0], fixed).unwrap());
+        }
+    }
+    for j in 0..n {
+        for i in 0..n {
+            let p = id[j * n + i];
+            if i + 1 < n {
+                s.add_distance(p, id[j * n + i + 1], None).unwrap();
+            }
+            if j + 1 < n {
+                s.add_distance(p, id[(j + 1) * n + i], None).unwrap();
+            }
+            if i + 1 < n && j + 1 < n {
+                s.add_spring_damper(p, id[(j + 1) * n + i + 1], 30.0, 0.2, None)
+                    .unwrap();
+            }
+            s.add_quadratic_drag(p, 0.01).unwrap();
+        }
+    }
+    s
+}
+
+/// An iterate off the constraints with non-zero multipliers, for any system.
+pub(crate) fn wiggled_iterate(ws: &mut StepWorkspace, q_n: &[Vec3]) {
+    for (i, (q, x)) in ws.state.q.iter_mut().zip(q_n).enumerate() {
+        let u = i as f64;
+        *q = [
+            x[0] + 0.01 * (0.7 * u).sin(),
+            x[1] - 0.02 * (1.3 * u).cos(),
+            x[2] + 0.005 * (0.3 * u).sin(),
+        ];
+    }
+    for (k, l) in ws.state.lambda.iter_mut().enumerate() {
+        *l = 1.5 * (0.9 * k as f64).sin() - 0.2;
+    }
+}
+
+/// Asserts that the parallel residuals are the serial ones bit for bit, and the Jacobians
+/// equal to 1e-14 (relative to the entry, or to 1 for small entries: the scaled matrix's
+/// entries are O(1)).
+pub(crate) fn assert_same_assembly(serial: &(Vec<f64>, Vec<f64>), parallel: &(Vec<f64>, Vec<f64>)) {
+    assert_eq!(serial.0.len(), parallel.0.len());
+    for (i, (s, p)) in serial.0.iter().zip(&parallel.0).enumerate() {
+        assert_eq!(
+            s.to_bits(),
+            p.to_bits(),
+            "residual {i}: serial {s}, parallel {p}"
+        );
+    }
+    assert_eq!(serial.1.len(), parallel.1.len());
+    for (k, (s, p)) in serial.1.iter().zip(&parallel.1).enumerate() {
+        assert!(
+            (s - p).abs() <= 1e-14 * s.abs().max(1.0),
+            "Jacobian slot {k}: serial {s}, parallel {p}"
+        );
+    }
+}

@@ -1,0 +1,180 @@
+//! The scheme contract: what a time rule is to the rest of the integrator.
+//!
+//! # Design
+//!
+//! A time rule (the generalised trapezoidal rule, with backward Euler as its alpha = 1 case; the
+//! generalised-alpha scheme) is data: its coefficients, and how it turns the unknown end-of-step
+//! positions into velocities and accelerations. It owns no matrix, no buffer and no loop. Each
+//! rule is one file implementing [`TimeRule`], registered once as a variant of
+//! [`super::Scheme`] (whose `with_rule!` dispatch is the only `match` on the scheme):
+//!
+//! - [`TimeRule::index3`] folds what is known before a step (q_n, v_n, the rule's own state)
+//!   into a per-step object implementing [`Index3Rule`]; the one index-3 step problem
+//!   ([`super::StepProblem`], see `step_problem.rs`) is generic over it and monomorphised per
+//!   rule, so the per-particle kinematics inline into the assembly loops;
+//! - [`TimeRule::ggl`] gives the coefficients of the common linear form of the stabilised step
+//!   (`stabilized.rs`), the one GGL step problem;
+//! - [`TimeRule::advance`] and [`TimeRule::advance_ggl`] update the rule's state after a
+//!   converged step, and [`TimeRule::end_acceleration`] gives the acceleration that the run
+//!   loop's predictor and error estimate use;
+//! - order, the key of the iteration matrix (for modified Newton) and the error-estimate
+//!   constants complete the contract.
+//!
+//! The equations each rule discretises are derived in `docs/theory/time-rules.md` (the index-3
+//! form in `docs/theory/formulation.md`, the stabilised form in `docs/theory/ggl.md`); the
+//! module documentation of each rule's file repeats the formulas it implements.
+
+use super::error_estimate::ErrorConstants;
+use crate::math::Vec3;
+
+/// The state a rule carries from step to step besides (q, v): generalised-alpha's true and
+/// algorithmic accelerations (the trapezoidal rules carry none and leave it untouched), and the
+/// per-step predictors it folds into its step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RuleState {
+    /// True accelerations qdd_n.
+    pub acceleration: Vec<Vec3>,
+    /// Algorithmic accelerations a_n.
+    pub algorithmic: Vec<Vec3>,
+    /// Per step: the parts of q_{n+1} and v_{n+1} known before the step (generalised-alpha).
+    pub(crate) predicted_q: Vec<Vec3>,
+    pub(crate) predicted_v: Vec<Vec3>,
+}
+
+impl RuleState {
+    /// The state at the start of a run: a_0 = qdd_0 = the consistent accelerations.
+    pub fn new(accelerations: &[Vec3]) -> RuleState {
+        RuleState {
+            acceleration: accelerations.to_vec(),
+            algorithmic: accelerations.to_vec(),
+            predicted_q: vec![[0.0; 3]; accelerations.len()],
+            predicted_v: vec![[0.0; 3]; accelerations.len()],
+        }
+    }
+
+    /// Copies the carried accelerations of `other` (not the per-step predictors), without
+    /// allocating: how a run loop restores the state of a rejected step.
+    pub fn copy_from(&mut self, other: &RuleState) {
+        self.acceleration.copy_from_slice(&other.acceleration);
+        self.algorithmic.copy_from_slice(&other.algorithmic);
+    }
+}
+
+/// One step of a rule as the index-3 step problem sees it: the kinematics of the unknown q =
+/// q_{n+1} and the weights of the scaled residual and Jacobian (`docs/theory/time-rules.md`,
+/// scaling in `docs/theory/formulation.md`).
+///
+/// The residual of the step is, per free particle and coordinate,
+/// `inertia_row(..) - sigma f(q_e, v_e, t_e) - sigma Phi_q(q_e, t_e)^T lambda`, and
+/// `s_k Phi_k(q, t_end)` per constraint; its Jacobian is `mass_diagonal` on the diagonal of the
+/// mass block plus `force_dq df/dq + force_dv df/dv + hessian sum_k lambda_k Phi_k,qq` at the
+/// evaluation point, `-s G(q_e)^T` and `s G(q, t_end)`.
+pub trait Index3Rule: Sync {
+    /// True when forces and constraint gradients are evaluated at the step's end (q_e = q,
+    /// v_e = v_{n+1}, t_e = t_{n+1}); false: at a point of their own (stored by the step problem
+    /// in its evaluation buffers).
+    const AT_END: bool;
+    /// The step's evaluation and end times and the scale of its dynamics rows.
+    fn point(&self) -> StepPoint;
+    /// (v_{n+1}, q_e, v_e) of particle `i` at the iterate `q` (q_e and v_e unused when
+    /// [`Index3Rule::AT_END`]).
+    fn kinematics(&self, i: usize, q: &Vec3) -> (Vec3, Vec3, Vec3);
+    /// The scaled inertia and gravity terms sigma (M qdd_{n+1} - m g) of particle `i`, from its
+    /// iterate `q` and new velocity `v`.
+    fn inertia_row(&self, i: usize, q: &Vec3, v: &Vec3, inertia: f64, mass: f64, g: &Vec3) -> Vec3;
+    /// The scaled mass term sigma (d qdd / dq) M of a particle of inertia `inertia`.
+    fn mass_diagonal(&self, inertia: f64) -> f64;
+    /// The weights (of df/dq, of df/dv, of lambda_k Phi_k,qq) in the scaled Jacobian.
+    fn weights(&self) -> (f64, f64, f64);
+}
+
+/// Where an index-3 step is evaluated and how its dynamics rows are scaled.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepPoint {
+    /// Time of the evaluation point t_e.
+    pub t_eval: f64,
+    /// t_{n+1}.
+    pub t_end: f64,
+    /// Scale of the dynamics rows.
+    pub sigma: f64,
+}
+
+/// The coefficients of a stabilised (GGL) step in its common linear form
+/// (`docs/theory/ggl.md`): q = b + kappa v + G^T mu, qdd = c + c_v v, evaluation point
+/// (1 - w) x_n + w x_{n+1}.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GglCoefficients {
+    /// dq/dv in the kinematics.
+    pub kappa: f64,
+    /// d(qdd)/dv in the dynamics.
+    pub c_v: f64,
+    /// Weight of the new state in the evaluation point.
+    pub w: f64,
+}
+
+/// A time rule: its coefficients and its state update (module documentation).
+pub trait TimeRule: Copy + Send + Sync {
+    /// One index-3 step of this rule, with what is known before the step folded in.
+    type Step<'a>: Index3Rule;
+
+    /// Order of accuracy of the positions.
+    fn order(&self) -> usize;
+
+    /// What identifies the iteration matrix of a step of size `h` (for its reuse).
+    fn matrix_key(&self, h: f64) -> [f64; 2];
+
+    /// The constants of the local-error estimate (`integrators/error_estimate.rs`).
+    fn error_constants(&self) -> ErrorConstants;
+
+    /// Where, after t_n, a step of size `h` leaves its acceleration sample.
+    fn sample_offset(&self, h: f64) -> f64;
+
+    /// The state at the start of a run with the consistent accelerations `acc`
+    /// ([`RuleState::new`]; rules that carry no accelerations may leave it empty).
+    fn initial_state(&self, acc: &[Vec3]) -> RuleState {
+        RuleState::new(acc)
+    }
+
+    /// The index-3 step of size `h` from (t_n, q_n, v_n, `state`), computing its predictors into
+    /// `state` first; `mass_ref` sets the scaling.
+    fn index3<'a>(
+        &self,
+        state: &'a mut RuleState,
+        t_n: f64,
+        q_n: &'a [Vec3],
+        v_n: &'a [Vec3],
+        h: f64,
+        mass_ref: f64,
+    ) -> Self::Step<'a>;
+
+    /// After a converged index-3 step of size `h` to q_{n+1} = `q` (from the predictors that
+    /// [`TimeRule::index3`] left in `state`): the rule's new state.
+    fn advance(&self, state: &mut RuleState, h: f64, q: &[Vec3]);
+
+    /// The GGL step of size `h` from (q_n, v_n, `state`): its coefficients, with b and c
+    /// written into `base_q` and `base_a`.
+    fn ggl(
+        &self,
+        state: &RuleState,
+        h: f64,
+        q_n: &[Vec3],
+        v_n: &[Vec3],
+        base_q: &mut [Vec3],
+        base_a: &mut [Vec3],
+    ) -> GglCoefficients;
+
+    /// After a converged GGL step of size `h` from v_n to v_{n+1} = `v`: the rule's new state.
+    fn advance_ggl(&self, state: &mut RuleState, h: f64, v_n: &[Vec3], v: &[Vec3]);
+
+    /// The acceleration of a converged step of size `h` from v_n to v_{n+1} = `v` (with the
+    /// state already advanced), into `out`: what the run loop's predictor extrapolates with and
+    /// its error estimate samples.
+    fn end_acceleration(
+        &self,
+        state: &RuleState,
+        h: f64,
+        v_n: &[Vec3],
+        v: &[Vec3],
+        out: &mut [Vec3],
+    );
+}

@@ -1,0 +1,348 @@
+//! The one index-3 step problem: the nonlinear system of one step of any time rule on the
+//! index-3 DAE, in Newton's scaled unknowns (q_{n+1}, lambda_{n+1} sigma / s).
+//!
+//! # Design
+//!
+//! The residual, the Jacobian, their parallel variants and the update are written once here and
+//! parametrised by the rule's per-step object ([`Index3Rule`], see `rule.rs`): the rule says how
+//! the iterate q becomes v_{n+1} and the evaluation point (q_e, v_e, t_e), what the inertia row
+//! and the mass block are, and with which weights df/dq, df/dv and the constraint Hessians enter.
+//! [`StepProblem`] is generic over it, so each rule gets its own monomorphised loops (no
+//! dynamic dispatch per particle). Placing the elements' local values and derivatives is the
+//! assembler's job (`assembly/`): the serial loops ([`Layout::residual`], [`Layout::jacobian`])
+//! and the parallel ones ([`ParallelAssembly`]) read the same [`ResidualTerms`] and
+//! [`JacobianTerms`] built here.
+//!
+//! The equations, their scaling and the Jacobian with its Hessian term are derived in
+//! `docs/theory/formulation.md` and `docs/theory/newton.md`; each rule's module documentation
+//! (`trapezoidal.rs`, `generalized_alpha.rs`, `docs/theory/time-rules.md`) gives its kinematics.
+
+use rayon::prelude::*;
+
+use super::newton::{self, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport};
+use super::rule::{Index3Rule, RuleState, TimeRule};
+use super::workspace::{StepBuffers, StepWorkspace};
+use crate::assembly::{
+    InertiaRows, JacobianTerms, Layout, ParallelAssembly, ResidualTerms, MIN_TASK,
+};
+use crate::math::Vec3;
+use crate::model::Particle;
+use crate::model::System;
+
+/// One index-3 step's nonlinear problem, for the rule step `R`.
+pub struct StepProblem<'a, R: Index3Rule> {
+    system: &'a System,
+    layout: &'a Layout,
+    buffers: &'a mut StepBuffers,
+    scales: &'a [f64],
+    inertia: &'a [f64],
+    parallel: Option<&'a mut ParallelAssembly>,
+    rule: R,
+}
+
+impl<'a, R: Index3Rule> StepProblem<'a, R> {
+    /// The problem of the rule step `rule` on the workspace's buffers (the iterate and
+    /// multipliers in `ws.state`), and the linear solver's share of the workspace.
+    pub fn new(system: &'a System, ws: &'a mut StepWorkspace, rule: R) -> (Self, LinearWork<'a>) {
+        let problem = StepProblem {
+            system,
+            layout: &ws.layout,
+            buffers: &mut ws.state,
+            scales: &ws.scales,
+            inertia: &ws.inertia,
+            parallel: ws.parallel.as_mut(),
+            rule,
+        };
+        let work = LinearWork {
+            solver: ws.solver.as_mut(),
+            values: &mut ws.values,
+            r: &mut ws.r,
+            matrix: &mut ws.matrix,
+        };
+        (problem, work)
+    }
+
+    /// Updates v_{n+1} (and the evaluation point, where the rule has one of its own) from the
+    /// iterate q.
+    pub fn kinematics(&mut self) {
+        let rule = &self.rule;
+        let b = &mut *self.buffers;
+        for i in 0..b.q.len() {
+            let (v, qe, ve) = rule.kinematics(i, &b.q[i]);
+            b.v[i] = v;
+            if !R::AT_END {
+                (b.q_eval[i], b.v_eval[i]) = (qe, ve);
+            }
+        }
+    }
+
+    /// [`StepProblem::kinematics`] on rayon's thread pool (the same numbers).
+    fn kinematics_parallel(&mut self) {
+        let rule = &self.rule;
+        let b = &mut *self.buffers;
+        if R::AT_END {
+            b.q.par_iter()
+                .zip(b.v.par_iter_mut())
+                .enumerate()
+                .with_min_len(MIN_TASK)
+                .for_each(|(i, (q, v))| *v = rule.kinematics(i, q).0);
+        } else {
+            b.q.par_iter()
+                .zip(b.v.par_iter_mut())
+                .zip(b.q_eval.par_iter_mut().zip(b.v_eval.par_iter_mut()))
+                .enumerate()
+                .with_min_len(MIN_TASK)
+                .for_each(|(i, ((q, v), (qe, ve)))| (*v, *qe, *ve) = rule.kinematics(i, q));
+        }
+    }
+
+    /// Positions and velocities of the evaluation point in the buffers `b`.
+    fn eval_point(b: &StepBuffers) -> (&[Vec3], &[Vec3]) {
+        if R::AT_END {
+            (&b.q, &b.v)
+        } else {
+            (&b.q_eval, &b.v_eval)
+        }
+    }
+}
+
+impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
+    fn residual(&mut self, r: &mut [f64]) {
+        if self.parallel.is_some() {
+            self.kinematics_parallel();
+        } else {
+            self.kinematics();
+        }
+        let b = &*self.buffers;
+        let (q_eval, v_eval) = Self::eval_point(b);
+        let rule = &self.rule;
+        let point = rule.point();
+        let terms = ResidualTerms {
+            q_eval,
+            v_eval,
+            t_eval: point.t_eval,
+            q_end: &b.q,
+            t_end: point.t_end,
+            sigma: point.sigma,
+            lambda: &b.lambda,
+            scales: self.scales,
+        };
+        let (system, layout, inertia) = (self.system, self.layout, self.inertia);
+        let (particles, g) = (system.particles(), system.gravity());
+        let row = Rows {
+            rule,
+            q: &b.q,
+            v: &b.v,
+            inertia,
+            particles,
+            g,
+        };
+        match self.parallel.as_deref_mut() {
+            Some(parallel) => parallel.residual(system, layout, &terms, r, &row),
+            None => layout.residual(system, &terms, r, &row),
+        }
+    }
+
+    fn jacobian(&mut self, values: &mut [f64]) {
+        let b = &*self.buffers;
+        let (q_eval, v_eval) = Self::eval_point(b);
+        let rule = &self.rule;
+        let (force_dq, force_dv, hessian) = rule.weights();
+        let point = rule.point();
+        let terms = JacobianTerms {
+            q_eval,
+            v_eval,
+            t_eval: point.t_eval,
+            q_end: &b.q,
+            t_end: point.t_end,
+            force_dq,
+            force_dv,
+            hessian,
+            lambda: &b.lambda,
+            scales: self.scales,
+        };
+        let inertia = self.inertia;
+        let mass = |i: usize| rule.mass_diagonal(inertia[i]);
+        match self.parallel.as_deref() {
+            Some(parallel) => parallel.jacobian(self.system, self.layout, &terms, values, mass),
+            None => self.layout.jacobian(self.system, &terms, values, mass),
+        }
+    }
+
+    fn update(&mut self, dx: &[f64]) {
+        let b = &mut *self.buffers;
+        self.layout.apply_increment(
+            &mut b.q,
+            &mut b.lambda,
+            dx,
+            self.scales,
+            self.rule.point().sigma,
+        );
+    }
+}
+
+/// The inertia and gravity rows of a step of the rule step `R` at the current iterate.
+struct Rows<'b, R> {
+    rule: &'b R,
+    q: &'b [Vec3],
+    v: &'b [Vec3],
+    inertia: &'b [f64],
+    particles: &'b [Particle],
+    g: Vec3,
+}
+
+impl<R: Index3Rule> InertiaRows for Rows<'_, R> {
+    #[inline(always)]
+    fn rows(&self, i: usize) -> Vec3 {
+        let mass = self.particles[i].mass;
+        let (q, v) = (&self.q[i], &self.v[i]);
+        self.rule
+            .inertia_row(i, q, v, self.inertia[i], mass, &self.g)
+    }
+}
+
+/// Takes one index-3 step of `rule` of size `h` from (t_n, q_n, v_n, `state`). The caller sets
+/// the predictor in `ws.state.q` and `ws.state.lambda`; on success they hold q_{n+1} and
+/// lambda_{n+1}, `ws.state.v` holds v_{n+1} and `state` the rule's new state. On failure the
+/// rule's carried state (its accelerations) is unchanged.
+#[allow(clippy::too_many_arguments)]
+pub fn index3_step<T: TimeRule>(
+    rule: T,
+    system: &System,
+    ws: &mut StepWorkspace,
+    t_n: f64,
+    q_n: &[Vec3],
+    v_n: &[Vec3],
+    state: &mut RuleState,
+    h: f64,
+    options: &NewtonOptions,
+) -> Result<NewtonReport, NewtonFailure> {
+    let report = {
+        let step = rule.index3(state, t_n, q_n, v_n, h, ws.mass_ref);
+        let (mut problem, work) = StepProblem::new(system, ws, step);
+        let report = newton::solve(&mut problem, work, rule.matrix_key(h), options)?;
+        problem.kinematics();
+        report
+    };
+    rule.advance(state, h, &ws.state.q);
+    Ok(report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrators::fixtures::{
+        assert_jacobian_matches, assert_same_assembly, chain, cloth, every_kind, perturbed_iterate,
+        wiggled_iterate,
+    };
+    use crate::integrators::{GeneralizedAlpha, GeneralizedTrapezoidal};
+    use crate::linear::SparseSolver;
+
+    /// The residual and Jacobian of a step of `rule` (h = 0.01 from t_n = 0.3) at the
+    /// workspace's iterate.
+    fn assemble<T: TimeRule>(
+        rule: T,
+        s: &System,
+        ws: &mut StepWorkspace,
+        state: &mut RuleState,
+    ) -> (Vec<f64>, Vec<f64>) {
+        let (q_n, v_n) = (s.initial_positions(), s.initial_velocities());
+        let (unknowns, nnz) = (ws.layout.unknowns(), ws.layout.pattern.nnz());
+        let step = rule.index3(state, 0.3, &q_n, &v_n, 0.01, ws.mass_ref);
+        let (mut problem, _) = StepProblem::new(s, ws, step);
+        let mut r = vec![0.0; unknowns];
+        let mut values = vec![0.0; nnz];
+        problem.residual(&mut r);
+        problem.jacobian(&mut values);
+        (r, values)
+    }
+
+    /// Generalised-alpha's state with non-zero old accelerations.
+    fn alpha_state(n: usize) -> RuleState {
+        let a_n: Vec<Vec3> = (0..n).map(|i| [0.3, -1.0, 0.01 * i as f64]).collect();
+        let mut state = RuleState::new(&a_n);
+        state.acceleration = (0..n)
+            .map(|i| [-0.1, 0.4, 0.7 / (1.0 + i as f64)])
+            .collect();
+        state
+    }
+
+    /// Parallel assembly (forced by a zero threshold) gives the serial residual and Jacobian,
+    /// on a chain and a cloth large enough to be split among threads and on the system with
+    /// every constraint and force kind, for the trapezoidal rule (alpha = 0.6) and
+    /// generalised-alpha (rho_inf = 0.6).
+    #[test]
+    fn parallel_assembly_matches_serial() {
+        for (name, s) in [
+            ("every kind", every_kind()),
+            ("chain", chain(5_000)),
+            ("cloth", cloth(50)),
+        ] {
+            let q_n = s.initial_positions();
+            let run = |parallel: bool, trapezoidal: bool| {
+                let mut ws = StepWorkspace::new(&s, 48);
+                if parallel {
+                    ws.assemble_in_parallel_from(&s, 0);
+                    let colours = ws.parallel.as_ref().unwrap().constraint_colours();
+                    assert!(colours >= 1 && (name != "chain" || colours == 2), "{name}");
+                }
+                wiggled_iterate(&mut ws, &q_n);
+                let mut state = alpha_state(q_n.len());
+                if trapezoidal {
+                    assemble(
+                        GeneralizedTrapezoidal { alpha: 0.6 },
+                        &s,
+                        &mut ws,
+                        &mut state,
+                    )
+                } else {
+                    assemble(GeneralizedAlpha { rho_inf: 0.6 }, &s, &mut ws, &mut state)
+                }
+            };
+            for trapezoidal in [true, false] {
+                assert_same_assembly(&run(false, trapezoidal), &run(true, trapezoidal));
+            }
+        }
+    }
+
+    /// The assembled Jacobian equals finite differences of the assembled residual, for a system
+    /// with every constraint and force kind, fixed particles and non-zero multipliers (and, for
+    /// generalised-alpha, non-zero old accelerations), over the range of each rule's parameter,
+    /// with the general sparse LU's layout and dense storage.
+    #[test]
+    fn jacobian_matches_finite_differences_of_the_residual() {
+        let s = every_kind();
+        let (q_n, v_n) = (s.initial_positions(), s.initial_velocities());
+        for dense_limit in [0, 1000] {
+            let workspace = || {
+                let mut ws = StepWorkspace::with_solver(&s, dense_limit, SparseSolver::SparseLu);
+                perturbed_iterate(&mut ws, &q_n);
+                ws
+            };
+            for alpha in [0.6, 1.0] {
+                let mut ws = workspace();
+                let layout = ws.layout.clone();
+                let mut state = RuleState::new(&q_n);
+                let rule = GeneralizedTrapezoidal { alpha };
+                let step = rule.index3(&mut state, 0.3, &q_n, &v_n, 0.01, ws.mass_ref);
+                let (mut problem, _) = StepProblem::new(&s, &mut ws, step);
+                assert_jacobian_matches(&mut problem, &layout);
+            }
+            for rho_inf in [0.0, 0.6, 1.0] {
+                let mut ws = workspace();
+                let layout = ws.layout.clone();
+                let a_n: Vec<Vec3> = (0..q_n.len())
+                    .map(|i| [0.3 * i as f64, -1.0, 0.2])
+                    .collect();
+                let mut state = RuleState::new(&a_n);
+                state.acceleration = (0..q_n.len())
+                    .map(|i| [-0.1, 0.4 * i as f64, 0.7])
+                    .collect();
+                let rule = GeneralizedAlpha { rho_inf };
+                let step = rule.index3(&mut state, 0.3, &q_n, &v_n, 0.01, ws.mass_ref);
+                let (mut problem, _) = StepProblem::new(&s, &mut ws, step);
+                assert_jacobian_matches(&mut problem, &layout);
+            }
+        }
+    }
+}

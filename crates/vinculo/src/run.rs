@@ -1,0 +1,757 @@
+//! The one run loop: a running simulation that a caller advances, inspects, drives and
+//! snapshots; [`crate::simulate()`] is a thin loop over it.
+//!
+//! # Design
+//!
+//! [`Simulation`] holds everything a run carries from step to step (time, positions,
+//! velocities, accelerations, multipliers, the time rule's state, the step controller's state)
+//! and the workspaces it reuses. One loop ([`Simulation::step_to`]) owns what every run shares,
+//! whatever its steps: the predictor (constant-acceleration extrapolation, last multipliers), the
+//! step of the scheme on the chosen formulation ([`crate::integrators::Scheme::step`]), the
+//! retry of a modified-Newton step with a fresh matrix, the rejected-step bookkeeping, the
+//! stored output, the tension check and the observer. What differs between fixed and
+//! error-controlled runs is a step-controller object (`Controller`): it proposes the next step,
+//! judges a converged step (fixed steps accept every one; the error control of
+//! `adaptive.rs` estimates its local error, `docs/theory/adaptive.md`) and answers a failed Newton
+//! solve with a smaller step or gives up.
+//!
+//! A snapshot ([`Simulation::snapshot`]) is a copy of the carried state and of the number of
+//! stored rows; restoring it and stepping on repeats the steps bit for bit (the workspaces
+//! hold nothing a step reads before writing it, except the factorisation that modified Newton
+//! reuses, which a restore discards).
+//!
+//! Error-controlled steps are never bent to an intermediate stop: [`Simulation::step_to`] ends
+//! with the step that reaches or passes it (its state is the current state), so a run stepped to
+//! t1 and then to t2 is bit for bit the run straight to t2. Requested output times are
+//! interpolated inside the steps as in one call.
+//!
+//! Fixed steps keep time on an exact grid (every step is dt / 2^j, an integer number of the
+//! smallest allowed step, so t = t_grid + units * unit never accumulates round-off); a stop at
+//! an intermediate time on the grid does not change the steps, so a run stepped to t1 and then
+//! to t2 is bit for bit the run straight to t2. A stop between grid points shortens the step
+//! to land on it and starts the grid afresh there.
+
+use crate::adaptive::ErrorControl;
+use crate::assembly::Layout;
+use crate::constraints::find_redundant;
+use crate::dense_output::StepEnds;
+use crate::error::{Error, Result};
+use crate::initial::{
+    consistent_accelerations, scaled_velocity_violation, scaled_violation, singular_error,
+};
+use crate::integrators::{
+    Formulation, NewtonFailure, NewtonOptions, RuleState, StabilizedWorkspace, StepWorkspace,
+};
+use crate::math::Vec3;
+use crate::model::System;
+use crate::options::{check_options, Observer, SimulationOptions};
+use crate::solution::{Solution, StepStats};
+use crate::step_control::{ErrorWeights, StepControl};
+
+/// How the next step is chosen and a converged one judged (module documentation).
+#[derive(Debug, Clone)]
+pub(crate) enum Controller {
+    /// Fixed steps on an exact grid, halved on a Newton failure and grown back after success.
+    Fixed(FixedSteps),
+    /// Error-controlled steps (the PI controller and the local-error estimate).
+    Adaptive(Box<ErrorControl>),
+}
+
+/// Fixed steps dt / 2^(top - level) on the grid t_grid + units * unit.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct FixedSteps {
+    top: u32,
+    unit: f64,
+    units: u64,
+    level: u32,
+    t_grid: f64,
+}
+
+/// Where a proposed step ends.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum StepEnd {
+    /// Where the step's size takes it: on the fixed-step grid (t_grid + units * unit after the
+    /// step), or t + h for error-controlled steps.
+    Natural,
+    /// At this time exactly (the stop or the end of the run).
+    At(f64),
+}
+
+impl FixedSteps {
+    fn new(dt: f64, max_halvings: usize, t0: f64) -> FixedSteps {
+        let top = max_halvings as u32;
+        FixedSteps {
+            top,
+            unit: dt / f64::powi(2.0, top as i32),
+            units: 0,
+            level: top,
+            t_grid: t0,
+        }
+    }
+
+    /// The next step from `t` towards `stop` (`t_end`: the run's end, where the last step is
+    /// stretched or shortened, by at most a millionth of a step or to what remains, to land on
+    /// it).
+    fn propose(&self, t: f64, stop: f64, t_end: f64) -> (f64, StepEnd) {
+        let h_nominal = self.unit * (1u64 << self.level) as f64;
+        let remaining = stop - t;
+        if remaining > h_nominal * (1.0 + 1e-6) {
+            return (h_nominal, StepEnd::Natural);
+        }
+        if stop < t_end {
+            // An intermediate stop on the grid: the step the run would take anyway.
+            let grid = self.t_grid + (self.units + (1u64 << self.level)) as f64 * self.unit;
+            if (grid - stop).abs() <= 1e-6 * h_nominal {
+                return (h_nominal, StepEnd::Natural);
+            }
+        }
+        (remaining, StepEnd::At(stop))
+    }
+
+    /// The time after an accepted step that ends at `end`.
+    fn accepted(&mut self, end: StepEnd) -> f64 {
+        let t = match end {
+            StepEnd::Natural => {
+                self.units += 1u64 << self.level;
+                self.t_grid + self.units as f64 * self.unit
+            }
+            StepEnd::At(t) => {
+                // Off the grid: start it afresh here.
+                self.t_grid = t;
+                self.units = 0;
+                t
+            }
+        };
+        // Grow back towards the nominal step after a reduction.
+        self.level = (self.level + 1).min(self.top);
+        t
+    }
+
+    /// After a Newton failure: true (and a halved step) while halvings remain.
+    fn newton_failed(&mut self) -> bool {
+        if self.level > 0 {
+            self.level -= 1;
+            true
+        } else {
+            false
+        }
+    }
+}
+
+/// What a run carries from step to step: everything a snapshot copies.
+#[derive(Debug, Clone)]
+struct Carried {
+    t: f64,
+    q: Vec<Vec3>,
+    v: Vec<Vec3>,
+    acc: Vec<Vec3>,
+    lambda: Vec<f64>,
+    rule: RuleState,
+    controller: Controller,
+    /// Accepted steps so far.
+    step: usize,
+    /// Next requested output time (error-controlled runs with output times).
+    next_output: usize,
+}
+
+/// A copy of a running simulation's state ([`Simulation::snapshot`]).
+#[derive(Debug, Clone)]
+pub struct Snapshot {
+    carried: Carried,
+    rows: usize,
+    steps_taken: usize,
+    steps_rejected: usize,
+    accepted: usize,
+    factorisations: usize,
+    status: std::result::Result<(), Error>,
+}
+
+impl Snapshot {
+    /// Time of the snapshot.
+    pub fn time(&self) -> f64 {
+        self.carried.t
+    }
+}
+
+/// The scratch arrays of a step (written before they are read: not part of a snapshot).
+struct Scratch {
+    q_new: Vec<Vec3>,
+    v_new: Vec<Vec3>,
+    lambda_new: Vec<f64>,
+    acc_new: Vec<Vec3>,
+    q_out: Vec<Vec3>,
+    v_out: Vec<Vec3>,
+    lambda_out: Vec<f64>,
+    rule_saved: RuleState,
+}
+
+/// A running simulation (module documentation).
+pub struct Simulation<'a> {
+    system: &'a System,
+    options: SimulationOptions,
+    newton: NewtonOptions,
+    tension_floor: f64,
+    ws: StepWorkspace,
+    stabilized: Option<StabilizedWorkspace>,
+    carried: Carried,
+    scratch: Scratch,
+    sol: Solution,
+}
+
+impl<'a> Simulation<'a> {
+    /// Validates `options`, checks that the initial state satisfies the constraints, computes
+    /// the consistent accelerations and multipliers, and stores the initial state.
+    ///
+    /// Errors in the input are returned as `Err`. A start that fails (a singular matrix,
+    /// redundant constraints, a string that would have to push) returns a simulation whose
+    /// [`Simulation::status`] holds the cause and which takes no step.
+    pub fn new(system: &'a System, options: &SimulationOptions) -> Result<Simulation<'a>> {
+        check_options(system, options)?;
+        // User groups start the run with empty caches and counters.
+        system.reset_user_groups();
+        let length = system.length_scale();
+        let t0 = options.t_start;
+        let q = system.initial_positions();
+        let v = system.initial_velocities();
+        // Positions are compared with the model's length scale; velocities with a speed scale,
+        // the largest initial speed or the speed of a fall through the length scale, sqrt(|g| l).
+        let g = system.gravity();
+        let speed = v
+            .iter()
+            .map(|x| crate::math::norm(*x))
+            .fold((crate::math::norm(g) * length).sqrt(), f64::max);
+        let speed = if speed > 0.0 { speed } else { length };
+        let (worst, k) = scaled_violation(system, &q, t0);
+        let velocity_worst = scaled_velocity_violation(system, &q, &v, t0);
+        if let Some(e) = system.user_failure() {
+            return Err(e);
+        }
+        let checks = [
+            ("positions", "Phi", (worst, k), length),
+            ("velocities", "Phi_q v + Phi_t", velocity_worst, speed),
+        ];
+        for (level, quantity, (violation, k), scale) in checks {
+            let tolerance = options.initial_tolerance * scale;
+            if violation.is_nan() || violation > tolerance {
+                let c = &system.constraints()[k];
+                return Err(Error::InconsistentInitialState {
+                    level: level.into(),
+                    quantity: quantity.into(),
+                    constraint: c.name(k),
+                    violation: violation / c.scale(),
+                    scaled: violation,
+                    tolerance,
+                });
+            }
+        }
+
+        let mut ws = StepWorkspace::with_solver(system, options.dense_limit, options.sparse_solver);
+        ws.assemble_in_parallel_from(system, options.parallel_from);
+        let newton = NewtonOptions {
+            tolerance: options.newton.tolerance * length,
+            ..options.newton
+        };
+        // The GGL steps have their own unknowns and solver; the index-3 workspace still serves
+        // the consistent start and carries the step's state in and out.
+        let stabilized = (options.formulation == Formulation::Ggl)
+            .then(|| StabilizedWorkspace::new(system, options.dense_limit));
+        let solver_name = match &stabilized {
+            Some(g) => g.solver.name(),
+            None => ws.solver.name(),
+        };
+        let mut sol = Solution::new(q.len(), system.constraints().len(), solver_name);
+        sol.scheme = options.scheme;
+        sol.formulation = options.formulation;
+        let start = consistent_accelerations(system, &mut ws, &q, &v, t0).map_err(|e| match e {
+            // Name the culprits when the matrix is singular because constraints are redundant.
+            Error::SingularMatrix { .. } => find_redundant(system, &q, t0, None).unwrap_or(e),
+            e => e,
+        });
+        // A failed user function is the cause of whatever else went wrong at the start.
+        let start = match (start, system.user_failure()) {
+            (_, Some(e)) => Err(e),
+            (start, None) => start,
+        };
+        let (acc, lambda, status) = match start {
+            Ok((acc, lambda)) => (acc, lambda, Ok(())),
+            Err(e) => (
+                vec![[0.0; 3]; q.len()],
+                vec![f64::NAN; sol.constraints],
+                Err(e),
+            ),
+        };
+        sol.push(
+            t0,
+            &q,
+            &v,
+            &lambda,
+            worst,
+            velocity_worst.0,
+            StepStats::default(),
+        );
+        sol.status = status;
+        let weight = system
+            .particles()
+            .iter()
+            .map(|p| p.mass * crate::math::norm(g))
+            .sum::<f64>();
+        let tension_floor = -1e-9 * if weight > 0.0 { weight } else { 1.0 };
+        if sol.status.is_ok() {
+            if let Some(e) = negative_tension(system, &lambda, t0, tension_floor) {
+                sol.status = Err(e);
+            }
+        }
+        let controller = match options.step_control {
+            StepControl::Fixed => {
+                Controller::Fixed(FixedSteps::new(options.dt, options.max_halvings, t0))
+            }
+            StepControl::Adaptive(control) => {
+                let weights = ErrorWeights {
+                    time_scale: length / speed,
+                    atol_q: control.atol,
+                    atol_v: control.atol * speed / length,
+                    rtol: control.rtol,
+                };
+                Controller::Adaptive(Box::new(ErrorControl::new(
+                    system,
+                    options.scheme,
+                    control,
+                    weights,
+                    options.dt,
+                    t0,
+                    &acc,
+                    ws.layout.unknowns(),
+                )))
+            }
+        };
+        // Requested output times: the initial row stays only when t_start is one of them.
+        let mut next_output = 0;
+        if let Some(outputs) = &options.output_times {
+            if outputs.first() == Some(&t0) {
+                next_output = 1;
+            } else if sol.status.is_ok() {
+                sol.truncate(0);
+            }
+        }
+        let rule = options.scheme.initial_state(&acc);
+        // Buffers of what only some runs do (allocated empty otherwise: at 10^6 particles each
+        // array of 3-vectors is 24 MB).
+        let adaptive = matches!(controller, Controller::Adaptive(_));
+        let dense = options.output_times.is_some();
+        let if_dense = |x: &Vec<Vec3>| if dense { x.clone() } else { Vec::new() };
+        let scratch = Scratch {
+            q_new: q.clone(),
+            v_new: v.clone(),
+            lambda_new: lambda.clone(),
+            acc_new: acc.clone(),
+            q_out: if_dense(&q),
+            v_out: if_dense(&v),
+            lambda_out: if dense { lambda.clone() } else { Vec::new() },
+            rule_saved: if adaptive {
+                rule.clone()
+            } else {
+                RuleState::new(&[])
+            },
+        };
+        Ok(Simulation {
+            system,
+            options: options.clone(),
+            newton,
+            tension_floor,
+            ws,
+            stabilized,
+            carried: Carried {
+                t: t0,
+                q,
+                v,
+                acc,
+                lambda,
+                rule,
+                controller,
+                step: 0,
+                next_output,
+            },
+            scratch,
+            sol,
+        })
+    }
+
+    /// Current time.
+    pub fn time(&self) -> f64 {
+        self.carried.t
+    }
+
+    /// Current positions, one 3-vector per particle.
+    pub fn positions(&self) -> &[Vec3] {
+        &self.carried.q
+    }
+
+    /// Current velocities, one 3-vector per particle.
+    pub fn velocities(&self) -> &[Vec3] {
+        &self.carried.v
+    }
+
+    /// Current multipliers (constraint forces, one per constraint equation; sign convention in
+    /// `docs/theory/formulation.md`).
+    pub fn multipliers(&self) -> &[f64] {
+        &self.carried.lambda
+    }
+
+    /// The states stored so far and the run's statistics.
+    pub fn solution(&self) -> &Solution {
+        &self.sol
+    }
+
+    /// `Ok` while the run can go on; the cause once it stopped (the states computed before
+    /// stay in [`Simulation::solution`]).
+    pub fn status(&self) -> &std::result::Result<(), Error> {
+        &self.sol.status
+    }
+
+    /// The stored states and statistics, ending the simulation.
+    pub fn into_solution(self) -> Solution {
+        self.sol
+    }
+
+    /// A copy of the running state (module documentation).
+    pub fn snapshot(&self) -> Snapshot {
+        Snapshot {
+            carried: self.carried.clone(),
+            rows: self.sol.len(),
+            steps_taken: self.sol.steps_taken,
+            steps_rejected: self.sol.steps_rejected,
+            accepted: self.sol.accepted_step_sizes.len(),
+            factorisations: self.sol.factorisations,
+            status: self.sol.status.clone(),
+        }
+    }
+
+    /// Returns to the state of `snapshot` (taken from this simulation): later stored states
+    /// are dropped, and stepping on repeats the steps that followed the snapshot bit for bit
+    /// (with modified Newton, the first step after a restore factorises a fresh matrix).
+    ///
+    /// # Panics
+    /// If the snapshot's model size differs from this simulation's.
+    #[track_caller]
+    pub fn restore(&mut self, snapshot: &Snapshot) {
+        assert_eq!(
+            snapshot.carried.q.len(),
+            self.carried.q.len(),
+            "a snapshot of another model"
+        );
+        assert_eq!(snapshot.carried.lambda.len(), self.carried.lambda.len());
+        self.carried.clone_from(&snapshot.carried);
+        self.sol.truncate(snapshot.rows);
+        self.sol.accepted_step_sizes.truncate(snapshot.accepted);
+        self.sol.steps_taken = snapshot.steps_taken;
+        self.sol.steps_rejected = snapshot.steps_rejected;
+        self.sol.factorisations = snapshot.factorisations;
+        self.sol.status = snapshot.status.clone();
+        self.ws.matrix.invalidate();
+        self.system.reset_user_groups();
+    }
+}
+
+/// What the loop does after an attempt.
+enum Next {
+    /// Take another attempt (or stop if the target is reached).
+    Go,
+    /// The run stopped (its status says why).
+    Stop,
+}
+
+impl Simulation<'_> {
+    /// Advances to time `t` (at most the run's `t_end`), step by step; stops early when the run
+    /// fails (see [`Simulation::status`]). Fixed steps land on `t` (on the grid when `t` is a
+    /// grid time, otherwise with a shortened step); error-controlled steps stop at the end of
+    /// the step that reaches or passes `t` ([`Simulation::time`] says where). Stored output
+    /// follows the options (`save_every`, output times); an intermediate stop stores nothing of
+    /// its own, so the stored states are those of one call to [`crate::simulate()`].
+    pub fn step_to(&mut self, t: f64) -> &std::result::Result<(), Error> {
+        self.step_to_with_observer(t, &mut Silent)
+    }
+
+    /// [`Simulation::step_to`] with an observer that sees each accepted step and may stop the
+    /// run.
+    pub fn step_to_with_observer(
+        &mut self,
+        t: f64,
+        observer: &mut dyn Observer,
+    ) -> &std::result::Result<(), Error> {
+        let stop = t.min(self.options.t_end);
+        while self.sol.status.is_ok() && self.carried.t < stop {
+            if let Next::Stop = self.attempt(stop, observer) {
+                break;
+            }
+        }
+        if let (Ok(()), Some(e)) = (&self.sol.status, self.system.user_failure()) {
+            self.sol.status = Err(e);
+        }
+        &self.sol.status
+    }
+
+    /// One attempt at a step towards `stop`: the shared loop body.
+    fn attempt(&mut self, stop: f64, observer: &mut dyn Observer) -> Next {
+        let (system, scheme, t_end) = (self.system, self.options.scheme, self.options.t_end);
+        let c = &mut self.carried;
+        let (h_try, end) = match &c.controller {
+            Controller::Fixed(fixed) => fixed.propose(c.t, stop, t_end),
+            Controller::Adaptive(control) => {
+                // Error-controlled steps are not bent to an intermediate stop: the run stops at
+                // the end of the step that reaches or passes it.
+                let (h, at) = control.propose(c.t, t_end);
+                (h, at.map_or(StepEnd::Natural, StepEnd::At))
+            }
+        };
+        let ends_run = end == StepEnd::At(t_end);
+        let mut fresh_retry = false;
+        loop {
+            // Predictor: constant-acceleration extrapolation, last multipliers.
+            let ws = &mut self.ws;
+            for i in 0..c.q.len() {
+                for k in 0..3 {
+                    ws.state.q[i][k] =
+                        c.q[i][k] + h_try * c.v[i][k] + 0.5 * h_try * h_try * c.acc[i][k];
+                }
+            }
+            ws.state.lambda.copy_from_slice(&c.lambda);
+            if !fresh_retry {
+                self.sol.steps_taken += 1;
+            }
+            // Modified Newton starting from a matrix of an earlier step gets one more attempt
+            // with a fresh matrix before the step counts as failed.
+            let stale = self.newton.jacobian_reuse && ws.matrix.holds(scheme.matrix_key(h_try));
+            let may_reject = matches!(c.controller, Controller::Adaptive(_));
+            if may_reject {
+                self.scratch.rule_saved.copy_from(&c.rule);
+            }
+            let attempt = scheme.step(
+                system,
+                ws,
+                self.stabilized.as_mut(),
+                c.t,
+                &c.q,
+                &c.v,
+                &mut c.rule,
+                h_try,
+                &self.newton,
+            );
+            self.sol.factorisations = ws.matrix.factorisations;
+            // A failed user function stops the run at once (NaN terms would only fail again).
+            if let Some(e) = system.user_failure() {
+                self.sol.status = Err(e);
+                return Next::Stop;
+            }
+            match attempt {
+                Ok(report) => return self.converged(h_try, end, ends_run, report, observer),
+                Err(_) if stale => {
+                    ws.matrix.invalidate();
+                    fresh_retry = true;
+                }
+                Err(failure) => {
+                    self.sol.steps_rejected += 1;
+                    let retry = match &mut c.controller {
+                        Controller::Fixed(fixed) => fixed.newton_failed(),
+                        Controller::Adaptive(control) => control.newton_failed(h_try),
+                    };
+                    if may_reject {
+                        c.rule.copy_from(&self.scratch.rule_saved);
+                    }
+                    if retry {
+                        return Next::Go;
+                    }
+                    self.sol.status = Err(step_failure(system, &ws.layout, failure, c.t, h_try));
+                    return Next::Stop;
+                }
+            }
+        }
+    }
+
+    /// A converged step of size `h` that ends at `end`: judged by the controller, then accepted
+    /// (stored, checked, observed) or rejected.
+    fn converged(
+        &mut self,
+        h: f64,
+        end: StepEnd,
+        ends_run: bool,
+        report: crate::integrators::NewtonReport,
+        observer: &mut dyn Observer,
+    ) -> Next {
+        let (system, scheme) = (self.system, self.options.scheme);
+        let c = &mut self.carried;
+        let s = &mut self.scratch;
+        let ws = &mut self.ws;
+        scheme.end_acceleration(&c.rule, h, &c.v, &ws.state.v, &mut s.acc_new);
+        let t_new = match &mut c.controller {
+            Controller::Fixed(fixed) => fixed.accepted(end),
+            Controller::Adaptive(control) => {
+                let judged = control.judge(
+                    system,
+                    ws,
+                    self.stabilized.is_some(),
+                    c.step,
+                    (c.t, h),
+                    (&c.q, &c.v, &c.acc),
+                    &s.acc_new,
+                );
+                match judged {
+                    Ok(true) => match end {
+                        StepEnd::At(t) => t,
+                        StepEnd::Natural => c.t + h,
+                    },
+                    Ok(false) => {
+                        self.sol.steps_rejected += 1;
+                        c.rule.copy_from(&s.rule_saved);
+                        return match control.rejected(c.t, h) {
+                            Ok(()) => Next::Go,
+                            Err(e) => {
+                                self.sol.status = Err(e);
+                                Next::Stop
+                            }
+                        };
+                    }
+                    Err(e) => {
+                        self.sol.status = Err(e);
+                        return Next::Stop;
+                    }
+                }
+            }
+        };
+        std::mem::swap(&mut c.acc, &mut s.acc_new);
+        s.q_new.copy_from_slice(&ws.state.q);
+        s.v_new.copy_from_slice(&ws.state.v);
+        s.lambda_new.copy_from_slice(&ws.state.lambda);
+        c.step += 1;
+        self.sol.accepted_step_sizes.push(h);
+        let stats = StepStats {
+            newton_iterations: report.iterations,
+            step_size: h,
+            residual_norm: report.residual,
+            increment_norm: report.increment,
+        };
+        let slack = negative_tension(system, &s.lambda_new, t_new, self.tension_floor);
+        let sol = &mut self.sol;
+        if let Some(outputs) = self.options.output_times.as_deref() {
+            let ends = StepEnds {
+                t: c.t,
+                h: t_new - c.t,
+                q_0: &c.q,
+                v_0: &c.v,
+                lambda_0: &c.lambda,
+                q_1: &s.q_new,
+                v_1: &s.v_new,
+                lambda_1: &s.lambda_new,
+            };
+            while c.next_output < outputs.len() && outputs[c.next_output] <= t_new {
+                let t_out = outputs[c.next_output];
+                ends.interpolate(t_out, &mut s.q_out, &mut s.v_out, &mut s.lambda_out);
+                store(
+                    sol,
+                    system,
+                    t_out,
+                    (&s.q_out, &s.v_out, &s.lambda_out),
+                    stats,
+                );
+                c.next_output += 1;
+            }
+            // A run that stops here shows the state where it stopped.
+            if slack.is_some() && sol.times.last() != Some(&t_new) {
+                store(
+                    sol,
+                    system,
+                    t_new,
+                    (&s.q_new, &s.v_new, &s.lambda_new),
+                    stats,
+                );
+            }
+        } else if c.step % self.options.save_every == 0 || ends_run || slack.is_some() {
+            store(
+                sol,
+                system,
+                t_new,
+                (&s.q_new, &s.v_new, &s.lambda_new),
+                stats,
+            );
+        }
+        std::mem::swap(&mut c.q, &mut s.q_new);
+        std::mem::swap(&mut c.v, &mut s.v_new);
+        std::mem::swap(&mut c.lambda, &mut s.lambda_new);
+        c.t = t_new;
+        if let Some(e) = slack {
+            sol.status = Err(e);
+            return Next::Stop;
+        }
+        if let Controller::Adaptive(control) = &mut c.controller {
+            control.accepted(h);
+        }
+        if !observer.step(c.t, self.options.t_end) {
+            sol.status = Err(Error::Interrupted { t: c.t });
+            return Next::Stop;
+        }
+        Next::Go
+    }
+}
+
+/// Stores a state with its violations and the statistics of the step that produced it.
+fn store(
+    sol: &mut Solution,
+    system: &System,
+    t: f64,
+    (q, v, lambda): (&[Vec3], &[Vec3], &[f64]),
+    stats: StepStats,
+) {
+    let position = scaled_violation(system, q, t).0;
+    let velocity = scaled_velocity_violation(system, q, v, t).0;
+    sol.push(t, q, v, lambda, position, velocity, stats);
+}
+
+/// An observer that lets the run go on.
+struct Silent;
+impl Observer for Silent {
+    fn step(&mut self, _t: f64, _t_end: f64) -> bool {
+        true
+    }
+}
+
+/// The first tension-only constraint whose tension is below `floor` (N), as an error.
+pub(crate) fn negative_tension(
+    system: &System,
+    lambda: &[f64],
+    t: f64,
+    floor: f64,
+) -> Option<Error> {
+    system.tension_only().iter().find_map(|&c| {
+        let tension = system.tension(c, lambda[c])?;
+        (tension < floor).then(|| Error::NegativeTension {
+            t,
+            constraint: system.constraints()[c].name(c),
+            index: c,
+            tension,
+        })
+    })
+}
+
+/// The error of a step from `t` of size `h` that failed at the smallest step allowed, naming the
+/// equation that dominated the residual or where the matrix was singular.
+pub(crate) fn step_failure(
+    system: &System,
+    layout: &Layout,
+    failure: NewtonFailure,
+    t: f64,
+    h: f64,
+) -> Error {
+    match failure {
+        NewtonFailure::NotConverged {
+            iterations,
+            residual,
+            worst,
+        } => Error::NewtonFailed {
+            t,
+            dt: h,
+            iterations,
+            residual,
+            equation: layout.equation_name(system, worst),
+        },
+        NewtonFailure::Singular(s) => singular_error(system, layout, t, s),
+    }
+}

@@ -1,0 +1,157 @@
+//! The stepping API: a run advanced in pieces, snapshotted and restored, is the run made in one
+//! call, bit for bit (the reference is `simulate` itself: the same steps must give the same
+//! floating-point numbers).
+
+use vinculo::integrators::{Formulation, Scheme};
+use vinculo::laws::{DrivenLaw, Law, VectorLaw};
+use vinculo::model::System;
+use vinculo::{simulate, AdaptiveOptions, Simulation, SimulationOptions, Solution, StepControl};
+
+/// A swinging chain of 8 links from a fixed anchor, with a spring-damper across two links and
+/// drag (forces and constraints of several kinds).
+fn chain() -> System {
+    let mut s = System::new([0.0, 0.0, -9.81]);
+    let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
+    let mut ids = vec![prev];
+    for i in 1..=8 {
+        let p = s
+            .add_particle(0.1, [0.1 * i as f64, 0.0, 0.0], [0.0, 0.1, 0.0], false)
+            .unwrap();
+        s.add_distance(prev, p, None).unwrap();
+        ids.push(p);
+        prev = p;
+    }
+    s.add_spring_damper(ids[2], ids[4], 5.0, 0.1, None).unwrap();
+    s.add_quadratic_drag(ids[8], 0.05).unwrap();
+    s
+}
+
+/// Asserts that two runs stored the same states, bit for bit.
+fn assert_same_run(a: &Solution, b: &Solution, what: &str) {
+    assert_eq!(
+        a.times.len(),
+        b.times.len(),
+        "{what}: number of stored states"
+    );
+    let pairs = [
+        (&a.times, &b.times, "times"),
+        (&a.positions, &b.positions, "positions"),
+        (&a.velocities, &b.velocities, "velocities"),
+        (&a.multipliers, &b.multipliers, "multipliers"),
+    ];
+    for (x, y, name) in pairs {
+        assert_eq!(x.len(), y.len(), "{what}: {name}");
+        for (k, (u, v)) in x.iter().zip(y.iter()).enumerate() {
+            assert_eq!(u.to_bits(), v.to_bits(), "{what}: {name}[{k}]: {u} vs {v}");
+        }
+    }
+    assert_eq!(
+        a.accepted_step_sizes, b.accepted_step_sizes,
+        "{what}: steps"
+    );
+    assert_eq!(a.status, b.status, "{what}: status");
+}
+
+/// Stepping to t1 = 0.1, taking a snapshot, on to t2 = 0.25, restoring and stepping to t2 again
+/// gives the stored states of one `simulate` to t2 (and of the stepped run before the restore),
+/// bit for bit, with each time rule on both formulations, with fixed and error-controlled steps
+/// (backward Euler with fixed steps only: with error control it gives up on this chain, as it
+/// did before the stepping API).
+#[test]
+fn restored_run_is_the_uninterrupted_run_bit_for_bit() {
+    let system = chain();
+    let schemes = [
+        Scheme::GeneralizedTrapezoidal { alpha: 0.5 },
+        Scheme::GeneralizedTrapezoidal { alpha: 1.0 },
+        Scheme::GeneralizedAlpha { rho_inf: 0.8 },
+    ];
+    for scheme in schemes {
+        for formulation in [Formulation::Index3, Formulation::Ggl] {
+            for adaptive in [false, true] {
+                if adaptive && scheme == (Scheme::GeneralizedTrapezoidal { alpha: 1.0 }) {
+                    continue; // gives up on this chain (StepSizeTooSmall at t = 0.159)
+                }
+                let options = SimulationOptions {
+                    t_end: 0.25,
+                    dt: 1e-2,
+                    scheme,
+                    formulation,
+                    step_control: if adaptive {
+                        StepControl::Adaptive(AdaptiveOptions::default())
+                    } else {
+                        StepControl::Fixed
+                    },
+                    ..Default::default()
+                };
+                let what = format!("{scheme:?} {formulation:?} adaptive {adaptive}");
+                let mut run = Simulation::new(&system, &options).unwrap();
+                run.step_to(0.1).clone().unwrap();
+                // Fixed steps land on the grid time 0.1; error-controlled ones stop after it.
+                if adaptive {
+                    assert!(run.time() >= 0.1, "{what}: stopped at {}", run.time());
+                } else {
+                    assert!(
+                        (run.time() - 0.1).abs() < 1e-12,
+                        "{what}: stopped at {}",
+                        run.time()
+                    );
+                }
+                let snapshot = run.snapshot();
+                run.step_to(0.25);
+                let first = run.solution().clone();
+                run.restore(&snapshot);
+                assert_eq!(run.time(), snapshot.time());
+                run.step_to(0.25);
+                assert_same_run(&first, run.solution(), &format!("{what}, restored"));
+                let one_call = simulate(&system, &options).unwrap();
+                assert_same_run(&one_call, run.solution(), &format!("{what}, one call"));
+            }
+        }
+    }
+}
+
+/// A pendulum (1 m string, 1 kg) hung from an anchor moved along x by `anchor_x`, with the
+/// bob started at rest below it.
+fn pendulum_on(anchor_x: Law) -> System {
+    let mut s = System::new([0.0, 0.0, -9.81]);
+    let p = s
+        .add_particle(1.0, [0.0, 0.0, -1.0], [0.0; 3], false)
+        .unwrap();
+    let anchor = VectorLaw([anchor_x, Law::Constant(0.0), Law::Constant(0.0)]);
+    s.add_distance_to_point(p, anchor, None).unwrap();
+    s
+}
+
+/// An anchor driven through the stepping API (its position set before each step_to) moves the
+/// pendulum exactly as the same motion given as a law, a piecewise-linear table through the same
+/// points: the stored states agree bit for bit. Times are multiples of dt = 1/64 s, exact in
+/// binary, so the steps end exactly at the knots.
+#[test]
+fn driven_point_is_the_same_motion_given_as_a_law() {
+    let dt = 1.0 / 64.0;
+    let times: Vec<f64> = (0..=32).map(|k| k as f64 * dt).collect();
+    let x: Vec<f64> = times
+        .iter()
+        .map(|t| 0.05 * (2.0 * std::f64::consts::PI * t).sin())
+        .collect();
+    let options = SimulationOptions {
+        t_end: times[32],
+        dt,
+        ..Default::default()
+    };
+    let driven = DrivenLaw::new(times[0], x[0]).unwrap();
+    let system = pendulum_on(Law::Driven(driven.clone()));
+    let mut run = Simulation::new(&system, &options).unwrap();
+    for k in 1..times.len() {
+        driven.set(times[k], x[k]).unwrap();
+        run.step_to(times[k]).clone().unwrap();
+        assert_eq!(run.time(), times[k]);
+    }
+    let table = Law::piecewise_linear(times.clone(), x.clone()).unwrap();
+    let as_law = simulate(&pendulum_on(table), &options).unwrap();
+    assert!(as_law.status.is_ok());
+    assert_same_run(&as_law, run.solution(), "driven anchor");
+    // The anchor really moved the bob (5 cm of anchor motion, a swing of centimetres).
+    let last = as_law.len() - 1;
+    assert!(as_law.position(last, 0)[0].abs() > 1e-3);
+}
