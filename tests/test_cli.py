@@ -18,7 +18,8 @@ def test_demo_writes_the_plots_and_reports_results(tmp_path, capsys):
         data = (output / name).read_bytes()
         assert data[:8] == PNG_SIGNATURE and len(data) > 10_000, name
     out = capsys.readouterr().out
-    # The pendulum line compares with the exact period (2.367841947576237 s, formulation.md).
+    # The pendulum line compares with the exact period (2.367841947576237 s,
+    # docs/theory/formulation.md).
     period = float(re.search(r"pendulum: period ([0-9.]+) s", out).group(1))
     assert period == pytest.approx(2.367841947576237, rel=1e-5)
     # The inclined-plane line: acceleration g sin 30 degrees.

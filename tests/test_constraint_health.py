@@ -39,7 +39,7 @@ def test_velocity_violation_matches_an_independent_computation():
 )
 def test_velocity_violation_shrinks_with_the_order_of_the_scheme(kwargs, order):
     # The exact motion satisfies Phi_q v + Phi_t = 0, and the index-3 schemes' velocities converge
-    # with the order of the positions (formulation.md; Arnold and Brüls 2007 for
+    # with the order of the positions (docs/theory/time-rules.md; Arnold and Brüls 2007 for
     # generalised-alpha), so the largest violation over 1 s of the horizontally released pendulum
     # is divided by about 2^order when the step is halved.
     largest = []

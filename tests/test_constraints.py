@@ -12,7 +12,8 @@ G = 9.81
 
 
 def test_chain_constraint_residual_stays_at_round_off():
-    # The positions are solved so that Phi(q^{n+1}, t^{n+1}) = 0 at each step end (formulation.md),
+    # The positions are solved so that Phi(q^{n+1}, t^{n+1}) = 0 at each step end
+    # (docs/theory/formulation.md),
     # to Newton tolerance; Newton converges quadratically, so what is left is round-off: we ask for
     # 1e-12 of the link length at dt = 1e-4 over 1 s of a 5-link chain swinging from 60 degrees.
     model = demos.build_hanging_chain(num_links=5, length=1.0, angle=np.pi / 3)
@@ -126,7 +127,8 @@ def test_fixed_coordinate_following_a_law():
     v = solution.particle_velocity(particle)[:, 0]
     assert np.max(np.abs(v - rate)) < 1e-5
     # Step n -> n+1 balances m (v1 - v0) / dt = lambda, i.e. the mean of m x'' over the step.
-    # With alpha = 1/2 the multipliers of an index-3 problem ring (formulation.md): an undamped
+    # With alpha = 1/2 the multipliers of an index-3 problem ring (docs/theory/formulation.md): an
+    # undamped
     # (-1)^n oscillation rides on them (here about 0.1 % of the peak force). Averaging two
     # consecutive steps removes it; what remains is the O(dt^2) error, ~1e-5 of the peak force
     # m A (2 pi)^2, well below the 1e-4 required.

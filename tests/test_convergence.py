@@ -20,7 +20,7 @@ def pendulum_position(dt: float, alpha: float) -> np.ndarray:
 @pytest.mark.parametrize(
     ("alpha", "expected_order", "reference_dt"),
     [
-        # formulation.md: alpha = 1/2 is the trapezoidal rule, second order ...
+        # docs/theory/time-rules.md: alpha = 1/2 is the trapezoidal rule, second order ...
         (0.5, 2.0, 1.25e-4),
         # ... and alpha = 1 is backward Euler, first order. Its reference run must be much finer
         # (40x below the finest step) to keep the reference's own error from biasing the fit.

@@ -6,7 +6,8 @@ import pytest
 from vinculo import demos
 
 G, L = 9.81, 1.0
-# Equal masses m and lengths l, linearised: omega^2 = (2 -/+ sqrt 2) g / l (formulation.md; e.g.
+# Equal masses m and lengths l, linearised: omega^2 = (2 -/+ sqrt 2) g / l
+# (docs/theory/formulation.md; e.g.
 # Goldstein, Classical Mechanics, the double pendulum), with mode shapes th2 / th1 = +/- sqrt 2.
 OMEGA_SLOW = np.sqrt((2 - np.sqrt(2)) * G / L)  # 2.3972 rad/s
 OMEGA_FAST = np.sqrt((2 + np.sqrt(2)) * G / L)  # 5.7874 rad/s

@@ -62,7 +62,8 @@ def long_chain(num_links: int, t_end: float) -> demos.HangingChainResult:
 
 
 def test_long_chain_under_tension_converges():
-    # formulation.md: without the constraint Hessian term lambda . Phi_qq in the Jacobian, Newton
+    # docs/theory/newton.md: without the constraint Hessian term lambda . Phi_qq in the Jacobian,
+    # Newton
     # diverges on a 1 m chain of 300 particles at dt = 1e-3. With it, Newton converges
     # quadratically: a handful of iterations per step, energy and lengths held to round-off.
     result = long_chain(num_links=300, t_end=0.5)

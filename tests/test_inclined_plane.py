@@ -29,7 +29,8 @@ def test_sliding_particle_follows_closed_form(degrees):
 
 @pytest.mark.parametrize("alpha", [0.5, 0.75, 1.0])
 def test_multiplier_is_the_normal_force(alpha):
-    # formulation.md: Phi = n . (q - p0), so Phi_q^T lambda = n lambda is the constraint force.
+    # docs/theory/formulation.md: Phi = n . (q - p0), so Phi_q^T lambda = n lambda is the
+    # constraint force.
     # Balancing gravity across the plane: n lambda . n / |n| = m g cos th, i.e.
     # lambda = m g cos th / |n| (positive: the plane pushes the particle out along n, upwards).
     # Holds at every stored time including row 0 (consistent initial accelerations) and for any

@@ -6,8 +6,8 @@ import pytest
 import vinculo
 from vinculo import demos
 
-# formulation.md, "Checks that any implementation must pass": L = 1 m, g = 9.81, released
-# horizontally at rest: T = 4 sqrt(L/g) K(1/sqrt 2) = 2.367841947576237 s.
+# docs/theory/formulation.md, "Checks that any implementation must pass": L = 1 m, g = 9.81,
+# released horizontally at rest: T = 4 sqrt(L/g) K(1/sqrt 2) = 2.367841947576237 s.
 EXACT_PERIOD = 2.367841947576237
 
 
@@ -47,7 +47,8 @@ def test_period_of_horizontally_released_pendulum():
 def test_rod_tension_from_multiplier_matches_energy_closed_form():
     # Closed form: v^2 = 2 g L (cos th - cos th0) from energy conservation, so the rod tension is
     # T = m g cos th + m v^2 / L = m g (3 cos th - 2 cos th0), with cos th = -z / L.
-    # formulation.md: Phi = L^2 - |q - p|^2 gives the force -2 lambda (q - p), tension 2 lambda L.
+    # docs/theory/formulation.md: Phi = L^2 - |q - p|^2 gives the force -2 lambda (q - p), tension
+    # 2 lambda L.
     model = demos.build_pendulum(length=1.0, mass=2.0, amplitude=np.pi / 3)
     dt = 1e-3
     solution = vinculo.simulate(model.system, t_end=3.0, dt=dt, alpha=0.5)

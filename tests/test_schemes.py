@@ -15,7 +15,8 @@ from vinculo import demos
 
 GRAVITY = demos.GRAVITY
 
-# (scheme keywords, expected order of the positions, label). Orders: formulation.md for the
+# (scheme keywords, expected order of the positions, label). Orders: docs/theory/time-rules.md for
+# the
 # generalised trapezoidal rule (alpha = 1/2: 2, alpha = 1: 1); Arnold and Brüls (2007), Multibody
 # System Dynamics 18:185-202, for generalised-alpha (2 for every rho_inf in [0, 1]).
 INDEX3 = [

@@ -54,7 +54,8 @@ __all__ = [
 ]
 
 GRAVITY = 9.81
-"""Standard gravity used by the demos, in m/s^2 (the value of formulation.md's reference period)."""
+"""Standard gravity used by the demos, in m/s^2 (the value of the reference period in
+docs/theory/formulation.md)."""
 
 
 # --------------------------------------------------------------------------------------------

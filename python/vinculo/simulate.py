@@ -107,7 +107,7 @@ def simulate(
             about twice the unknowns and the general sparse LU instead of the tree elimination).
         t_start: initial time, in s.
         tolerance: Newton stops when the scaled residual and the last increment (both lengths, see
-            formulation.md) are below ``tolerance * system.length_scale()``.
+            docs/theory/formulation.md) are below ``tolerance * system.length_scale()``.
         max_iterations: Newton iterations allowed per attempt.
         max_halvings: how many times a failing step may be halved before giving up.
         initial_tolerance: largest initial violation accepted, relative to the model's scales:

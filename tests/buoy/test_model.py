@@ -72,7 +72,8 @@ def test_small_oscillation_frequency_matches_two_dof_linear_theory():
 
 
 def test_string_made_rigid_with_the_sphere_gives_the_one_dof_frequency():
-    # Reference: eq. 31 corrected (buoy.md), omega^2 = (m_f - m_s) g L / ((m_s + m_a) L^2 + I_c)
+    # Reference: eq. 31 corrected (docs/theory/hydrodynamics.md),
+    # omega^2 = (m_f - m_s) g L / ((m_s + m_a) L^2 + I_c)
     # with L = string + R. The string is made rigid with the sphere by tying the anchor also to
     # the +x and +y vertices, so that the anchor is a point fixed in the body (a ball joint).
     case = BuoyCase(drag_coefficient=0.0)
@@ -122,7 +123,8 @@ def test_whole_sweep_matches_the_two_dof_reference():
 
 def test_high_frequency_relative_amplitude_tends_to_the_mass_ratio():
     # Reference: far above both natural frequencies the sphere translates without turning and
-    # (m_s + m_a) r'' = (m_f - m_s) a_t, so |r| -> (m_f - m_s)/(m_s + m_a) X0 (buoy.md: 0.714 X0).
+    # (m_s + m_a) r'' = (m_f - m_s) a_t, so |r| -> (m_f - m_s)/(m_s + m_a) X0
+    # (docs/theory/hydrodynamics.md: 0.714 X0).
     # The linear 2-DOF response approaches it as 1 - O((f_n/f)^2): drag off, 15 and 30 Hz.
     case = BuoyCase(drag_coefficient=0.0, ramp_periods=20.0)
     limit = high_frequency_ratio(case)

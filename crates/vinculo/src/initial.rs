@@ -282,7 +282,7 @@ mod tests {
 
     #[test]
     fn pendulum_multiplier_at_rest_balances_gravity() {
-        // Hanging at rest: the link carries m g, so 2 lambda L = m g (formulation.md sign convention).
+        // Hanging at rest: the link carries m g, so 2 lambda L = m g (docs/theory/formulation.md sign convention).
         let mut s = System::new([0.0, 0.0, -9.81]);
         let a = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
         let b = s

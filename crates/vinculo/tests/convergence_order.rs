@@ -5,7 +5,7 @@
 //!
 //! Without a closed-form solution the error of a run at step h is estimated by its distance to
 //! the run at h/2: for a method of order p, |q_h - q_{h/2}| ~ C h^p (1 - 2^-p), so successive
-//! differences shrink by 2^p. Expected orders: formulation.md for the generalised trapezoidal
+//! differences shrink by 2^p. Expected orders: docs/theory/time-rules.md for the generalised trapezoidal
 //! rule (2 at alpha = 1/2, 1 otherwise), Arnold and Brüls (2007) for generalised-alpha (2).
 //!
 //! Modified Newton runs at a tolerance of 1e-13 of the length instead of the default 1e-10: it

@@ -1,5 +1,5 @@
 //! A 1 m chain of 300 links released horizontally at dt = 1e-3: the case where a peer's Newton
-//! diverges in the first step (formulation.md). With the constraint-Hessian term in the Jacobian
+//! diverges in the first step (docs/theory/newton.md). With the constraint-Hessian term in the Jacobian
 //! vinculo converges at every step, with no step reduction.
 
 use vinculo::model::System;

@@ -4,7 +4,7 @@ use vinculo::model::System;
 use vinculo::{simulate, SimulationOptions};
 
 /// T = 4 sqrt(L/g) K(sin(pi/4)) for L = 1 m, g = 9.81 m/s^2, amplitude 90 degrees
-/// (formulation.md, "Checks that any implementation must pass").
+/// (docs/theory/formulation.md, "Checks that any implementation must pass").
 const EXACT_PERIOD: f64 = 2.367841947576237;
 
 #[test]

@@ -369,7 +369,7 @@ mod tests {
     #[test]
     fn sphere_is_the_papers_octahedron() {
         // Reference: a uniform sphere, I = 2/5 m R^2 (closed form); the octahedron has vertices at
-        // distance R carrying m/10 each and a centre of 4 m/10 (buoy.md).
+        // distance R carrying m/10 each and a centre of 4 m/10 (docs/theory/hydrodynamics.md).
         let (m, r) = (0.192, 0.05);
         let i = 0.4 * m * r * r;
         let spec = RigidBodySpec {
