@@ -307,12 +307,11 @@ def _parameter_descriptions() -> dict[str, str]:
 
 
 def _parameter_units() -> dict[str, str]:
-    """The unit of each buoy case and sweep parameter, as the study writes it to parameters.csv."""
-    try:
-        from vinculo.buoy import report
-    except ImportError:
-        return {}
-    return dict(getattr(report, "_UNITS", {}))
+    """The unit of each buoy case and sweep parameter (``vinculo.buoy.case.UNITS``, as ``--help``
+    states it)."""
+    from vinculo.buoy.case import UNITS
+
+    return dict(UNITS)
 
 
 def _unit(action: argparse.Action, units: dict[str, str]) -> str:

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from vinculo.buoy.calibration import Calibration
-from vinculo.buoy.case import ASSUMPTIONS, PAPER_VALUES, BuoyCase
+from vinculo.buoy.case import ASSUMPTIONS, PAPER_VALUES, UNITS, BuoyCase
 from vinculo.buoy.data import Measurements
 from vinculo.buoy.harmonic import PHASE_CONVENTION
 from vinculo.buoy.parameter_study import ParameterStudy
@@ -287,7 +287,7 @@ def _write_parameters(study: StudyResult, path: Path, sources: dict[str, str]) -
                 else:
                     source = f"{source}; {_amplitude_note(study)}"
             w.writerow([name, _show(value) if name == "tank_size" else value,
-                        _UNITS.get(name, ""), source])
+                        _unit(name), source])
         for name, (value, unit) in derived.items():
             w.writerow([name, value, unit, "derived"])
         w.writerow([
@@ -301,29 +301,13 @@ def _write_parameters(study: StudyResult, path: Path, sources: dict[str, str]) -
                         "derived: Stokes layer alone, rigid pendulum at its natural frequency"])
         for name, value in settings.to_dict().items():
             source = sources.get(f"sweep.{name}", "sweep setting")
-            w.writerow([f"sweep.{name}", value, _UNITS.get(name, ""), source])
+            w.writerow([f"sweep.{name}", value, _unit(name), source])
 
 
-_UNITS = {
-    "diameter": "m",
-    "sphere_density": "kg/m^3",
-    "fluid_density": "kg/m^3",
-    "string_length": "m",
-    "gravity": "m/s^2",
-    "amplitude": "m",
-    "ramp_periods": "periods",
-    "string_mass": "kg",
-    "tank_size": "m",
-    "kinematic_viscosity": "m^2/s",
-    "max_periods": "periods",
-    "phase_tolerance": "deg",
-    "resonance_tolerance": "Hz",
-    "f_min": "Hz",
-    "f_max": "Hz",
-    "dt": "s",
-    "settle_periods": "periods",
-    "fit_periods": "periods",
-}
+def _unit(name: str) -> str:
+    """The unit of a case or sweep field for parameters.csv (case.UNITS; empty for a choice)."""
+    unit = UNITS.get(name, "")
+    return "" if unit.startswith("one of") else unit
 
 
 def _write_sweep(study: StudyResult, data: Measurements | None, path: Path) -> None:
