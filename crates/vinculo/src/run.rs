@@ -108,6 +108,11 @@ impl FixedSteps {
         (remaining, StepEnd::At(stop))
     }
 
+    /// The step size at the current level (dt after a full recovery from halvings).
+    fn nominal(&self) -> f64 {
+        self.unit * (1u64 << self.level) as f64
+    }
+
     /// The time after an accepted step that ends at `end`.
     fn accepted(&mut self, end: StepEnd) -> f64 {
         let t = match end {
@@ -479,7 +484,7 @@ impl Simulation<'_> {
         observer: &mut dyn Observer,
     ) -> &std::result::Result<(), Error> {
         let stop = t.min(self.options.t_end);
-        while self.sol.status.is_ok() && self.carried.t < stop {
+        while self.sol.status.is_ok() && !self.reached(stop) {
             if let Next::Stop = self.attempt(stop, observer) {
                 break;
             }
@@ -488,6 +493,18 @@ impl Simulation<'_> {
             self.sol.status = Err(e);
         }
         &self.sol.status
+    }
+
+    /// Whether the run is at `stop`: past it, or (fixed steps) on the grid point within a
+    /// millionth of a step before it, where [`FixedSteps::propose`] lands a step meant for it
+    /// (a stop computed as k dt by the caller may differ from the grid time in the last bits;
+    /// another step of that difference would be a step of ~1e-17 s).
+    fn reached(&self, stop: f64) -> bool {
+        let c = &self.carried;
+        match &c.controller {
+            Controller::Fixed(fixed) => stop - c.t <= 1e-6 * fixed.nominal(),
+            Controller::Adaptive(_) => c.t >= stop,
+        }
     }
 
     /// One attempt at a step towards `stop`: the shared loop body.
