@@ -137,7 +137,7 @@ def test_restore_of_a_snapshot_of_another_system_is_refused():
     with pytest.raises(vinculo.InvalidInputError, match="another system") as raised:
         sim.restore(foreign)
     assert raised.value.name == "snapshot"
-    assert "1 particles" in str(raised.value.value)
+    assert "1 particles" in str(raised.value)
     with pytest.raises(vinculo.InvalidInputError, match="Snapshot"):
         sim.restore("not a snapshot")
 
@@ -174,3 +174,57 @@ def test_a_failed_step_raises_and_keeps_what_was_computed():
         sim.step_to(0.2)
     assert raised.value.solution.times[0] == 0.0
     assert np.array_equal(sim.solution().times, raised.value.solution.times)
+
+
+@pytest.mark.parametrize("options", CASES, ids=lambda o: "-".join(str(v) for v in o.values()))
+def test_snapshot_file_continues_as_one_simulate_call(tmp_path, options):
+    # Reference: one vinculo.simulate() to t2; a new simulation loads the state saved at t1 and
+    # stores, from t1 on, the same rows bit for bit (the file holds the floats' exact bits).
+    t1, t2, dt = 0.25, 0.6, 0.01
+    reference = vinculo.simulate(double_pendulum(), t_end=t2, dt=dt, **options)
+    sim = vinculo.Simulation(double_pendulum(), t_end=t2, dt=dt, **options)
+    sim.step_to(t1)
+    path = tmp_path / "state.snap"
+    sim.save_snapshot(path)
+    other = vinculo.Simulation(double_pendulum(), t_end=t2, dt=dt, **options)
+    other.load_snapshot(path)
+    assert other.time == sim.time
+    assert np.array_equal(other.positions, sim.positions)
+    other.step_to(t2)
+    continued = other.solution()
+    later = reference.times >= sim.time
+    assert np.array_equal(continued.times, reference.times[later])
+    for name in FIELDS[1:]:
+        assert np.array_equal(getattr(continued, name), getattr(reference, name)[later]), name
+
+
+def test_corrupt_foreign_and_adaptive_snapshot_files_are_refused(tmp_path):
+    sim = vinculo.Simulation(double_pendulum(), t_end=0.1, dt=0.01)
+    sim.step_to(0.05)
+    path = tmp_path / "state.snap"
+    sim.save_snapshot(path)
+    data = bytearray(path.read_bytes())
+    data[40] ^= 0x01  # one bit of the stored time flipped (bytes 36-43)
+    corrupt = tmp_path / "corrupt.snap"
+    corrupt.write_bytes(bytes(data))
+    with pytest.raises(vinculo.InvalidInputError, match="checksum") as raised:
+        sim.load_snapshot(corrupt)
+    assert "corrupt.snap" in str(raised.value.value)
+    truncated = tmp_path / "truncated.snap"
+    truncated.write_bytes(path.read_bytes()[:30])
+    with pytest.raises(vinculo.InvalidInputError, match=r"corrupt|truncated"):
+        sim.load_snapshot(truncated)
+    text = tmp_path / "text.snap"
+    text.write_text("not a snapshot at all")
+    with pytest.raises(vinculo.InvalidInputError, match="VNCLSNAP"):
+        sim.load_snapshot(text)
+    with pytest.raises(vinculo.InvalidInputError, match="cannot be read"):
+        sim.load_snapshot(tmp_path / "missing.snap")
+    other = vinculo.System(gravity=(0.0, 0.0, -9.81))
+    bob = other.add_particle(mass=1.0, position=(1.0, 0.0, 0.0))
+    other.add_distance_to_point(bob, (0.0, 0.0, 0.0), length=1.0)
+    with pytest.raises(vinculo.InvalidInputError, match="another system"):
+        vinculo.Simulation(other, t_end=0.1, dt=0.01).load_snapshot(path)
+    adaptive = vinculo.Simulation(double_pendulum(), t_end=0.1, dt=0.01, adaptive=True)
+    with pytest.raises(vinculo.InvalidInputError, match="adaptive"):
+        adaptive.save_snapshot(tmp_path / "adaptive.snap")

@@ -481,6 +481,29 @@ class Snapshot:
     @property
     def time(self) -> float:
         """Time of the snapshot, in s."""
+    def save(self, path: str) -> None:
+        """Save the snapshot to a file (format: ``crates/vinculo/src/snapshot_file.rs``).
+
+        Arguments:
+            path: the file to write.
+
+        Raises:
+            InvalidInputError: a snapshot of an error-controlled or stopped run, or the file
+                cannot be written.
+        """
+    @staticmethod
+    def load(path: str) -> "Snapshot":
+        """Load a snapshot saved by ``save``.
+
+        Arguments:
+            path: the file.
+
+        Returns:
+            The snapshot.
+
+        Raises:
+            InvalidInputError: unreadable, not a snapshot file, other version, truncated or corrupt.
+        """
 
 class Simulation:
     """The core's stepping object; ``vinculo.Simulation`` wraps it (same arguments as ``simulate``

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 
 import numpy as np
@@ -164,8 +165,10 @@ class Simulation:
     def restore(self, snapshot: Snapshot) -> None:
         """Return to the state of a snapshot; stepping on repeats the later steps bit for bit.
 
-        States stored after the snapshot are dropped. A driven law keeps every value set
-        (values are set once, at increasing times): the steps after a restore see them.
+        States stored after the snapshot are dropped. A snapshot of another simulation of the
+        same system carries the state but not the history: the stored states restart at it. A
+        driven law keeps every value set (values are set once, at increasing times): the steps
+        after a restore see them.
 
         Arguments:
             snapshot: taken by :meth:`snapshot` of a simulation of the same system.
@@ -175,3 +178,31 @@ class Simulation:
                 counts, or another model), or not a snapshot.
         """
         self._core.restore(snapshot)
+
+    def save_snapshot(self, path: str | os.PathLike[str]) -> None:
+        """Save a snapshot of the current state to a file (a small binary format, floats bit-exact).
+
+        Arguments:
+            path: the file to write.
+
+        Raises:
+            InvalidInputError: the run uses error-controlled steps (``adaptive=True``: keep
+                in-memory snapshots instead), the run has stopped, or the file cannot be written.
+        """
+        self._core.snapshot().save(os.fspath(path))
+
+    def load_snapshot(self, path: str | os.PathLike[str]) -> None:
+        """Restore the state saved by :meth:`save_snapshot` (here or in another process).
+
+        The run goes on from the saved state as the saved run would, bit for bit; the stored
+        states restart at the snapshot's (the history before it is not in the file), unless the
+        snapshot is of this very run (then as :meth:`restore`).
+
+        Arguments:
+            path: the file written by :meth:`save_snapshot`.
+
+        Raises:
+            InvalidInputError: the file cannot be read, is not a snapshot file, is truncated or
+                corrupt, or is a snapshot of another system.
+        """
+        self._core.restore(Snapshot.load(os.fspath(path)))

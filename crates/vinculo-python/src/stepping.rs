@@ -8,6 +8,7 @@ use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::path::PathBuf;
 use std::sync::{Mutex, MutexGuard};
 use vinculo::model::System;
 use vinculo::{Simulation, Snapshot};
@@ -16,9 +17,6 @@ use vinculo::{Simulation, Snapshot};
 #[pyclass(name = "Snapshot", module = "vinculo._core", frozen)]
 pub struct PySnapshot {
     inner: Snapshot,
-    system_id: u64,
-    particles: usize,
-    constraints: usize,
 }
 
 #[pymethods]
@@ -29,12 +27,25 @@ impl PySnapshot {
         self.inner.time()
     }
 
+    /// Saves the snapshot to a file.
+    fn save(&self, path: PathBuf) -> PyResult<()> {
+        self.inner.save(path).map_err(to_py)
+    }
+
+    /// Loads a snapshot saved by `save`.
+    #[staticmethod]
+    fn load(path: PathBuf) -> PyResult<PySnapshot> {
+        Ok(PySnapshot {
+            inner: Snapshot::load(path).map_err(to_py)?,
+        })
+    }
+
     fn __repr__(&self) -> String {
         format!(
-            "Snapshot(time={}, particles={}, constraints={})",
+            "Snapshot(time={}, particles={}, constraint equations={})",
             self.inner.time(),
-            self.particles,
-            self.constraints
+            self.inner.particles(),
+            self.inner.constraints()
         )
     }
 }
@@ -42,25 +53,16 @@ impl PySnapshot {
 /// A running simulation of its own copy of a system.
 #[pyclass(name = "Simulation", module = "vinculo._core")]
 pub struct PySimulation {
-    // Declared before `system`, so dropped before it: `sim` borrows the boxed system.
+    // Declared before `_system`, so dropped before it: `sim` borrows the boxed system.
     // In a mutex only to make the class Sync (Python holds the GIL around every call but
     // step_to, which has the `&mut` borrow).
     sim: Mutex<Simulation<'static>>,
     // Never moved out of nor mutated while `sim` lives (the box keeps its address).
-    system: Box<System>,
+    _system: Box<System>,
     user_errors: PendingError,
 }
 
 impl PySimulation {
-    /// The model size and identity a snapshot of this simulation records.
-    fn identity(&self) -> (u64, usize, usize) {
-        (
-            self.system.id(),
-            self.system.particles().len(),
-            self.system.constraints().len(),
-        )
-    }
-
     /// The running simulation.
     fn sim(&self) -> MutexGuard<'_, Simulation<'static>> {
         self.sim.lock().unwrap_or_else(|p| p.into_inner())
@@ -132,7 +134,7 @@ impl PySimulation {
         let sim = Simulation::new(borrowed, &options).map_err(to_py)?;
         Ok(PySimulation {
             sim: Mutex::new(sim),
-            system: model,
+            _system: model,
             user_errors,
         })
     }
@@ -214,12 +216,8 @@ impl PySimulation {
 
     /// A copy of the running state.
     fn snapshot(&self) -> PySnapshot {
-        let (system_id, particles, constraints) = self.identity();
         PySnapshot {
             inner: self.sim().snapshot(),
-            system_id,
-            particles,
-            constraints,
         }
     }
 
@@ -232,19 +230,6 @@ impl PySimulation {
                 "expected a Snapshot taken by Simulation.snapshot()",
             ));
         };
-        let s = snapshot.get();
-        let (id, particles, constraints) = self.identity();
-        if (s.system_id, s.particles, s.constraints) != (id, particles, constraints) {
-            return Err(invalid(
-                "snapshot",
-                format!(
-                    "a snapshot of another system ({} particles, {} constraints; this one has {particles} and {constraints})",
-                    s.particles, s.constraints
-                ),
-                "restore only snapshots taken from a simulation of the same system",
-            ));
-        }
-        self.sim().restore(&s.inner);
-        Ok(())
+        self.sim().try_restore(&snapshot.get().inner).map_err(to_py)
     }
 }
