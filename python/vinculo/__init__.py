@@ -29,9 +29,10 @@ from vinculo.errors import (
     UserFunctionOutputError,
     VinculoError,
 )
-from vinculo.laws import constant, polynomial, sine, tabulated
+from vinculo.laws import constant, driven, piecewise_linear, polynomial, sine, tabulated
 from vinculo.simulate import simulate
 from vinculo.solution import Solution
+from vinculo.stepping import Simulation, Snapshot
 
 try:
     _installed_version = version("vinculo")
@@ -53,6 +54,8 @@ __all__ = [
     "ParticleId",
     "RedundantConstraintsError",
     "SchedulerError",
+    "Simulation",
+    "Snapshot",
     "Solution",
     "StepSizeTooSmallError",
     "System",
@@ -63,6 +66,8 @@ __all__ = [
     "VinculoError",
     "__version__",
     "constant",
+    "driven",
+    "piecewise_linear",
     "polynomial",
     "simulate",
     "sine",

@@ -27,6 +27,45 @@ class Law:
     def tabulated(times: Sequence[float], values: Sequence[float]) -> "Law":
         """Natural cubic spline through the samples (C2). Runs must stay within [times[0], times[-1]];
         evaluated outside, the spline continues along its end tangents."""
+    @staticmethod
+    def piecewise_linear(times: Sequence[float], values: Sequence[float]) -> "Law":
+        """Linear interpolation between knots (left-continuous rate), at rest outside them.
+
+        Arguments:
+            times: strictly increasing knot times (at least one).
+            values: the value at each knot.
+
+        Returns:
+            The law.
+
+        Raises:
+            InvalidInputError: lengths differ, no knot, times not increasing, a value not finite.
+        """
+    @staticmethod
+    def driven(x: float, t: float = 0.0) -> "Law":
+        """A piecewise-linear law whose values are set while a run is stepped.
+
+        Arguments:
+            x: the value at time t (and before).
+            t: the time of the first value, in s.
+
+        Returns:
+            The law (``set`` adds values; copies of it share them).
+
+        Raises:
+            InvalidInputError: a number is not finite.
+        """
+    def set(self, t: float, x: float) -> None:
+        """Set a driven law's value at time t: the law moves linearly to it from the last value.
+
+        Arguments:
+            t: the time, in s (after the last time set).
+            x: the value at t.
+
+        Raises:
+            InvalidInputError: the law is not driven, t is not after the last time set, or a
+                number is not finite.
+        """
     def __call__(self, t: float) -> float:
         """The law's value at time t."""
     def derivatives(self, t: float) -> tuple[float, float, float]:
@@ -435,3 +474,95 @@ def simulate(system: System, t_end: float, dt: float, alpha: float | None = None
     'equation'} when the run stopped early (the arrays then hold every step completed).
     progress(t, t_end) is called about twice a second of wall time.
     Raises the vinculo.errors classes for bad input."""
+
+class Snapshot:
+    """A copy of a running simulation's state (``Simulation.snapshot``), restored by
+    ``Simulation.restore``."""
+    @property
+    def time(self) -> float:
+        """Time of the snapshot, in s."""
+    def save(self, path: str) -> None:
+        """Save the snapshot to a file (format: ``crates/vinculo/src/snapshot_file.rs``).
+
+        Arguments:
+            path: the file to write.
+
+        Raises:
+            InvalidInputError: a snapshot of an error-controlled or stopped run, or the file
+                cannot be written.
+        """
+    @staticmethod
+    def load(path: str) -> "Snapshot":
+        """Load a snapshot saved by ``save``.
+
+        Arguments:
+            path: the file.
+
+        Returns:
+            The snapshot.
+
+        Raises:
+            InvalidInputError: unreadable, not a snapshot file, other version, truncated or corrupt.
+        """
+
+class Simulation:
+    """The core's stepping object; ``vinculo.Simulation`` wraps it (same arguments as ``simulate``
+    without ``progress``).
+
+    Arguments:
+        system: the model (the simulation keeps its own copy).
+        t_end: the latest time the run may reach, in s.
+        dt: step size, in s.
+        alpha: parameter of the generalised trapezoidal rule.
+
+    Raises:
+        InvalidInputError: a bad argument.
+        InconsistentInitialStateError: the initial state violates a constraint.
+    """
+    def __init__(self, system: System, t_end: float, dt: float, alpha: float | None = None,
+                 t_start: float = 0.0, tolerance: float = 1e-10, max_iterations: int = 25,
+                 max_halvings: int = 4, initial_tolerance: float = 1e-8, save_every: int = 1,
+                 jacobian_reuse: bool = False, scheme: str = "trapezoidal",
+                 rho_inf: float | None = None, formulation: str = "index-3",
+                 adaptive: bool = False, rtol: float = 1e-6, atol: float = 1e-6,
+                 h_min: float = 1e-10, h_max: float | None = None,
+                 t_eval: list[float] | None = None) -> None: ...
+    def step_to(self, t: float) -> dict | None:
+        """Advance to time t (at most t_end).
+
+        Arguments:
+            t: the time to reach, in s.
+
+        Returns:
+            None while the run goes on; the 'error' dict of ``simulate`` once it stopped.
+
+        Raises:
+            InvalidInputError: t is before the current time.
+        """
+    def error(self) -> dict | None:
+        """The 'error' dict of ``simulate`` of a stopped run, None while it goes on."""
+    @property
+    def time(self) -> float:
+        """Current time, in s."""
+    @property
+    def positions(self) -> npt.NDArray[np.float64]:
+        """Current positions, shape (n, 3)."""
+    @property
+    def velocities(self) -> npt.NDArray[np.float64]:
+        """Current velocities, shape (n, 3)."""
+    @property
+    def multipliers(self) -> npt.NDArray[np.float64]:
+        """Current multipliers, shape (m,)."""
+    def solution(self) -> dict:
+        """The states stored so far, as the dict ``simulate`` returns."""
+    def snapshot(self) -> Snapshot:
+        """A copy of the running state."""
+    def restore(self, snapshot: Snapshot) -> None:
+        """Return to the state of a snapshot of a simulation of the same system.
+
+        Arguments:
+            snapshot: the snapshot.
+
+        Raises:
+            InvalidInputError: a snapshot of another system, or not a snapshot.
+        """

@@ -19,7 +19,7 @@ import numpy as np
 
 from vinculo._core import Law
 
-__all__ = ["Law", "constant", "polynomial", "sine", "tabulated"]
+__all__ = ["Law", "constant", "driven", "piecewise_linear", "polynomial", "sine", "tabulated"]
 
 
 def _floats(name: str, values: Sequence[float] | np.ndarray) -> list[float]:
@@ -124,3 +124,45 @@ def tabulated(times: Sequence[float] | np.ndarray, values: Sequence[float] | np.
             not strictly increasing, or a number is not finite.
     """
     return Law.tabulated(_floats("times", times), _floats("values", values))
+
+
+def piecewise_linear(
+    times: Sequence[float] | np.ndarray, values: Sequence[float] | np.ndarray
+) -> Law:
+    """Linear interpolation between knots, at rest before the first and after the last.
+
+    At a knot the rate is that of the segment ending there (left-continuous), so a driven law
+    (:func:`driven`) set knot by knot evaluates as this table of the same knots.
+
+    Arguments:
+        times: strictly increasing knot times (at least one).
+        values: the value at each knot.
+
+    Returns:
+        The law.
+
+    Raises:
+        InvalidInputError: if the lengths differ, there is no knot, the times are not strictly
+            increasing, or a number is not finite.
+    """
+    return Law.piecewise_linear(_floats("times", times), _floats("values", values))
+
+
+def driven(x0: float, t0: float = 0.0) -> Law:
+    """A law set while a :class:`vinculo.Simulation` is stepped (a coupling loop's input).
+
+    It starts as the value ``x0`` at ``t0`` (and before); ``law.set(t, x)`` adds the value at a
+    later time, and the law moves linearly to it (a :func:`piecewise_linear` law growing knot by
+    knot). Use it where a law is accepted; set the value at a time before stepping to it.
+
+    Arguments:
+        x0: the value at ``t0``.
+        t0: the time of the first value, in s.
+
+    Returns:
+        The law (its ``set(t, x)`` sets the next value).
+
+    Raises:
+        InvalidInputError: if a number is not finite.
+    """
+    return Law.driven(float(x0), float(t0))

@@ -80,6 +80,10 @@ pub fn details<'py>(py: Python<'py>, e: &Error) -> PyResult<Bound<'py, PyDict>> 
             d.set_item("error_norm", error)?;
         }
         Error::Interrupted { t } => d.set_item("time", t)?,
+        Error::Snapshot { what, .. } => {
+            d.set_item("name", "snapshot")?;
+            d.set_item("value", what)?;
+        }
         Error::UserFunction { group, call, t, .. }
         | Error::UserFunctionOutput { group, call, t, .. } => {
             d.set_item("group", group)?;

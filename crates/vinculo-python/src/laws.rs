@@ -2,7 +2,7 @@
 
 use crate::errors::{invalid, to_py};
 use pyo3::prelude::*;
-use vinculo::laws::{Law, VectorLaw};
+use vinculo::laws::{DrivenLaw, Law, VectorLaw};
 
 /// A prescribed scalar function of time with its first and second derivatives.
 #[pyclass(name = "Law", module = "vinculo._core", frozen)]
@@ -52,6 +52,35 @@ impl PyLaw {
         Ok(PyLaw {
             inner: Law::tabulated(times, values).map_err(to_py)?,
         })
+    }
+
+    /// Linear interpolation between knots (times, values), at rest outside them.
+    #[staticmethod]
+    fn piecewise_linear(times: Vec<f64>, values: Vec<f64>) -> PyResult<PyLaw> {
+        Ok(PyLaw {
+            inner: Law::piecewise_linear(times, values).map_err(to_py)?,
+        })
+    }
+
+    /// A piecewise-linear law driven while a run is stepped: value x at time t (and before).
+    #[staticmethod]
+    #[pyo3(signature = (x, t=0.0))]
+    fn driven(x: f64, t: f64) -> PyResult<PyLaw> {
+        Ok(PyLaw {
+            inner: Law::Driven(DrivenLaw::new(t, x).map_err(to_py)?),
+        })
+    }
+
+    /// Sets a driven law's value at time t (after the last time set).
+    fn set(&self, t: f64, x: f64) -> PyResult<()> {
+        match &self.inner {
+            Law::Driven(driven) => driven.set(t, x).map_err(to_py),
+            _ => Err(invalid(
+                "law",
+                self.__repr__(),
+                "only a driven law (Law.driven) can be set",
+            )),
+        }
     }
 
     /// Value at t.

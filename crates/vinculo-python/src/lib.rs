@@ -4,6 +4,7 @@
 mod errors;
 mod laws;
 mod run;
+mod stepping;
 mod system;
 mod user_physics;
 
@@ -17,6 +18,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<system::PyConstraintId>()?;
     m.add_class::<system::PyForceId>()?;
     m.add_class::<user_physics::PyUserGroup>()?;
+    m.add_class::<stepping::PySimulation>()?;
+    m.add_class::<stepping::PySnapshot>()?;
     m.add_function(wrap_pyfunction!(run::simulate, m)?)?;
     Ok(())
 }

@@ -176,6 +176,15 @@ pub enum Error {
         /// first element with a non-finite value).
         problem: String,
     },
+    /// A snapshot that cannot be used: an unreadable, corrupt or foreign snapshot file, or a
+    /// snapshot of another model.
+    #[error("{what}: {problem}")]
+    Snapshot {
+        /// The snapshot (its file's path, or "snapshot").
+        what: String,
+        /// What is wrong and what to do instead.
+        problem: String,
+    },
     /// The run was stopped by its observer (for instance a keyboard interrupt).
     #[error("run interrupted at t = {t:.6} s")]
     Interrupted {
@@ -192,7 +201,8 @@ impl Error {
             | Error::InvalidVector { .. }
             | Error::SameParticle { .. }
             | Error::ConstraintOnFixedParticles { .. }
-            | Error::LawOutOfDomain { .. } => "InvalidInputError",
+            | Error::LawOutOfDomain { .. }
+            | Error::Snapshot { .. } => "InvalidInputError",
             Error::UnknownParticle { .. } => "UnknownHandleError",
             Error::InconsistentInitialState { .. } => "InconsistentInitialStateError",
             Error::RedundantConstraints { .. } => "RedundantConstraintsError",

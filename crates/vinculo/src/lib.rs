@@ -53,6 +53,7 @@ pub mod model;
 mod options;
 pub mod run;
 pub mod simulate;
+pub mod snapshot_file;
 pub mod solution;
 pub mod step_control;
 pub mod user;

@@ -60,11 +60,11 @@ pub(crate) enum Controller {
 /// Fixed steps dt / 2^(top - level) on the grid t_grid + units * unit.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct FixedSteps {
-    top: u32,
-    unit: f64,
-    units: u64,
-    level: u32,
-    t_grid: f64,
+    pub(crate) top: u32,
+    pub(crate) unit: f64,
+    pub(crate) units: u64,
+    pub(crate) level: u32,
+    pub(crate) t_grid: f64,
 }
 
 /// Where a proposed step ends.
@@ -108,6 +108,11 @@ impl FixedSteps {
         (remaining, StepEnd::At(stop))
     }
 
+    /// The step size at the current level (dt after a full recovery from halvings).
+    fn nominal(&self) -> f64 {
+        self.unit * (1u64 << self.level) as f64
+    }
+
     /// The time after an accepted step that ends at `end`.
     fn accepted(&mut self, end: StepEnd) -> f64 {
         let t = match end {
@@ -140,30 +145,38 @@ impl FixedSteps {
 
 /// What a run carries from step to step: everything a snapshot copies.
 #[derive(Debug, Clone)]
-struct Carried {
-    t: f64,
-    q: Vec<Vec3>,
-    v: Vec<Vec3>,
-    acc: Vec<Vec3>,
-    lambda: Vec<f64>,
-    rule: RuleState,
-    controller: Controller,
+pub(crate) struct Carried {
+    pub(crate) t: f64,
+    pub(crate) q: Vec<Vec3>,
+    pub(crate) v: Vec<Vec3>,
+    pub(crate) acc: Vec<Vec3>,
+    pub(crate) lambda: Vec<f64>,
+    pub(crate) rule: RuleState,
+    pub(crate) controller: Controller,
     /// Accepted steps so far.
-    step: usize,
+    pub(crate) step: usize,
     /// Next requested output time (error-controlled runs with output times).
-    next_output: usize,
+    pub(crate) next_output: usize,
 }
 
 /// A copy of a running simulation's state ([`Simulation::snapshot`]).
 #[derive(Debug, Clone)]
+///
+/// It records the model it belongs to (particle and constraint counts and a fingerprint of the
+/// model, [`fingerprint`]) and the run it was taken from: restored into another run (of the
+/// same model, for instance after [`Snapshot::load`]), it carries the state but not the stored
+/// history before it ([`Simulation::try_restore`]).
 pub struct Snapshot {
-    carried: Carried,
-    rows: usize,
-    steps_taken: usize,
-    steps_rejected: usize,
-    accepted: usize,
-    factorisations: usize,
-    status: std::result::Result<(), Error>,
+    pub(crate) carried: Carried,
+    pub(crate) rows: usize,
+    pub(crate) steps_taken: usize,
+    pub(crate) steps_rejected: usize,
+    pub(crate) accepted: usize,
+    pub(crate) factorisations: usize,
+    pub(crate) status: std::result::Result<(), Error>,
+    pub(crate) fingerprint: u64,
+    /// The run it was taken from (0: none, a snapshot loaded from a file).
+    pub(crate) run: u64,
 }
 
 impl Snapshot {
@@ -171,7 +184,65 @@ impl Snapshot {
     pub fn time(&self) -> f64 {
         self.carried.t
     }
+
+    /// Number of particles of the model it belongs to.
+    pub fn particles(&self) -> usize {
+        self.carried.q.len()
+    }
+
+    /// Number of constraint equations of the model it belongs to.
+    pub fn constraints(&self) -> usize {
+        self.carried.lambda.len()
+    }
+
+    /// The fingerprint of the model it belongs to ([`fingerprint`]).
+    pub fn fingerprint(&self) -> u64 {
+        self.fingerprint
+    }
 }
+
+/// A fingerprint of a model's structure (FNV-1a over the particles' masses and fixed flags,
+/// gravity, the constraints' names and scales and the number of forces): two models with the
+/// same fingerprint take the same state vector. Initial positions and velocities do not enter.
+pub fn fingerprint(system: &System) -> u64 {
+    let mut h = Fnv::new();
+    for p in system.particles() {
+        h.write(&p.mass.to_bits().to_le_bytes());
+        h.write(&[p.fixed as u8]);
+    }
+    for g in system.gravity() {
+        h.write(&g.to_bits().to_le_bytes());
+    }
+    for (k, c) in system.constraints().iter().enumerate() {
+        h.write(c.name(k).as_bytes());
+        h.write(&c.scale().to_bits().to_le_bytes());
+    }
+    h.write(&(system.forces().len() as u64).to_le_bytes());
+    h.finish()
+}
+
+/// The 64-bit FNV-1a hash (fingerprints and the snapshot file's checksum).
+pub(crate) struct Fnv(u64);
+
+impl Fnv {
+    pub(crate) fn new() -> Fnv {
+        Fnv(0xcbf2_9ce4_8422_2325)
+    }
+
+    pub(crate) fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 ^= b as u64;
+            self.0 = self.0.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+
+    pub(crate) fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+/// Identifies each simulation (a snapshot remembers its run).
+static NEXT_RUN: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
 
 /// The scratch arrays of a step (written before they are read: not part of a snapshot).
 struct Scratch {
@@ -196,6 +267,8 @@ pub struct Simulation<'a> {
     carried: Carried,
     scratch: Scratch,
     sol: Solution,
+    fingerprint: u64,
+    run: u64,
 }
 
 impl<'a> Simulation<'a> {
@@ -373,6 +446,8 @@ impl<'a> Simulation<'a> {
             },
             scratch,
             sol,
+            fingerprint: fingerprint(system),
+            run: NEXT_RUN.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         })
     }
 
@@ -423,7 +498,55 @@ impl<'a> Simulation<'a> {
             accepted: self.sol.accepted_step_sizes.len(),
             factorisations: self.sol.factorisations,
             status: self.sol.status.clone(),
+            fingerprint: self.fingerprint,
+            run: self.run,
         }
+    }
+
+    /// [`Simulation::restore`] after checking that `snapshot` belongs to this model (its
+    /// particle and constraint counts and fingerprint). A snapshot of another run of the model
+    /// (another simulation's, or one loaded from a file) carries the state but not the history
+    /// before it: the stored states restart with the snapshot's (stored as a row of its own
+    /// unless the run has requested output times, with the statistics of no step).
+    ///
+    /// # Errors
+    /// [`Error::Snapshot`] for a snapshot of another model.
+    pub fn try_restore(&mut self, snapshot: &Snapshot) -> Result<()> {
+        let (n, m) = (self.carried.q.len(), self.carried.lambda.len());
+        if (snapshot.particles(), snapshot.constraints()) != (n, m)
+            || snapshot.fingerprint != self.fingerprint
+        {
+            return Err(Error::Snapshot {
+                what: "snapshot".into(),
+                problem: format!(
+                    "a snapshot of another system ({} particles, {} constraint equations, \
+                     fingerprint {:016x}; this one has {n}, {m}, {:016x}): restore only \
+                     snapshots of simulations of the same system",
+                    snapshot.particles(),
+                    snapshot.constraints(),
+                    snapshot.fingerprint,
+                    self.fingerprint
+                ),
+            });
+        }
+        if snapshot.run == self.run {
+            self.restore(snapshot);
+            return Ok(());
+        }
+        self.restore(snapshot);
+        self.sol.truncate(0);
+        self.sol.accepted_step_sizes.clear();
+        if self.options.output_times.is_none() {
+            let c = &self.carried;
+            store(
+                &mut self.sol,
+                self.system,
+                c.t,
+                (&c.q, &c.v, &c.lambda),
+                StepStats::default(),
+            );
+        }
+        Ok(())
     }
 
     /// Returns to the state of `snapshot` (taken from this simulation): later stored states
@@ -479,7 +602,7 @@ impl Simulation<'_> {
         observer: &mut dyn Observer,
     ) -> &std::result::Result<(), Error> {
         let stop = t.min(self.options.t_end);
-        while self.sol.status.is_ok() && self.carried.t < stop {
+        while self.sol.status.is_ok() && !self.reached(stop) {
             if let Next::Stop = self.attempt(stop, observer) {
                 break;
             }
@@ -488,6 +611,18 @@ impl Simulation<'_> {
             self.sol.status = Err(e);
         }
         &self.sol.status
+    }
+
+    /// Whether the run is at `stop`: past it, or (fixed steps) on the grid point within a
+    /// millionth of a step before it, where [`FixedSteps::propose`] lands a step meant for it
+    /// (a stop computed as k dt by the caller may differ from the grid time in the last bits;
+    /// another step of that difference would be a step of ~1e-17 s).
+    fn reached(&self, stop: f64) -> bool {
+        let c = &self.carried;
+        match &c.controller {
+            Controller::Fixed(fixed) => stop - c.t <= 1e-6 * fixed.nominal(),
+            Controller::Adaptive(_) => c.t >= stop,
+        }
     }
 
     /// One attempt at a step towards `stop`: the shared loop body.

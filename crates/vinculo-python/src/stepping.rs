@@ -1,0 +1,235 @@
+//! `Simulation`: the core's stepping object behind a Python class (glue only).
+
+use crate::errors::{invalid, to_py};
+use crate::run::{options, solution_dict};
+use crate::system::PySystem;
+use crate::user_physics::PendingError;
+use numpy::ndarray::{Array1, Array2};
+use numpy::{IntoPyArray, PyArray1, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::PathBuf;
+use std::sync::{Mutex, MutexGuard};
+use vinculo::model::System;
+use vinculo::{Simulation, Snapshot};
+
+/// A copy of a running simulation's state, with what identifies the model it belongs to.
+#[pyclass(name = "Snapshot", module = "vinculo._core", frozen)]
+pub struct PySnapshot {
+    inner: Snapshot,
+}
+
+#[pymethods]
+impl PySnapshot {
+    /// Time of the snapshot, in s.
+    #[getter]
+    fn time(&self) -> f64 {
+        self.inner.time()
+    }
+
+    /// Saves the snapshot to a file.
+    fn save(&self, path: PathBuf) -> PyResult<()> {
+        self.inner.save(path).map_err(to_py)
+    }
+
+    /// Loads a snapshot saved by `save`.
+    #[staticmethod]
+    fn load(path: PathBuf) -> PyResult<PySnapshot> {
+        Ok(PySnapshot {
+            inner: Snapshot::load(path).map_err(to_py)?,
+        })
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Snapshot(time={}, particles={}, constraint equations={})",
+            self.inner.time(),
+            self.inner.particles(),
+            self.inner.constraints()
+        )
+    }
+}
+
+/// A running simulation of its own copy of a system.
+#[pyclass(name = "Simulation", module = "vinculo._core")]
+pub struct PySimulation {
+    // Declared before `_system`, so dropped before it: `sim` borrows the boxed system.
+    // In a mutex only to make the class Sync (Python holds the GIL around every call but
+    // step_to, which has the `&mut` borrow).
+    sim: Mutex<Simulation<'static>>,
+    // Never moved out of nor mutated while `sim` lives (the box keeps its address).
+    _system: Box<System>,
+    user_errors: PendingError,
+}
+
+impl PySimulation {
+    /// The running simulation.
+    fn sim(&self) -> MutexGuard<'_, Simulation<'static>> {
+        self.sim.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// Forgets the exception of a user function of an earlier call.
+    fn clear_pending(&self) {
+        self.user_errors
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .take();
+    }
+}
+
+#[pymethods]
+impl PySimulation {
+    #[new]
+    #[pyo3(signature = (system, t_end, dt, alpha=None, t_start=0.0, tolerance=1e-10, max_iterations=25,
+                        max_halvings=4, initial_tolerance=1e-8, save_every=1,
+                        jacobian_reuse=false, scheme="trapezoidal", rho_inf=None,
+                        formulation="index-3", adaptive=false, rtol=1e-6, atol=1e-6, h_min=1e-10,
+                        h_max=None, t_eval=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        system: PyRef<'_, PySystem>,
+        t_end: f64,
+        dt: f64,
+        alpha: Option<f64>,
+        t_start: f64,
+        tolerance: f64,
+        max_iterations: i64,
+        max_halvings: i64,
+        initial_tolerance: f64,
+        save_every: i64,
+        jacobian_reuse: bool,
+        scheme: &str,
+        rho_inf: Option<f64>,
+        formulation: &str,
+        adaptive: bool,
+        rtol: f64,
+        atol: f64,
+        h_min: f64,
+        h_max: Option<f64>,
+        t_eval: Option<Vec<f64>>,
+    ) -> PyResult<PySimulation> {
+        let options = options(
+            t_end,
+            dt,
+            alpha,
+            t_start,
+            tolerance,
+            max_iterations,
+            max_halvings,
+            initial_tolerance,
+            save_every,
+            jacobian_reuse,
+            (scheme, rho_inf, formulation),
+            (adaptive, rtol, atol, h_min, h_max),
+            t_eval,
+        )?;
+        // The simulation's own copy: editing the Python system afterwards does not reach it
+        // (driven laws and user groups are shared with the copy).
+        let model = Box::new(system.inner.clone());
+        let user_errors = system.user_errors.clone();
+        user_errors.lock().unwrap_or_else(|p| p.into_inner()).take();
+        // SAFETY: the reference points into the box, which lives as long as `sim` (dropped
+        // first, field order) and is never moved out of or mutated.
+        let borrowed: &'static System = unsafe { &*(model.as_ref() as *const System) };
+        let sim = Simulation::new(borrowed, &options).map_err(to_py)?;
+        Ok(PySimulation {
+            sim: Mutex::new(sim),
+            _system: model,
+            user_errors,
+        })
+    }
+
+    /// Advances to time t (at most t_end); returns None while the run goes on, else the error
+    /// dictionary of `_core.simulate` (the run stopped).
+    fn step_to<'py>(&mut self, py: Python<'py>, t: f64) -> PyResult<Option<Bound<'py, PyDict>>> {
+        if t.is_nan() || t < self.sim().time() {
+            return Err(invalid(
+                "t",
+                t,
+                &format!(
+                    "must not be before the current time {}; restore a snapshot to go back",
+                    self.sim().time()
+                ),
+            ));
+        }
+        if self.sim().status().is_err() {
+            return self.error(py);
+        }
+        self.clear_pending();
+        let sim = self.sim.get_mut().unwrap_or_else(|p| p.into_inner());
+        let result = py.detach(|| {
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| sim.step_to(t).is_ok()))
+        });
+        let ok = result.map_err(crate::errors::internal)?;
+        if ok {
+            Ok(None)
+        } else {
+            self.error(py)
+        }
+    }
+
+    /// The error dictionary of a stopped run (None while it goes on).
+    fn error<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let d = solution_dict(py, self.sim().solution(), &self.user_errors)?;
+        match d.get_item("error")? {
+            Some(e) if !e.is_none() => Ok(Some(e.cast_into::<PyDict>()?)),
+            _ => Ok(None),
+        }
+    }
+
+    /// Current time, in s.
+    #[getter]
+    fn time(&self) -> f64 {
+        self.sim().time()
+    }
+
+    /// Current positions, shape (n, 3).
+    #[getter]
+    fn positions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let sim = self.sim();
+        let q = sim.positions();
+        Array2::from_shape_vec((q.len(), 3), q.iter().flatten().copied().collect())
+            .expect("shape")
+            .into_pyarray(py)
+    }
+
+    /// Current velocities, shape (n, 3).
+    #[getter]
+    fn velocities<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let sim = self.sim();
+        let v = sim.velocities();
+        Array2::from_shape_vec((v.len(), 3), v.iter().flatten().copied().collect())
+            .expect("shape")
+            .into_pyarray(py)
+    }
+
+    /// Current multipliers, shape (m,).
+    #[getter]
+    fn multipliers<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        Array1::from(self.sim().multipliers().to_vec()).into_pyarray(py)
+    }
+
+    /// The stored states so far, as the dictionary of `_core.simulate`.
+    fn solution<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        solution_dict(py, self.sim().solution(), &self.user_errors)
+    }
+
+    /// A copy of the running state.
+    fn snapshot(&self) -> PySnapshot {
+        PySnapshot {
+            inner: self.sim().snapshot(),
+        }
+    }
+
+    /// Returns to the state of a snapshot of this simulation's model.
+    fn restore(&mut self, snapshot: &Bound<'_, PyAny>) -> PyResult<()> {
+        let Ok(snapshot) = snapshot.cast::<PySnapshot>() else {
+            return Err(invalid(
+                "snapshot",
+                snapshot.repr().map(|r| r.to_string()).unwrap_or_default(),
+                "expected a Snapshot taken by Simulation.snapshot()",
+            ));
+        };
+        self.sim().try_restore(&snapshot.get().inner).map_err(to_py)
+    }
+}

@@ -1,0 +1,279 @@
+//! Snapshot files: a [`Snapshot`] saved to and loaded from a small binary file.
+//!
+//! # Format (version 1)
+//!
+//! Little-endian throughout; every float is stored as its IEEE-754 bits, so a loaded snapshot
+//! is bit for bit the saved one.
+//!
+//! | field | type |
+//! |---|---|
+//! | magic `VNCLSNAP` | 8 bytes |
+//! | version (1) | u32 |
+//! | model fingerprint ([`crate::run::fingerprint`]), particles n, constraint equations m | 3 x u64 |
+//! | time | f64 |
+//! | positions, velocities, accelerations | 3 x (n x 3 f64) |
+//! | multipliers | m f64 |
+//! | the time rule's state: 4 arrays of 3-vectors, each a u64 length then length x 3 f64 | |
+//! | step controller tag (0: fixed steps), then top u32, unit f64, units u64, level u32, t_grid f64 | |
+//! | accepted steps, next output, stored rows, steps taken, steps rejected, accepted step sizes, factorisations | 7 x u64 |
+//! | checksum: FNV-1a 64 of every byte before it | u64 |
+//!
+//! Only snapshots of fixed-step runs that have not stopped are saved (the state of the error
+//! control is not part of the format).
+
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::integrators::RuleState;
+use crate::math::Vec3;
+use crate::run::{Carried, Controller, FixedSteps, Fnv, Snapshot};
+
+const MAGIC: &[u8; 8] = b"VNCLSNAP";
+const VERSION: u32 = 1;
+
+fn file_error(path: &Path, problem: impl Into<String>) -> Error {
+    Error::Snapshot {
+        what: format!("snapshot file {}", path.display()),
+        problem: problem.into(),
+    }
+}
+
+/// Appends the encoding of the values.
+struct Writer(Vec<u8>);
+
+impl Writer {
+    fn u32(&mut self, x: u32) {
+        self.0.extend_from_slice(&x.to_le_bytes());
+    }
+    fn u64(&mut self, x: u64) {
+        self.0.extend_from_slice(&x.to_le_bytes());
+    }
+    fn f64(&mut self, x: f64) {
+        self.0.extend_from_slice(&x.to_bits().to_le_bytes());
+    }
+    fn vecs(&mut self, xs: &[Vec3]) {
+        for x in xs.iter().flatten() {
+            self.f64(*x);
+        }
+    }
+    fn sized_vecs(&mut self, xs: &[Vec3]) {
+        self.u64(xs.len() as u64);
+        self.vecs(xs);
+    }
+}
+
+/// Reads the values back, failing on a short file.
+struct Reader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+    path: &'a Path,
+}
+
+impl Reader<'_> {
+    fn take(&mut self, n: usize) -> Result<&[u8]> {
+        let end = self.at.checked_add(n).filter(|&e| e <= self.bytes.len());
+        let end = end.ok_or_else(|| {
+            file_error(
+                self.path,
+                "the file is truncated or corrupt: save the snapshot again",
+            )
+        })?;
+        let out = &self.bytes[self.at..end];
+        self.at = end;
+        Ok(out)
+    }
+    fn u32(&mut self) -> Result<u32> {
+        Ok(u32::from_le_bytes(
+            self.take(4)?.try_into().expect("4 bytes"),
+        ))
+    }
+    fn u64(&mut self) -> Result<u64> {
+        Ok(u64::from_le_bytes(
+            self.take(8)?.try_into().expect("8 bytes"),
+        ))
+    }
+    fn usize(&mut self) -> Result<usize> {
+        let x = self.u64()?;
+        usize::try_from(x).map_err(|_| file_error(self.path, format!("a count of {x} is corrupt")))
+    }
+    fn f64(&mut self) -> Result<f64> {
+        Ok(f64::from_bits(self.u64()?))
+    }
+    fn vecs(&mut self, n: usize) -> Result<Vec<Vec3>> {
+        // The length is checked against the bytes left before anything is allocated.
+        if n.saturating_mul(24) > self.bytes.len() - self.at {
+            return Err(file_error(
+                self.path,
+                "the file is truncated or corrupt: save the snapshot again",
+            ));
+        }
+        (0..n)
+            .map(|_| Ok([self.f64()?, self.f64()?, self.f64()?]))
+            .collect()
+    }
+    fn sized_vecs(&mut self) -> Result<Vec<Vec3>> {
+        let n = self.usize()?;
+        self.vecs(n)
+    }
+}
+
+impl Snapshot {
+    /// Saves the snapshot to a file at `path` (format in the module documentation).
+    ///
+    /// # Errors
+    /// [`Error::Snapshot`] when the snapshot is of an error-controlled run or of a run that
+    /// stopped, or when the file cannot be written.
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
+        let path = path.as_ref();
+        let Controller::Fixed(fixed) = &self.carried.controller else {
+            return Err(file_error(
+                path,
+                "snapshots of error-controlled (adaptive) runs cannot be saved to a file; keep \
+                 them in memory or use fixed steps",
+            ));
+        };
+        if let Err(e) = &self.status {
+            return Err(file_error(
+                path,
+                format!("the run had stopped ({e}): save a snapshot taken before it stopped"),
+            ));
+        }
+        let c = &self.carried;
+        let mut w = Writer(Vec::new());
+        w.0.extend_from_slice(MAGIC);
+        w.u32(VERSION);
+        w.u64(self.fingerprint);
+        w.u64(c.q.len() as u64);
+        w.u64(c.lambda.len() as u64);
+        w.f64(c.t);
+        w.vecs(&c.q);
+        w.vecs(&c.v);
+        w.vecs(&c.acc);
+        for &x in &c.lambda {
+            w.f64(x);
+        }
+        w.sized_vecs(&c.rule.acceleration);
+        w.sized_vecs(&c.rule.algorithmic);
+        w.sized_vecs(&c.rule.predicted_q);
+        w.sized_vecs(&c.rule.predicted_v);
+        w.0.push(0);
+        w.u32(fixed.top);
+        w.f64(fixed.unit);
+        w.u64(fixed.units);
+        w.u32(fixed.level);
+        w.f64(fixed.t_grid);
+        for x in [
+            c.step,
+            c.next_output,
+            self.rows,
+            self.steps_taken,
+            self.steps_rejected,
+            self.accepted,
+            self.factorisations,
+        ] {
+            w.u64(x as u64);
+        }
+        let mut h = Fnv::new();
+        h.write(&w.0);
+        w.u64(h.finish());
+        std::fs::write(path, &w.0).map_err(|e| file_error(path, format!("cannot be written ({e})")))
+    }
+
+    /// Loads a snapshot saved by [`Snapshot::save`]; restore it with
+    /// [`crate::Simulation::try_restore`] into a simulation of the same model.
+    ///
+    /// # Errors
+    /// [`Error::Snapshot`] when the file cannot be read, is not a snapshot file, is of another
+    /// format version, or is truncated or corrupt (its checksum does not match).
+    pub fn load(path: impl AsRef<Path>) -> Result<Snapshot> {
+        let path = path.as_ref();
+        let bytes =
+            std::fs::read(path).map_err(|e| file_error(path, format!("cannot be read ({e})")))?;
+        if bytes.len() < MAGIC.len() + 4 + 8 || &bytes[..MAGIC.len()] != MAGIC {
+            return Err(file_error(
+                path,
+                "not a vinculo snapshot file (no VNCLSNAP header): give a file written by \
+                 save_snapshot",
+            ));
+        }
+        let (body, sum) = bytes.split_at(bytes.len() - 8);
+        let mut h = Fnv::new();
+        h.write(body);
+        let version = u32::from_le_bytes(body[8..12].try_into().expect("4 bytes"));
+        if version != VERSION {
+            return Err(file_error(
+                path,
+                format!("format version {version}; this vinculo reads version {VERSION}"),
+            ));
+        }
+        if h.finish() != u64::from_le_bytes(sum.try_into().expect("8 bytes")) {
+            return Err(file_error(
+                path,
+                "the file is corrupt (checksum mismatch): save the snapshot again",
+            ));
+        }
+        let mut r = Reader {
+            bytes: body,
+            at: 12,
+            path,
+        };
+        let fingerprint = r.u64()?;
+        let n = r.usize()?;
+        let m = r.usize()?;
+        let t = r.f64()?;
+        let q = r.vecs(n)?;
+        let v = r.vecs(n)?;
+        let acc = r.vecs(n)?;
+        if m.saturating_mul(8) > body.len() - r.at {
+            return Err(file_error(path, "the file is truncated or corrupt"));
+        }
+        let lambda = (0..m).map(|_| r.f64()).collect::<Result<Vec<f64>>>()?;
+        let rule = RuleState {
+            acceleration: r.sized_vecs()?,
+            algorithmic: r.sized_vecs()?,
+            predicted_q: r.sized_vecs()?,
+            predicted_v: r.sized_vecs()?,
+        };
+        let tag = r.take(1)?[0];
+        if tag != 0 {
+            return Err(file_error(path, format!("unknown step controller {tag}")));
+        }
+        let controller = Controller::Fixed(FixedSteps {
+            top: r.u32()?,
+            unit: r.f64()?,
+            units: r.u64()?,
+            level: r.u32()?,
+            t_grid: r.f64()?,
+        });
+        let mut counts = [0usize; 7];
+        for x in &mut counts {
+            *x = r.usize()?;
+        }
+        if r.at != body.len() {
+            return Err(file_error(path, "the file is corrupt (trailing bytes)"));
+        }
+        let [step, next_output, rows, steps_taken, steps_rejected, accepted, factorisations] =
+            counts;
+        Ok(Snapshot {
+            carried: Carried {
+                t,
+                q,
+                v,
+                acc,
+                lambda,
+                rule,
+                controller,
+                step,
+                next_output,
+            },
+            rows,
+            steps_taken,
+            steps_rejected,
+            accepted,
+            factorisations,
+            status: Ok(()),
+            fingerprint,
+            run: 0,
+        })
+    }
+}
