@@ -623,9 +623,9 @@ impl Simulation<'_> {
     }
 
     /// Whether the run is at `stop`: past it, or (fixed steps, a stop before the end) on the
-    /// grid point within a millionth of a step before it, where [`FixedSteps::propose`] lands a step meant for it
-    /// (a stop computed as k dt by the caller may differ from the grid time in the last bits;
-    /// another step of that difference would be a step of ~1e-17 s).
+    /// grid point within a millionth of a step before it, where [`FixedSteps::propose`] lands
+    /// a step meant for it (a stop computed as k dt by the caller may differ from the grid
+    /// time in the last bits; another step of that difference would be a step of ~1e-17 s).
     fn reached(&self, stop: f64) -> bool {
         let c = &self.carried;
         match &c.controller {
