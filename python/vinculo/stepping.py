@@ -31,10 +31,22 @@ class Simulation:
         t_end: the latest time the run may reach, in s (the last fixed step lands on it).
         dt: step size, in s (the first step with ``adaptive=True``).
         alpha: parameter of the generalised trapezoidal rule (see :func:`vinculo.simulate`).
-        **options: the keyword arguments of :func:`vinculo.simulate` (``scheme``, ``rho_inf``,
-            ``formulation``, ``t_start``, ``tolerance``, ``max_iterations``, ``max_halvings``,
-            ``initial_tolerance``, ``save_every``, ``jacobian_reuse``, ``adaptive``, ``rtol``,
-            ``atol``, ``h_min``, ``h_max``, ``t_eval``).
+        scheme: the time rule, as in :func:`vinculo.simulate`.
+        rho_inf: generalised-alpha's parameter, as in :func:`vinculo.simulate`.
+        formulation: 'index-3' or 'ggl', as in :func:`vinculo.simulate`.
+        t_start: initial time, in s.
+        tolerance: Newton tolerance, as in :func:`vinculo.simulate`.
+        max_iterations: Newton iterations allowed per attempt.
+        max_halvings: how many times a failing step may be halved.
+        initial_tolerance: largest initial violation accepted, as in :func:`vinculo.simulate`.
+        save_every: store every k-th step.
+        jacobian_reuse: modified Newton, as in :func:`vinculo.simulate`.
+        adaptive: error-controlled steps, as in :func:`vinculo.simulate`.
+        rtol: relative tolerance of adaptive steps.
+        atol: absolute tolerance of adaptive steps, in m.
+        h_min: smallest adaptive step, in s.
+        h_max: largest adaptive step, in s (default: no limit).
+        t_eval: times at which to store the state with ``adaptive=True``.
 
     Raises:
         InvalidInputError: a bad argument (as :func:`vinculo.simulate`).

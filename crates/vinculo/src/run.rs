@@ -601,7 +601,16 @@ impl Simulation<'_> {
         t: f64,
         observer: &mut dyn Observer,
     ) -> &std::result::Result<(), Error> {
-        let stop = t.min(self.options.t_end);
+        if t.is_nan() {
+            return &self.sol.status;
+        }
+        let t_end = self.options.t_end;
+        // A stop within a millionth of a fixed step of the end is the end (the run lands there).
+        let near_end = match &self.carried.controller {
+            Controller::Fixed(fixed) => t_end - t <= 1e-6 * fixed.nominal(),
+            Controller::Adaptive(_) => false,
+        };
+        let stop = if near_end { t_end } else { t };
         while self.sol.status.is_ok() && !self.reached(stop) {
             if let Next::Stop = self.attempt(stop, observer) {
                 break;
@@ -613,13 +622,15 @@ impl Simulation<'_> {
         &self.sol.status
     }
 
-    /// Whether the run is at `stop`: past it, or (fixed steps) on the grid point within a
-    /// millionth of a step before it, where [`FixedSteps::propose`] lands a step meant for it
-    /// (a stop computed as k dt by the caller may differ from the grid time in the last bits;
-    /// another step of that difference would be a step of ~1e-17 s).
+    /// Whether the run is at `stop`: past it, or (fixed steps, a stop before the end) on the
+    /// grid point within a millionth of a step before it, where [`FixedSteps::propose`] lands
+    /// a step meant for it (a stop computed as k dt by the caller may differ from the grid
+    /// time in the last bits; another step of that difference would be a step of ~1e-17 s).
     fn reached(&self, stop: f64) -> bool {
         let c = &self.carried;
         match &c.controller {
+            // The end is reached only when landed on (its step stores the last state).
+            Controller::Fixed(_) if stop >= self.options.t_end => c.t >= stop,
             Controller::Fixed(fixed) => stop - c.t <= 1e-6 * fixed.nominal(),
             Controller::Adaptive(_) => c.t >= stop,
         }

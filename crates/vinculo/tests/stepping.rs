@@ -235,3 +235,28 @@ fn snapshot_file_continues_the_run_bit_for_bit() {
     assert!(err.to_string().contains("another system"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Stops computed by the caller as k * 0.05 (3 * 0.05 = 0.15000000000000002, one bit past the
+/// grid time 0.15 of 15 steps of 0.01) land on the grid and count as reached: the run is one
+/// `simulate` call bit for bit (without the tolerance, a second step of ~1e-17 s would follow);
+/// so does a stop a few bits before the end.
+#[test]
+fn stops_a_few_bits_off_the_grid_change_no_step() {
+    let system = chain();
+    let options = SimulationOptions {
+        t_end: 0.25,
+        dt: 1e-2,
+        ..Default::default()
+    };
+    assert_ne!(3.0 * 0.05, 0.15);
+    let mut run = Simulation::new(&system, &options).unwrap();
+    for k in 1..=4 {
+        run.step_to(k as f64 * 0.05).clone().unwrap();
+    }
+    // A stop a few bits before the end is the end (the last step lands on t_end).
+    run.step_to(0.25 - 1e-15).clone().unwrap();
+    assert_eq!(run.time(), 0.25);
+    run.step_to(0.25).clone().unwrap();
+    let one_call = simulate(&system, &options).unwrap();
+    assert_same_run(&one_call, run.solution(), "stops at k * 0.05");
+}
