@@ -165,29 +165,24 @@ def simulate(
             is the ``__cause__``; ``solution`` holds the steps completed before).
         UserFunctionOutputError: such a function returned a wrong shape or a non-finite value.
     """
-    if not isinstance(scheme, str):
-        raise errors.InvalidInputError(
-            f"scheme must be a name ('trapezoidal', 'backward-euler' or 'generalized-alpha'), "
-            f"got {scheme!r}",
-            name="scheme",
-            value=scheme,
-        )
-    times = None
-    if t_eval is not None:
-        times = np.asarray(t_eval, dtype=np.float64)
-        if times.ndim != 1:
-            raise errors.InvalidInputError(
-                f"t_eval must be a 1-D sequence of times, got an array of shape {times.shape}",
-                name="t_eval",
-                value=t_eval,
-            )
-        times = [float(x) for x in times]
-    if not isinstance(formulation, str):
-        raise errors.InvalidInputError(
-            f"formulation must be a name ('index-3' or 'ggl'), got {formulation!r}",
-            name="formulation",
-            value=formulation,
-        )
+    options = _run_options(
+        scheme=scheme,
+        rho_inf=rho_inf,
+        formulation=formulation,
+        t_start=t_start,
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+        max_halvings=max_halvings,
+        initial_tolerance=initial_tolerance,
+        save_every=save_every,
+        jacobian_reuse=jacobian_reuse,
+        adaptive=adaptive,
+        rtol=rtol,
+        atol=atol,
+        h_min=h_min,
+        h_max=h_max,
+        t_eval=t_eval,
+    )
     bar: ProgressBar | None = None
     callback: ProgressCallback | None
     if progress is True:
@@ -204,29 +199,7 @@ def simulate(
             value=progress,
         )
     try:
-        data = _core.simulate(
-            system,
-            t_end,
-            dt,
-            alpha,
-            t_start=t_start,
-            tolerance=tolerance,
-            max_iterations=max_iterations,
-            max_halvings=max_halvings,
-            initial_tolerance=initial_tolerance,
-            save_every=save_every,
-            progress=callback,
-            jacobian_reuse=bool(jacobian_reuse),
-            scheme=scheme,
-            rho_inf=rho_inf,
-            adaptive=bool(adaptive),
-            rtol=rtol,
-            atol=atol,
-            h_min=h_min,
-            h_max=h_max,
-            t_eval=times,
-            formulation=formulation,
-        )
+        data = _core.simulate(system, t_end, dt, alpha, progress=callback, **options)
     finally:
         if bar is not None:
             bar.close()
@@ -241,6 +214,81 @@ def simulate(
         raise _convergence_error(solution.error, solution) from cause
     return solution
 
+
+
+def _run_options(
+    *,
+    scheme: str,
+    rho_inf: float | None,
+    formulation: str,
+    t_start: float,
+    tolerance: float,
+    max_iterations: int,
+    max_halvings: int,
+    initial_tolerance: float,
+    save_every: int,
+    jacobian_reuse: bool,
+    adaptive: bool,
+    rtol: float,
+    atol: float,
+    h_min: float,
+    h_max: float | None,
+    t_eval: Sequence[float] | np.ndarray | None,
+) -> dict[str, Any]:
+    """The keyword arguments of a run as the compiled core takes them, for :func:`simulate` and
+    :class:`vinculo.Simulation` alike (their meaning: :func:`simulate`).
+
+    The core checks every value's range; this checks what Python must convert first: the names
+    are strings and ``t_eval`` is one-dimensional.
+
+    Returns:
+        The keyword arguments of ``_core.simulate`` and ``_core.Simulation`` (less ``progress``).
+
+    Raises:
+        InvalidInputError: ``scheme`` or ``formulation`` is not a string, or ``t_eval`` is not a
+            1-D sequence of times.
+    """
+    if not isinstance(scheme, str):
+        raise errors.InvalidInputError(
+            f"scheme must be a name ('trapezoidal', 'backward-euler' or 'generalized-alpha'), "
+            f"got {scheme!r}",
+            name="scheme",
+            value=scheme,
+        )
+    if not isinstance(formulation, str):
+        raise errors.InvalidInputError(
+            f"formulation must be a name ('index-3' or 'ggl'), got {formulation!r}",
+            name="formulation",
+            value=formulation,
+        )
+    times = None
+    if t_eval is not None:
+        array = np.asarray(t_eval, dtype=np.float64)
+        if array.ndim != 1:
+            raise errors.InvalidInputError(
+                f"t_eval must be a 1-D sequence of times, got an array of shape {array.shape}",
+                name="t_eval",
+                value=t_eval,
+            )
+        times = [float(x) for x in array]
+    return {
+        "scheme": scheme,
+        "rho_inf": rho_inf,
+        "formulation": formulation,
+        "t_start": t_start,
+        "tolerance": tolerance,
+        "max_iterations": max_iterations,
+        "max_halvings": max_halvings,
+        "initial_tolerance": initial_tolerance,
+        "save_every": save_every,
+        "jacobian_reuse": bool(jacobian_reuse),
+        "adaptive": bool(adaptive),
+        "rtol": rtol,
+        "atol": atol,
+        "h_min": h_min,
+        "h_max": h_max,
+        "t_eval": times,
+    }
 
 def _convergence_error(error: dict[str, Any], solution: Solution) -> errors.VinculoError:
     """The exception for a run the core stopped early, carrying the partial solution."""

@@ -7,9 +7,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from vinculo import _core, errors
+from vinculo import _core
 from vinculo._core import Snapshot, System
-from vinculo.simulate import _convergence_error
+from vinculo.simulate import _convergence_error, _run_options
 from vinculo.solution import Solution
 
 __all__ = ["Simulation", "Snapshot"]
@@ -77,46 +77,26 @@ class Simulation:
         h_max: float | None = None,
         t_eval: Sequence[float] | np.ndarray | None = None,
     ) -> None:
-        for name, value in (("scheme", scheme), ("formulation", formulation)):
-            if not isinstance(value, str):
-                raise errors.InvalidInputError(
-                    f"{name} must be a name as in vinculo.simulate, got {value!r}",
-                    name=name,
-                    value=value,
-                )
-        times = None
-        if t_eval is not None:
-            array = np.asarray(t_eval, dtype=np.float64)
-            if array.ndim != 1:
-                raise errors.InvalidInputError(
-                    f"t_eval must be a 1-D sequence of times, got an array of shape {array.shape}",
-                    name="t_eval",
-                    value=t_eval,
-                )
-            times = [float(x) for x in array]
         self._system = system.copy()
-        self._core = _core.Simulation(
-            system,
-            t_end,
-            dt,
-            alpha,
+        options = _run_options(
+            scheme=scheme,
+            rho_inf=rho_inf,
+            formulation=formulation,
             t_start=t_start,
             tolerance=tolerance,
             max_iterations=max_iterations,
             max_halvings=max_halvings,
             initial_tolerance=initial_tolerance,
             save_every=save_every,
-            jacobian_reuse=bool(jacobian_reuse),
-            scheme=scheme,
-            rho_inf=rho_inf,
-            formulation=formulation,
-            adaptive=bool(adaptive),
+            jacobian_reuse=jacobian_reuse,
+            adaptive=adaptive,
             rtol=rtol,
             atol=atol,
             h_min=h_min,
             h_max=h_max,
-            t_eval=times,
+            t_eval=t_eval,
         )
+        self._core = _core.Simulation(system, t_end, dt, alpha, **options)
 
     def step_to(self, t: float) -> None:
         """Advance to time ``t`` (at most ``t_end``).
