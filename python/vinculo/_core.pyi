@@ -448,15 +448,25 @@ class System:
         least mass-weighted change; returns {'position_change': max |dq|, 'velocity_change': max |dv|,
         'iterations': n}."""
 
-def simulate(system: System, t_end: float, dt: float, alpha: float | None = None, t_start: float = 0.0,
-             tolerance: float = 1e-10, max_iterations: int = 25, max_halvings: int = 4,
-             initial_tolerance: float = 1e-8, save_every: int = 1,
-             progress: Callable[[float, float], None] | None = None,
-             jacobian_reuse: bool = False, scheme: str = "trapezoidal",
-             rho_inf: float | None = None, formulation: str = "index-3",
-             adaptive: bool = False, rtol: float = 1e-6, atol: float = 1e-6,
-             h_min: float = 1e-10, h_max: float | None = None,
-             t_eval: list[float] | None = None) -> dict:
+class RunSettings:
+    """The settings of a run (the keyword arguments of ``vinculo.simulate`` less ``progress``,
+    with the same names, defaults and meaning), converted to the core's options and checked once.
+    ``simulate`` and ``Simulation`` take it.
+
+    Raises:
+        InvalidInputError: a value out of its range (as ``vinculo.simulate``).
+    """
+    def __init__(self, t_end: float, dt: float, alpha: float | None = None, t_start: float = 0.0,
+                 tolerance: float = 1e-10, max_iterations: int = 25, max_halvings: int = 4,
+                 initial_tolerance: float = 1e-8, save_every: int = 1,
+                 jacobian_reuse: bool = False, scheme: str = "trapezoidal",
+                 rho_inf: float | None = None, formulation: str = "index-3",
+                 adaptive: bool = False, rtol: float = 1e-6, atol: float = 1e-6,
+                 h_min: float = 1e-10, h_max: float | None = None,
+                 t_eval: list[float] | None = None) -> None: ...
+
+def simulate(system: System, settings: RunSettings,
+             progress: Callable[[float, float], None] | None = None) -> dict:
     """Integrate; returns a dict of numpy arrays:
     times (s,), positions (s, n, 3), velocities (s, n, 3), multipliers (s, m),
     constraint_residual (s,) [max_k |s_k Phi_k| at each stored time, metres],
@@ -506,27 +516,17 @@ class Snapshot:
         """
 
 class Simulation:
-    """The core's stepping object; ``vinculo.Simulation`` wraps it (same arguments as ``simulate``
-    without ``progress``).
+    """The core's stepping object; ``vinculo.Simulation`` wraps it.
 
     Arguments:
         system: the model (the simulation keeps its own copy).
-        t_end: the latest time the run may reach, in s.
-        dt: step size, in s.
-        alpha: parameter of the generalised trapezoidal rule.
+        settings: the run's settings (``RunSettings``: t_end, dt and the rest).
 
     Raises:
         InvalidInputError: a bad argument.
         InconsistentInitialStateError: the initial state violates a constraint.
     """
-    def __init__(self, system: System, t_end: float, dt: float, alpha: float | None = None,
-                 t_start: float = 0.0, tolerance: float = 1e-10, max_iterations: int = 25,
-                 max_halvings: int = 4, initial_tolerance: float = 1e-8, save_every: int = 1,
-                 jacobian_reuse: bool = False, scheme: str = "trapezoidal",
-                 rho_inf: float | None = None, formulation: str = "index-3",
-                 adaptive: bool = False, rtol: float = 1e-6, atol: float = 1e-6,
-                 h_min: float = 1e-10, h_max: float | None = None,
-                 t_eval: list[float] | None = None) -> None: ...
+    def __init__(self, system: System, settings: RunSettings) -> None: ...
     def step_to(self, t: float) -> dict | None:
         """Advance to time t (at most t_end).
 

@@ -165,7 +165,10 @@ def simulate(
             is the ``__cause__``; ``solution`` holds the steps completed before).
         UserFunctionOutputError: such a function returned a wrong shape or a non-finite value.
     """
-    options = _run_options(
+    settings = _run_settings(
+        t_end,
+        dt,
+        alpha,
         scheme=scheme,
         rho_inf=rho_inf,
         formulation=formulation,
@@ -199,7 +202,7 @@ def simulate(
             value=progress,
         )
     try:
-        data = _core.simulate(system, t_end, dt, alpha, progress=callback, **options)
+        data = _core.simulate(system, settings, progress=callback)
     finally:
         if bar is not None:
             bar.close()
@@ -216,7 +219,10 @@ def simulate(
 
 
 
-def _run_options(
+def _run_settings(
+    t_end: float,
+    dt: float,
+    alpha: float | None,
     *,
     scheme: str,
     rho_inf: float | None,
@@ -234,15 +240,16 @@ def _run_options(
     h_min: float,
     h_max: float | None,
     t_eval: Sequence[float] | np.ndarray | None,
-) -> dict[str, Any]:
-    """The keyword arguments of a run as the compiled core takes them, for :func:`simulate` and
+) -> _core.RunSettings:
+    """The settings of a run, as one object of the compiled core, for :func:`simulate` and
     :class:`vinculo.Simulation` alike (their meaning: :func:`simulate`).
 
-    The core checks every value's range; this checks what Python must convert first: the names
-    are strings and ``t_eval`` is one-dimensional.
+    The core checks every value's range when it builds the settings; this checks first what
+    Python must convert: the names are strings and ``t_eval`` is one-dimensional.
 
     Returns:
-        The keyword arguments of ``_core.simulate`` and ``_core.Simulation`` (less ``progress``).
+        The core's ``RunSettings`` (its ``SimulationOptions``), taken by ``_core.simulate`` and
+        ``_core.Simulation``.
 
     Raises:
         InvalidInputError: ``scheme`` or ``formulation`` is not a string, or ``t_eval`` is not a
@@ -271,24 +278,27 @@ def _run_options(
                 value=t_eval,
             )
         times = [float(x) for x in array]
-    return {
-        "scheme": scheme,
-        "rho_inf": rho_inf,
-        "formulation": formulation,
-        "t_start": t_start,
-        "tolerance": tolerance,
-        "max_iterations": max_iterations,
-        "max_halvings": max_halvings,
-        "initial_tolerance": initial_tolerance,
-        "save_every": save_every,
-        "jacobian_reuse": bool(jacobian_reuse),
-        "adaptive": bool(adaptive),
-        "rtol": rtol,
-        "atol": atol,
-        "h_min": h_min,
-        "h_max": h_max,
-        "t_eval": times,
-    }
+    return _core.RunSettings(
+        t_end,
+        dt,
+        alpha,
+        scheme=scheme,
+        rho_inf=rho_inf,
+        formulation=formulation,
+        t_start=t_start,
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+        max_halvings=max_halvings,
+        initial_tolerance=initial_tolerance,
+        save_every=save_every,
+        jacobian_reuse=bool(jacobian_reuse),
+        adaptive=bool(adaptive),
+        rtol=rtol,
+        atol=atol,
+        h_min=h_min,
+        h_max=h_max,
+        t_eval=times,
+    )
 
 def _convergence_error(error: dict[str, Any], solution: Solution) -> errors.VinculoError:
     """The exception for a run the core stopped early, carrying the partial solution."""

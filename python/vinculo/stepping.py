@@ -9,7 +9,7 @@ import numpy as np
 
 from vinculo import _core
 from vinculo._core import Snapshot, System
-from vinculo.simulate import _convergence_error, _run_options
+from vinculo.simulate import _convergence_error, _run_settings
 from vinculo.solution import Solution
 
 __all__ = ["Simulation", "Snapshot"]
@@ -78,7 +78,10 @@ class Simulation:
         t_eval: Sequence[float] | np.ndarray | None = None,
     ) -> None:
         self._system = system.copy()
-        options = _run_options(
+        settings = _run_settings(
+            t_end,
+            dt,
+            alpha,
             scheme=scheme,
             rho_inf=rho_inf,
             formulation=formulation,
@@ -96,7 +99,7 @@ class Simulation:
             h_max=h_max,
             t_eval=t_eval,
         )
-        self._core = _core.Simulation(system, t_end, dt, alpha, **options)
+        self._core = _core.Simulation(system, settings)
 
     def step_to(self, t: float) -> None:
         """Advance to time ``t`` (at most ``t_end``).

@@ -20,6 +20,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<user_physics::PyUserGroup>()?;
     m.add_class::<stepping::PySimulation>()?;
     m.add_class::<stepping::PySnapshot>()?;
+    m.add_class::<run::PyRunSettings>()?;
     m.add_function(wrap_pyfunction!(run::simulate, m)?)?;
     Ok(())
 }

@@ -92,51 +92,14 @@ fn formulation_by_name(name: &str) -> PyResult<Formulation> {
 
 /// Integrates the system; see the type stubs (`_core.pyi`) for the returned dictionary.
 #[pyfunction]
-#[pyo3(signature = (system, t_end, dt, alpha=None, t_start=0.0, tolerance=1e-10, max_iterations=25,
-                    max_halvings=4, initial_tolerance=1e-8, save_every=1, progress=None,
-                    jacobian_reuse=false, scheme="trapezoidal", rho_inf=None,
-                    formulation="index-3", adaptive=false, rtol=1e-6, atol=1e-6, h_min=1e-10,
-                    h_max=None, t_eval=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (system, settings, progress=None))]
 pub fn simulate<'py>(
     py: Python<'py>,
     system: PyRef<'py, PySystem>,
-    t_end: f64,
-    dt: f64,
-    alpha: Option<f64>,
-    t_start: f64,
-    tolerance: f64,
-    max_iterations: i64,
-    max_halvings: i64,
-    initial_tolerance: f64,
-    save_every: i64,
+    settings: PyRef<'py, PyRunSettings>,
     progress: Option<Py<PyAny>>,
-    jacobian_reuse: bool,
-    scheme: &str,
-    rho_inf: Option<f64>,
-    formulation: &str,
-    adaptive: bool,
-    rtol: f64,
-    atol: f64,
-    h_min: f64,
-    h_max: Option<f64>,
-    t_eval: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let options = options(
-        t_end,
-        dt,
-        alpha,
-        t_start,
-        tolerance,
-        max_iterations,
-        max_halvings,
-        initial_tolerance,
-        save_every,
-        jacobian_reuse,
-        (scheme, rho_inf, formulation),
-        (adaptive, rtol, atol, h_min, h_max),
-        t_eval,
-    )?;
+    let options = &settings.options;
     let model = &system.inner;
     // The exception of a user function of an earlier run is no longer of interest.
     let pending = system.user_errors.clone();
@@ -148,7 +111,7 @@ pub fn simulate<'py>(
     };
     let result = py.detach(|| {
         std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            simulate_with_observer(model, &options, &mut observer)
+            simulate_with_observer(model, options, &mut observer)
         }))
     });
     if let Some(e) = observer.error.take() {
@@ -167,9 +130,69 @@ pub fn simulate<'py>(
     solution_dict(py, &sol, &pending)
 }
 
-/// The core's options from the keyword arguments of `simulate` (shared with `Simulation`).
+/// The settings of a run (the keyword arguments of `vinculo.simulate`, less `progress`), converted
+/// to the core's `SimulationOptions` and checked once; `simulate` and `Simulation` take it.
+#[pyclass(name = "RunSettings", module = "vinculo._core", frozen)]
+pub struct PyRunSettings {
+    pub(crate) options: SimulationOptions,
+}
+
+#[pymethods]
+impl PyRunSettings {
+    #[new]
+    #[pyo3(signature = (t_end, dt, alpha=None, t_start=0.0, tolerance=1e-10, max_iterations=25,
+                        max_halvings=4, initial_tolerance=1e-8, save_every=1,
+                        jacobian_reuse=false, scheme="trapezoidal", rho_inf=None,
+                        formulation="index-3", adaptive=false, rtol=1e-6, atol=1e-6, h_min=1e-10,
+                        h_max=None, t_eval=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        t_end: f64,
+        dt: f64,
+        alpha: Option<f64>,
+        t_start: f64,
+        tolerance: f64,
+        max_iterations: i64,
+        max_halvings: i64,
+        initial_tolerance: f64,
+        save_every: i64,
+        jacobian_reuse: bool,
+        scheme: &str,
+        rho_inf: Option<f64>,
+        formulation: &str,
+        adaptive: bool,
+        rtol: f64,
+        atol: f64,
+        h_min: f64,
+        h_max: Option<f64>,
+        t_eval: Option<Vec<f64>>,
+    ) -> PyResult<Self> {
+        let options = options(
+            t_end,
+            dt,
+            alpha,
+            t_start,
+            tolerance,
+            max_iterations,
+            max_halvings,
+            initial_tolerance,
+            save_every,
+            jacobian_reuse,
+            (scheme, rho_inf, formulation),
+            (adaptive, rtol, atol, h_min, h_max),
+            t_eval,
+        )?;
+        Ok(Self { options })
+    }
+
+    fn __repr__(&self) -> String {
+        format!("RunSettings({:?})", self.options)
+    }
+}
+
+/// The core's options from the keyword arguments of `simulate` (for `RunSettings`).
 #[allow(clippy::too_many_arguments)]
-pub fn options(
+fn options(
     t_end: f64,
     dt: f64,
     alpha: Option<f64>,

@@ -1,7 +1,7 @@
 //! `Simulation`: the core's stepping object behind a Python class (glue only).
 
 use crate::errors::{invalid, to_py};
-use crate::run::{options, solution_dict};
+use crate::run::{solution_dict, PyRunSettings};
 use crate::system::PySystem;
 use crate::user_physics::PendingError;
 use numpy::ndarray::{Array1, Array2};
@@ -80,49 +80,12 @@ impl PySimulation {
 #[pymethods]
 impl PySimulation {
     #[new]
-    #[pyo3(signature = (system, t_end, dt, alpha=None, t_start=0.0, tolerance=1e-10, max_iterations=25,
-                        max_halvings=4, initial_tolerance=1e-8, save_every=1,
-                        jacobian_reuse=false, scheme="trapezoidal", rho_inf=None,
-                        formulation="index-3", adaptive=false, rtol=1e-6, atol=1e-6, h_min=1e-10,
-                        h_max=None, t_eval=None))]
-    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (system, settings))]
     fn new(
         system: PyRef<'_, PySystem>,
-        t_end: f64,
-        dt: f64,
-        alpha: Option<f64>,
-        t_start: f64,
-        tolerance: f64,
-        max_iterations: i64,
-        max_halvings: i64,
-        initial_tolerance: f64,
-        save_every: i64,
-        jacobian_reuse: bool,
-        scheme: &str,
-        rho_inf: Option<f64>,
-        formulation: &str,
-        adaptive: bool,
-        rtol: f64,
-        atol: f64,
-        h_min: f64,
-        h_max: Option<f64>,
-        t_eval: Option<Vec<f64>>,
+        settings: PyRef<'_, PyRunSettings>,
     ) -> PyResult<PySimulation> {
-        let options = options(
-            t_end,
-            dt,
-            alpha,
-            t_start,
-            tolerance,
-            max_iterations,
-            max_halvings,
-            initial_tolerance,
-            save_every,
-            jacobian_reuse,
-            (scheme, rho_inf, formulation),
-            (adaptive, rtol, atol, h_min, h_max),
-            t_eval,
-        )?;
+        let options = &settings.options;
         // The simulation's own copy: editing the Python system afterwards does not reach it
         // (driven laws and user groups are shared with the copy).
         let model = Box::new(system.inner.clone());
@@ -131,7 +94,7 @@ impl PySimulation {
         // SAFETY: the reference points into the box, which lives as long as `sim` (dropped
         // first, field order) and is never moved out of or mutated.
         let borrowed: &'static System = unsafe { &*(model.as_ref() as *const System) };
-        let sim = Simulation::new(borrowed, &options).map_err(to_py)?;
+        let sim = Simulation::new(borrowed, options).map_err(to_py)?;
         Ok(PySimulation {
             sim: Mutex::new(sim),
             _system: model,
