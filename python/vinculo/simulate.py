@@ -218,34 +218,24 @@ def simulate(
     return solution
 
 
-
 def _run_settings(
     t_end: float,
     dt: float,
     alpha: float | None,
     *,
     scheme: str,
-    rho_inf: float | None,
     formulation: str,
-    t_start: float,
-    tolerance: float,
-    max_iterations: int,
-    max_halvings: int,
-    initial_tolerance: float,
-    save_every: int,
     jacobian_reuse: bool,
     adaptive: bool,
-    rtol: float,
-    atol: float,
-    h_min: float,
-    h_max: float | None,
     t_eval: Sequence[float] | np.ndarray | None,
+    **options: Any,
 ) -> _core.RunSettings:
     """The settings of a run, as one object of the compiled core, for :func:`simulate` and
     :class:`vinculo.Simulation` alike (their meaning: :func:`simulate`).
 
     The core checks every value's range when it builds the settings; this checks first what
-    Python must convert: the names are strings and ``t_eval`` is one-dimensional.
+    Python must convert: the names are strings and ``t_eval`` is one-dimensional. ``options`` are
+    the other keyword arguments of :func:`simulate` (less ``progress``), passed on unchanged.
 
     Returns:
         The core's ``RunSettings`` (its ``SimulationOptions``), taken by ``_core.simulate`` and
@@ -283,21 +273,11 @@ def _run_settings(
         dt,
         alpha,
         scheme=scheme,
-        rho_inf=rho_inf,
         formulation=formulation,
-        t_start=t_start,
-        tolerance=tolerance,
-        max_iterations=max_iterations,
-        max_halvings=max_halvings,
-        initial_tolerance=initial_tolerance,
-        save_every=save_every,
         jacobian_reuse=bool(jacobian_reuse),
         adaptive=bool(adaptive),
-        rtol=rtol,
-        atol=atol,
-        h_min=h_min,
-        h_max=h_max,
         t_eval=times,
+        **options,
     )
 
 def _convergence_error(error: dict[str, Any], solution: Solution) -> errors.VinculoError:

@@ -167,81 +167,47 @@ impl PyRunSettings {
         h_max: Option<f64>,
         t_eval: Option<Vec<f64>>,
     ) -> PyResult<Self> {
-        let options = options(
+        let count = |name: &str, v: i64, min: i64| -> PyResult<usize> {
+            if v < min {
+                Err(invalid(name, v, &format!("must be an integer >= {min}")))
+            } else {
+                Ok(v as usize)
+            }
+        };
+        let options = SimulationOptions {
+            t_start,
             t_end,
             dt,
-            alpha,
-            t_start,
-            tolerance,
-            max_iterations,
-            max_halvings,
+            scheme: scheme_by_name(scheme, alpha, rho_inf)?,
+            formulation: formulation_by_name(formulation)?,
+            newton: NewtonOptions {
+                tolerance,
+                max_iterations: count("max_iterations", max_iterations, 1)?,
+                jacobian_reuse,
+            },
+            max_halvings: count("max_halvings", max_halvings, 0)?,
             initial_tolerance,
-            save_every,
-            jacobian_reuse,
-            (scheme, rho_inf, formulation),
-            (adaptive, rtol, atol, h_min, h_max),
-            t_eval,
-        )?;
+            save_every: count("save_every", save_every, 1)?,
+            step_control: if adaptive {
+                StepControl::Adaptive(AdaptiveOptions {
+                    rtol,
+                    atol,
+                    h_min,
+                    h_max: h_max.unwrap_or(f64::INFINITY),
+                    ..Default::default()
+                })
+            } else {
+                StepControl::Fixed
+            },
+            output_times: t_eval,
+            ..Default::default()
+        };
         Ok(Self { options })
     }
 
     fn __repr__(&self) -> String {
         format!("RunSettings({:?})", self.options)
     }
-}
-
-/// The core's options from the keyword arguments of `simulate` (for `RunSettings`).
-#[allow(clippy::too_many_arguments)]
-fn options(
-    t_end: f64,
-    dt: f64,
-    alpha: Option<f64>,
-    t_start: f64,
-    tolerance: f64,
-    max_iterations: i64,
-    max_halvings: i64,
-    initial_tolerance: f64,
-    save_every: i64,
-    jacobian_reuse: bool,
-    (scheme, rho_inf, formulation): (&str, Option<f64>, &str),
-    (adaptive, rtol, atol, h_min, h_max): (bool, f64, f64, f64, Option<f64>),
-    t_eval: Option<Vec<f64>>,
-) -> PyResult<SimulationOptions> {
-    let count = |name: &str, v: i64, min: i64| -> PyResult<usize> {
-        if v < min {
-            Err(invalid(name, v, &format!("must be an integer >= {min}")))
-        } else {
-            Ok(v as usize)
-        }
-    };
-    Ok(SimulationOptions {
-        t_start,
-        t_end,
-        dt,
-        scheme: scheme_by_name(scheme, alpha, rho_inf)?,
-        formulation: formulation_by_name(formulation)?,
-        newton: NewtonOptions {
-            tolerance,
-            max_iterations: count("max_iterations", max_iterations, 1)?,
-            jacobian_reuse,
-        },
-        max_halvings: count("max_halvings", max_halvings, 0)?,
-        initial_tolerance,
-        save_every: count("save_every", save_every, 1)?,
-        step_control: if adaptive {
-            StepControl::Adaptive(AdaptiveOptions {
-                rtol,
-                atol,
-                h_min,
-                h_max: h_max.unwrap_or(f64::INFINITY),
-                ..Default::default()
-            })
-        } else {
-            StepControl::Fixed
-        },
-        output_times: t_eval,
-        ..Default::default()
-    })
 }
 
 /// The dictionary `Solution.from_core` reads (stubs, `_core.pyi`), with the user's exception of a
