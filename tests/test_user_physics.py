@@ -421,7 +421,9 @@ def test_bad_groups_are_refused_when_added():
     with pytest.raises(vinculo.UnknownHandleError):
         system.add_force_group([0, 7], force)
     with pytest.raises(vinculo.InvalidInputError, match="particles"):
-        system.add_force_group(np.zeros((2, 3), dtype=int), force)
+        system.add_force_group(np.zeros((2, 2, 3), dtype=int), force)
+    with pytest.raises(vinculo.InvalidInputError, match="itself"):
+        system.add_force_group([[0, 1, 0]], force)
     with pytest.raises(vinculo.InvalidInputError, match="integer"):
         system.add_force_group([0.5, 1.0], force)
     with pytest.raises(vinculo.InvalidInputError, match="itself"):

@@ -283,11 +283,11 @@ class System:
     ) -> "UserGroup":
         """Forces computed by one Python function for a whole group of elements at once.
 
-        ``particles`` is a (k,) integer array (one particle per element, arity 1) or (k, 2)
-        (two per element, arity 2) of particle indices (``ParticleId.index``). Once per
+        ``particles`` is a (k,) integer array (one particle per element, arity 1) or (k, a)
+        (a particles per element, arity a: pairs, triples or more) of particle indices (``ParticleId.index``). Once per
         evaluation point (each Newton residual) the core calls ``force(t, q, v)`` with the
         positions and velocities of every element's particles, arrays of shape (k, 3) for arity 1
-        or (k, 2, 3) for arity 2, and expects the forces on those particles (N) in the same
+        or (k, a, 3) for arity a >= 2, and expects the forces on those particles (N) in the same
         shape. Element i's result must depend only on ``t`` and row i of ``q`` and ``v``.
 
         ``jacobian(t, q, v)`` returns ``(df_dq, df_dv)``, each (k, 3a, 3a) with a the arity:

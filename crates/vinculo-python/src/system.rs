@@ -423,11 +423,11 @@ impl PySystem {
 
     /// Forces computed by one Python function for a whole group of elements at once.
     ///
-    /// `particles`: (k,) integer array (one particle per element) or (k, 2) (pairs) of
-    /// particle indices. `force(t, q, v)` gets the elements' positions and velocities, (k, 3)
-    /// or (k, 2, 3), and returns the forces on those particles in the same shape; element i's
+    /// `particles`: (k,) integer array (one particle per element) or (k, a) (a particles per
+    /// element, any a) of particle indices. `force(t, q, v)` gets the elements' positions and
+    /// velocities, (k, 3) or (k, a, 3), and returns the forces on those particles in the same shape; element i's
     /// result may depend only on t and row i. It is called once per residual evaluation.
-    /// `jacobian(t, q, v)` returns (df_dq, df_dv), each (k, 3a, 3a) (a = 1 or 2; row 3p + l:
+    /// `jacobian(t, q, v)` returns (df_dq, df_dv), each (k, 3a, 3a) (a the arity; row 3p + l:
     /// component l of the force on particle p, column 3r + m: coordinate m of particle r);
     /// None: forward differences over the group (6a force calls per Jacobian). Returns a
     /// `UserGroup` (calls and seconds of the last run). During a run, an exception stops it with
@@ -443,7 +443,8 @@ impl PySystem {
         name: Option<String>,
     ) -> PyResult<crate::user_physics::PyUserGroup> {
         use crate::user_physics as up;
-        let (elements, arity) = up::elements(particles)?;
+        let elements = up::elements(particles)?;
+        let arity = elements.arity();
         let force = up::callable("force", Some(force))?
             .ok_or_else(|| invalid("force", "None", "expected a function force(t, q, v)"))?;
         let jacobian = up::callable("jacobian", jacobian)?;
@@ -456,7 +457,7 @@ impl PySystem {
         );
         let group = self
             .inner
-            .add_user_force_group(elements, arity, Box::new(functions), name)
+            .add_user_force_group(elements, Box::new(functions), name)
             .map_err(to_py)?;
         Ok(up::PyUserGroup::force(group))
     }
@@ -485,7 +486,8 @@ impl PySystem {
         name: Option<String>,
     ) -> PyResult<crate::user_physics::PyUserGroup> {
         use crate::user_physics as up;
-        let (elements, arity) = up::elements(particles)?;
+        let elements = up::elements(particles)?;
+        let arity = elements.arity();
         let phi = up::callable("phi", Some(phi))?
             .ok_or_else(|| invalid("phi", "None", "expected a function phi(t, q)"))?;
         let functions = [
@@ -499,13 +501,7 @@ impl PySystem {
             up::constraint_functions(elements.len(), arity, self.user_errors.clone(), functions);
         let (group, first) = self
             .inner
-            .add_user_constraint_group(
-                elements,
-                arity,
-                Box::new(functions),
-                scale.unwrap_or(1.0),
-                name,
-            )
+            .add_user_constraint_group(elements, Box::new(functions), scale.unwrap_or(1.0), name)
             .map_err(to_py)?;
         Ok(up::PyUserGroup::constraint(group, first))
     }

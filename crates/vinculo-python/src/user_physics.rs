@@ -7,24 +7,24 @@
 //! after checking the shape. An exception is kept (the first one per system) so that the run can
 //! re-raise it as the cause of `UserFunctionError`.
 
-use crate::errors::invalid;
+use crate::errors::{invalid, to_py};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use std::sync::{Arc, Mutex};
 use vinculo::constraints::{ConstraintCall, ConstraintGroup, UserConstraints};
 use vinculo::forces::{ForceGroup, UserForces};
-use vinculo::user::UserFailure;
+use vinculo::user::{GroupElements, UserFailure};
 
 /// The first exception raised by a user function of a system, kept for the run to chain.
 pub type PendingError = Arc<Mutex<Option<PyErr>>>;
 
-/// Shape of a group array: (k, 3) for arity 1, (k, 2, 3) for arity 2.
+/// Shape of a group array: (k, 3) for arity 1, (k, a, 3) for arity a >= 2.
 fn state_shape(k: usize, arity: usize) -> Vec<usize> {
     if arity == 1 {
         vec![k, 3]
     } else {
-        vec![k, 2, 3]
+        vec![k, arity, 3]
     }
 }
 
@@ -234,7 +234,7 @@ impl ConstraintGroup for PyConstraintFunctions {
         let (k, n) = (c.k, 3 * c.arity);
         let shapes: Vec<Vec<usize>> = match call {
             ConstraintCall::Gradient if c.arity == 1 => vec![vec![k, 1, 3], vec![k, 3]],
-            ConstraintCall::Gradient => vec![vec![k, 2, 3]],
+            ConstraintCall::Gradient => vec![vec![k, c.arity, 3]],
             ConstraintCall::Hessian => vec![vec![k, n, n]],
             _ => vec![vec![k]],
         };
@@ -252,8 +252,8 @@ impl ConstraintGroup for PyConstraintFunctions {
     }
 }
 
-/// Reads `particles`: (k,) integers (arity 1) or (k, 2) integers (arity 2).
-pub fn elements(particles: &Bound<'_, PyAny>) -> PyResult<(Vec<[usize; 2]>, usize)> {
+/// Reads `particles`: (k,) integers (arity 1) or (k, a) integers (arity a, any a >= 1).
+pub fn elements(particles: &Bound<'_, PyAny>) -> PyResult<GroupElements> {
     let py = particles.py();
     let bad = |why: &str| {
         invalid(
@@ -272,11 +272,11 @@ pub fn elements(particles: &Bound<'_, PyAny>) -> PyResult<(Vec<[usize; 2]>, usiz
         .import("numpy")?
         .getattr("asarray")?
         .call1((particles,))
-        .map_err(|_| bad("expected a (k,) or (k, 2) array of particle indices"))?;
+        .map_err(|_| bad("expected a (k,) or (k, a) array of particle indices"))?;
     let kind: String = array.getattr("dtype")?.getattr("kind")?.extract()?;
     if !(kind == "i" || kind == "u") {
         return Err(bad(
-            "expected integer particle indices (ParticleId.index), shape (k,) or (k, 2)",
+            "expected integer particle indices (ParticleId.index), shape (k,) or (k, a)",
         ));
     }
     let shape: Vec<usize> = array.getattr("shape")?.extract()?;
@@ -290,14 +290,18 @@ pub fn elements(particles: &Bound<'_, PyAny>) -> PyResult<(Vec<[usize; 2]>, usiz
         )));
     }
     let flat: Vec<usize> = flat.into_iter().map(|p| p as usize).collect();
-    match shape.as_slice() {
-        [_] => Ok((flat.iter().map(|&p| [p, 0]).collect(), 1)),
-        [_, 2] => Ok((flat.chunks(2).map(|c| [c[0], c[1]]).collect(), 2)),
-        _ => Err(bad(&format!(
-            "an array of shape {} is neither (k,) (one particle per element) nor (k, 2) (two)",
-            shape_text(&shape)
-        ))),
-    }
+    let arity = match shape.as_slice() {
+        [_] => 1,
+        [_, a] if *a >= 1 => *a,
+        _ => {
+            return Err(bad(&format!(
+                "an array of shape {} is neither (k,) (one particle per element) nor (k, a) \
+                 (a >= 1 particles per element)",
+                shape_text(&shape)
+            )))
+        }
+    };
+    GroupElements::new(arity, flat).map_err(to_py)
 }
 
 /// Checks that `f` is callable (or absent when optional).
@@ -414,8 +418,8 @@ impl PyUserGroup {
     #[getter]
     fn arity(&self) -> usize {
         match &self.group {
-            Group::Force(g) => g.arity,
-            Group::Constraint(g, _) => g.arity,
+            Group::Force(g) => g.elements.arity(),
+            Group::Constraint(g, _) => g.elements.arity(),
         }
     }
 

@@ -28,8 +28,8 @@ pub enum Error {
         /// What is expected instead.
         expected: String,
     },
-    /// A two-particle element was given the same particle twice.
-    #[error("{what} links particle {particle} to itself: give two different particles")]
+    /// An element was given the same particle twice.
+    #[error("{what} links particle {particle} to itself: give different particles")]
     SameParticle {
         /// The element kind.
         what: String,

@@ -29,13 +29,11 @@ fn fill_saddle(system: &System, ws: &mut StepWorkspace, q: &[Vec3], t: f64) {
     }
     for (c, con) in system.constraints().iter().enumerate() {
         let g = con.gradient(q, t);
-        let s = ws.scales[c];
-        for x in 0..con.particles().len() {
-            for k in 0..3 {
-                add(values, layout.constraint_column[c][x][k], -s * g[x][k]);
-                add(values, layout.constraint_row[c][x][k], s * g[x][k]);
-            }
-        }
+        // The saddle matrix has no Hessian term: zero blocks.
+        let none = crate::local::Blocks::zeros(g.len());
+        layout.add_constraint_blocks(c, &none, ws.scales[c], (&g, &g), |slot, v| {
+            add(values, slot, v)
+        });
     }
 }
 

@@ -48,6 +48,7 @@ pub mod initial;
 pub mod integrators;
 pub mod laws;
 pub mod linear;
+pub mod local;
 pub mod math;
 pub mod model;
 mod options;

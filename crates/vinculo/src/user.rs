@@ -164,8 +164,7 @@ impl<const N: usize> GroupState<N> {
         &mut self,
         memo: usize,
         width: usize,
-        elements: &[[usize; 2]],
-        arity: usize,
+        elements: &GroupElements,
         e: usize,
         q: &[Vec3],
         v: Option<&[Vec3]>,
@@ -173,15 +172,15 @@ impl<const N: usize> GroupState<N> {
         compute: impl FnOnce(&mut Self, &[f64], &[f64]) -> Option<Vec<f64>>,
         read: impl FnOnce(&[f64]) -> R,
     ) -> R {
-        let parts = &elements[e][..arity];
+        let parts = elements.get(e);
         if let Some(s) = self.memos[memo].find(e, parts, q, v, t) {
             return read(&s.out[e * width..(e + 1) * width]);
         }
         if self.failure.is_some() {
             return read(&vec![f64::NAN; width]);
         }
-        let qg = gather(elements, arity, q);
-        let vg = v.map(|v| gather(elements, arity, v)).unwrap_or_default();
+        let qg = gather(elements, q);
+        let vg = v.map(|v| gather(elements, v)).unwrap_or_default();
         match compute(self, &qg, &vg) {
             Some(out) => {
                 let s = self.memos[memo].store(t, qg, vg, out);
@@ -267,13 +266,81 @@ impl Memo {
     }
 }
 
-/// The k x arity x 3 array of `x` at the elements' particles.
-pub(crate) fn gather(elements: &[[usize; 2]], arity: usize, x: &[Vec3]) -> Vec<f64> {
-    let mut out = Vec::with_capacity(elements.len() * arity * 3);
-    for e in elements {
-        for &p in &e[..arity] {
-            out.extend_from_slice(&x[p]);
+/// The particles of a group's k elements, the same number a >= 1 ("arity") per element, stored
+/// flat: element e touches `particles[e a..(e + 1) a]`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct GroupElements {
+    arity: usize,
+    particles: Vec<usize>,
+}
+
+impl GroupElements {
+    /// Elements of `arity` particles each from the flat list `particles` (k a entries).
+    ///
+    /// # Errors
+    /// [`crate::Error::InvalidParameter`] when `arity` is 0 or the list's length is not a
+    /// multiple of it. (The indices are checked against a system when the group is added.)
+    pub fn new(arity: usize, particles: Vec<usize>) -> crate::Result<GroupElements> {
+        if arity == 0 {
+            return Err(crate::Error::InvalidParameter {
+                name: "arity of a user group".into(),
+                value: 0.0,
+                expected: "must be >= 1: the number of particles of each element".into(),
+            });
         }
+        if particles.len() % arity != 0 {
+            return Err(crate::Error::InvalidParameter {
+                name: "number of particle indices of a user group".into(),
+                value: particles.len() as f64,
+                expected: format!(
+                    "must be a multiple of the arity {arity}: {arity} particles per element"
+                ),
+            });
+        }
+        Ok(GroupElements { arity, particles })
+    }
+
+    /// Elements given as rows of A particles each.
+    pub fn from_rows<const A: usize>(rows: &[[usize; A]]) -> GroupElements {
+        assert!(A >= 1, "elements need at least one particle");
+        GroupElements {
+            arity: A,
+            particles: rows.iter().flatten().copied().collect(),
+        }
+    }
+
+    /// Particles per element.
+    pub fn arity(&self) -> usize {
+        self.arity
+    }
+
+    /// Number of elements k.
+    pub fn len(&self) -> usize {
+        self.particles.len() / self.arity
+    }
+
+    /// True when the group has no element.
+    pub fn is_empty(&self) -> bool {
+        self.particles.is_empty()
+    }
+
+    /// The particles of element `e`.
+    #[inline]
+    pub fn get(&self, e: usize) -> &[usize] {
+        &self.particles[e * self.arity..(e + 1) * self.arity]
+    }
+
+    /// Every element's particles, in element order.
+    pub fn iter(&self) -> std::slice::ChunksExact<'_, usize> {
+        self.particles.chunks_exact(self.arity)
+    }
+}
+
+/// The k x arity x 3 array of `x` at the elements' particles.
+pub(crate) fn gather(elements: &GroupElements, x: &[Vec3]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(elements.particles.len() * 3);
+    for &p in &elements.particles {
+        out.extend_from_slice(&x[p]);
     }
     out
 }
@@ -325,10 +392,10 @@ mod tests {
 
     #[test]
     fn memo_matches_per_element_and_evicts_the_least_recent() {
-        let elements = [[0, 1], [2, 3]];
+        let elements = GroupElements::from_rows(&[[0, 1], [2, 3]]);
         let q: Vec<Vec3> = (0..4).map(|i| [i as f64, 0.5, -1.0]).collect();
         let mut m = Memo::default();
-        m.store(0.1, gather(&elements, 2, &q), vec![], vec![1.0, 2.0]);
+        m.store(0.1, gather(&elements, &q), vec![], vec![1.0, 2.0]);
         assert!(m.find(1, &[2, 3], &q, None, 0.1).is_some());
         assert!(m.find(1, &[2, 3], &q, None, 0.2).is_none());
         // Element 0 still matches when only element 1's particles moved.
@@ -336,9 +403,9 @@ mod tests {
         q2[3][0] += 1e-12;
         assert!(m.find(0, &[0, 1], &q2, None, 0.1).is_some());
         assert!(m.find(1, &[2, 3], &q2, None, 0.1).is_none());
-        m.store(0.1, gather(&elements, 2, &q2), vec![], vec![3.0, 4.0]);
+        m.store(0.1, gather(&elements, &q2), vec![], vec![3.0, 4.0]);
         m.find(1, &[2, 3], &q, None, 0.1); // touch the first slot
-        m.store(0.3, gather(&elements, 2, &q), vec![], vec![5.0, 6.0]);
+        m.store(0.3, gather(&elements, &q), vec![], vec![5.0, 6.0]);
         // The second slot (least recently used) was replaced.
         assert!(m.find(1, &[2, 3], &q2, None, 0.1).is_none());
         assert_eq!(

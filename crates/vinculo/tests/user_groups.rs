@@ -8,7 +8,7 @@ use vinculo::constraints::{ConstraintCall, ConstraintGroup};
 use vinculo::forces::ForceGroup;
 use vinculo::integrators::Scheme;
 use vinculo::model::System;
-use vinculo::user::UserFailure;
+use vinculo::user::{GroupElements, UserFailure};
 use vinculo::{simulate, Error, SimulationOptions};
 
 /// Spring-damper f_a = -(k (|d| - L0) + c u.(v_a - v_b)) u, f_b = -f_a, u = d/|d|, d = q_a - q_b
@@ -125,7 +125,8 @@ fn chain(n: usize, user_links: Option<Link>, user_springs: Option<Spring>) -> Sy
     let pairs: Vec<[usize; 2]> = (0..n).map(|i| [i, i + 1]).collect();
     match user_links {
         Some(link) => {
-            s.add_user_constraint_group(pairs, 2, Box::new(link), 0.5 / 0.1, Some("links".into()))
+            let elements = GroupElements::from_rows(&pairs);
+            s.add_user_constraint_group(elements, Box::new(link), 0.5 / 0.1, Some("links".into()))
                 .unwrap();
         }
         None => {
@@ -137,7 +138,7 @@ fn chain(n: usize, user_links: Option<Link>, user_springs: Option<Spring>) -> Sy
     let springs: Vec<[usize; 2]> = (0..n - 1).map(|i| [i, i + 2]).collect();
     match user_springs {
         Some(spring) => {
-            s.add_user_force_group(springs, 2, Box::new(spring), None)
+            s.add_user_force_group(GroupElements::from_rows(&springs), Box::new(spring), None)
                 .unwrap();
         }
         None => {

@@ -4,14 +4,15 @@
 //!
 //! Unknowns are ordered x = (q of the free particles, 3 each; lambda, one per constraint).
 
+mod elements;
 mod parallel;
 mod pattern;
 mod serial;
 
+pub use elements::{push_column, push_pair_blocks, push_row, ElementOffsets};
 pub use parallel::{JacobianTerms, ParallelAssembly, ResidualTerms, MIN_TASK};
 pub use pattern::{Pattern, Storage};
 
-use crate::forces::MAX_FORCE_PARTICLES;
 use crate::model::System;
 
 /// Marks an absent unknown (a fixed particle has no coordinates among the unknowns).
@@ -28,10 +29,6 @@ pub const NO_SLOT: Slot = Slot::MAX;
 /// Slots of a 3x3 block, row-major.
 pub type Block = [Slot; 9];
 
-/// Blocks \[a\]\[b\] of a force's Jacobian between its touched particles.
-pub type ForceBlocks =
-    [[Block; crate::forces::MAX_FORCE_PARTICLES]; crate::forces::MAX_FORCE_PARTICLES];
-
 /// Where each element writes in the matrix.
 #[derive(Debug, Clone)]
 pub struct Layout {
@@ -45,14 +42,18 @@ pub struct Layout {
     pub pattern: Pattern,
     /// Diagonal block of each particle (all NONE for fixed particles).
     pub particle_block: Vec<Block>,
-    /// Per constraint: blocks [a][b] of the Hessian term between its touched particles.
-    pub constraint_hessian: Vec<[[Block; 2]; 2]>,
-    /// Per constraint: slots of -Phi_q^T (rows of particle a, its multiplier's column).
-    pub constraint_column: Vec<[[Slot; 3]; 2]>,
-    /// Per constraint: slots of Phi_q (its row, columns of particle a).
-    pub constraint_row: Vec<[[Slot; 3]; 2]>,
-    /// Per force: blocks [a][b] of its Jacobian.
-    pub force_block: Vec<ForceBlocks>,
+    /// Where each constraint's entries start in the tables below.
+    pub constraint_offsets: ElementOffsets,
+    /// Per constraint and ordered pair (a, b) of its particles: the block of the Hessian term.
+    pub constraint_hessian: Vec<Block>,
+    /// Per constraint and particle a: slots of -Phi_q^T (rows of a, the multiplier's column).
+    pub constraint_column: Vec<[Slot; 3]>,
+    /// Per constraint and particle a: slots of Phi_q (the constraint's row, columns of a).
+    pub constraint_row: Vec<[Slot; 3]>,
+    /// Where each force's entries start in `force_block`.
+    pub force_offsets: ElementOffsets,
+    /// Per force and ordered pair (a, b) of its particles: the block of its Jacobian.
+    pub force_block: Vec<Block>,
 }
 
 impl Layout {
@@ -123,48 +124,45 @@ impl Layout {
             }
         }
         let pattern = Pattern::new(n, entries, n <= dense_limit);
-        let slot = |row: usize, col: usize| pattern.slot32(row, col);
-        let block_slots = |a: usize, b: usize| pattern.block_slots(a, b);
-        let pair_blocks = |parts: &[usize]| element_blocks::<2>(parts, &dof, &block_slots);
-        let particle_block = dof.iter().map(|&d| block_slots(d, d)).collect();
-        let mut constraint_hessian = Vec::with_capacity(m);
-        let mut constraint_column = Vec::with_capacity(m);
-        let mut constraint_row = Vec::with_capacity(m);
+        let particle_block = dof.iter().map(|&d| pattern.block_slots(d, d)).collect();
+        let constraint_offsets =
+            ElementOffsets::new(system.constraints().iter().map(|c| c.particles()));
+        let mut constraint_hessian = Vec::with_capacity(constraint_offsets.pair_entries());
+        let mut constraint_column = Vec::with_capacity(constraint_offsets.particle_entries());
+        let mut constraint_row = Vec::with_capacity(constraint_offsets.particle_entries());
         for (k, c) in system.constraints().iter().enumerate() {
-            constraint_hessian.push(pair_blocks(c.particles()));
-            let mut col = [[NO_SLOT; 3]; 2];
-            let mut row = [[NO_SLOT; 3]; 2];
-            for (x, &p) in c.particles().iter().enumerate() {
-                if dof[p] != NONE {
-                    for r in 0..3 {
-                        col[x][r] = slot(dof[p] + r, lambda(k));
-                        row[x][r] = slot(lambda(k), dof[p] + r);
-                    }
-                }
-            }
-            constraint_column.push(col);
-            constraint_row.push(row);
+            let parts = c.particles();
+            push_pair_blocks(&mut constraint_hessian, &pattern, parts, &dof, (0, 0));
+            push_column(
+                &mut constraint_column,
+                &pattern,
+                parts,
+                &dof,
+                (0, lambda(k)),
+            );
+            push_row(&mut constraint_row, &pattern, parts, &dof, (lambda(k), 0));
         }
-        let force_block = system
-            .forces()
-            .iter()
-            .map(|f| {
-                if f.has_jacobian() {
-                    element_blocks(f.particles(), &dof, &block_slots)
-                } else {
-                    [[[NO_SLOT; 9]; MAX_FORCE_PARTICLES]; MAX_FORCE_PARTICLES]
-                }
-            })
-            .collect();
+        let force_offsets = ElementOffsets::new(system.forces().iter().map(|f| f.particles()));
+        let mut force_block = Vec::with_capacity(force_offsets.pair_entries());
+        for f in system.forces() {
+            if f.has_jacobian() {
+                push_pair_blocks(&mut force_block, &pattern, f.particles(), &dof, (0, 0));
+            } else {
+                let n = f.particles().len();
+                force_block.extend(std::iter::repeat_n([NO_SLOT; 9], n * n));
+            }
+        }
         Layout {
             dof,
             free,
             constraints: m,
             pattern,
             particle_block,
+            constraint_offsets,
             constraint_hessian,
             constraint_column,
             constraint_row,
+            force_offsets,
             force_block,
         }
     }
@@ -192,34 +190,40 @@ impl Layout {
 
 impl Layout {
     /// Adds constraint `c`'s part of the iteration matrix: its Hessian-term blocks `hess` between
-    /// its `n` touched particles, `-s grad_column` into its multiplier's column (the -Phi_q^T
-    /// block) and `s grad_row` into its row (the Phi_q block). The schemes differ only in where
-    /// they evaluate the two gradients and the Hessian.
-    #[allow(clippy::too_many_arguments)]
+    /// its touched particles, `-s grad_column` into its multiplier's column (the -Phi_q^T
+    /// block) and `s grad_row` into its row (the Phi_q block), through `add` (which adds a value
+    /// at a slot). The schemes differ only in where they evaluate the two gradients and the
+    /// Hessian.
     #[inline(always)]
     pub fn add_constraint_blocks(
         &self,
-        values: &mut [f64],
         c: usize,
-        n: usize,
-        hess: &[[crate::math::Mat3; 2]; 2],
+        hess: &crate::local::Blocks,
         s: f64,
-        grad_column: &[crate::math::Vec3; 2],
-        grad_row: &[crate::math::Vec3; 2],
+        (grad_column, grad_row): (&[crate::math::Vec3], &[crate::math::Vec3]),
+        mut add: impl FnMut(Slot, f64),
     ) {
+        let n = hess.particles();
+        let blocks = &self.constraint_hessian[self.constraint_offsets.pairs(c)];
         for x in 0..n {
             for y in 0..n {
-                add_block(values, &self.constraint_hessian[c][x][y], 1.0, &hess[x][y]);
+                let (b, m) = (&blocks[x * n + y], &hess[x][y]);
+                if b[0] != NO_SLOT {
+                    for r in 0..3 {
+                        for k in 0..3 {
+                            add(b[3 * r + k], m[r][k]);
+                        }
+                    }
+                }
             }
         }
+        let range = self.constraint_offsets.particles(c);
+        let columns = &self.constraint_column[range.clone()];
+        let rows = &self.constraint_row[range];
         for x in 0..n {
             for k in 0..3 {
-                add(
-                    values,
-                    self.constraint_column[c][x][k],
-                    -s * grad_column[x][k],
-                );
-                add(values, self.constraint_row[c][x][k], s * grad_row[x][k]);
+                add(columns[x][k], -s * grad_column[x][k]);
+                add(rows[x][k], s * grad_row[x][k]);
             }
         }
     }
@@ -262,22 +266,6 @@ impl Layout {
     }
 }
 
-/// The blocks [x][y] between an element's touched particles `parts` (at most N), absent past
-/// them.
-fn element_blocks<const N: usize>(
-    parts: &[usize],
-    dof: &[usize],
-    block_slots: &impl Fn(usize, usize) -> Block,
-) -> [[Block; N]; N] {
-    let mut out = [[[NO_SLOT; 9]; N]; N];
-    for (x, &a) in parts.iter().enumerate() {
-        for (y, &b) in parts.iter().enumerate() {
-            out[x][y] = block_slots(dof[a], dof[b]);
-        }
-    }
-    out
-}
-
 /// The first unknown of each particle, 3 per free particle in order (NONE for fixed ones), and
 /// the number of free particles.
 pub fn number_particles(system: &System) -> (Vec<usize>, usize) {
@@ -309,24 +297,24 @@ pub fn add(values: &mut [f64], slot: Slot, value: f64) {
     }
 }
 
-/// Places a force's local Jacobians: `dq[x][y]` weighted by `wq` into `blocks_q[x][y]` and
-/// `dv[x][y]` weighted by `wv` into `blocks_v[x][y]`, for its `n` particles, through `add`
-/// (which adds a weighted 3x3 matrix into a block). The index-3 layout has one block per pair
-/// (`blocks_q` and `blocks_v` the same), the GGL layout one in the position and one in the
-/// velocity columns.
+/// Places a force's local Jacobians: `dq[x][y]` weighted by `wq` into block x n + y of
+/// `blocks_q` and `dv[x][y]` weighted by `wv` into that of `blocks_v`, for its n particles,
+/// through `add` (which adds a weighted 3x3 matrix into a block). The index-3 layout has one
+/// block per pair (`blocks_q` and `blocks_v` the same), the GGL layout one in the position and
+/// one in the velocity columns.
 #[inline]
 pub fn add_force_blocks(
-    n: usize,
-    blocks_q: &ForceBlocks,
-    blocks_v: &ForceBlocks,
+    blocks_q: &[Block],
+    blocks_v: &[Block],
     (wq, dq): (f64, &crate::forces::Jacobian),
     (wv, dv): (f64, &crate::forces::Jacobian),
     mut add: impl FnMut(&Block, f64, &crate::math::Mat3),
 ) {
+    let n = dq.particles();
     for x in 0..n {
         for y in 0..n {
-            add(&blocks_q[x][y], wq, &dq[x][y]);
-            add(&blocks_v[x][y], wv, &dv[x][y]);
+            add(&blocks_q[x * n + y], wq, &dq[x][y]);
+            add(&blocks_v[x * n + y], wv, &dv[x][y]);
         }
     }
 }

@@ -21,12 +21,9 @@
 
 use rayon::prelude::*;
 
-use super::{add_force_blocks, Block, InertiaRows, Layout, Slot, NONE, NO_SLOT};
-use crate::constraints::{Gradient, Hessian};
-use crate::forces::{Jacobian, Local, MAX_FORCE_PARTICLES};
-
-/// Entries of the force incidence lists per force.
-const FORCE_STRIDE: usize = MAX_FORCE_PARTICLES;
+use super::{add_force_blocks, Block, ElementOffsets, InertiaRows, Layout, Slot, NONE, NO_SLOT};
+use crate::constraints::Hessian;
+use crate::forces::Jacobian;
 use crate::math::{Mat3, Vec3};
 use crate::model::System;
 
@@ -45,12 +42,14 @@ pub struct ParallelAssembly {
     free: Vec<usize>,
     /// Per particle, the range of `force_incidence` of the forces touching it.
     force_start: Vec<usize>,
-    /// Entries 3 f + x ([`FORCE_STRIDE`]): force f touches the particle as its particle x; increasing in f.
-    force_incidence: Vec<usize>,
+    /// Entries (f, i): force f touches the particle, whose local force is entry i of `forces`;
+    /// increasing in f.
+    force_incidence: Vec<[u32; 2]>,
     /// Per particle, the range of `constraint_incidence` of the constraints touching it.
     constraint_start: Vec<usize>,
-    /// Entries 2 c + x: constraint c touches the particle as its particle x; increasing in c.
-    constraint_incidence: Vec<usize>,
+    /// Entries (c, i): constraint c touches the particle, whose gradient is entry i of
+    /// `gradients`; increasing in c.
+    constraint_incidence: Vec<[u32; 2]>,
     /// Chunks of [`CHUNK`] forces, grouped by colour (`force_colour_start` delimits the
     /// groups).
     force_colours: Vec<usize>,
@@ -59,10 +58,12 @@ pub struct ParallelAssembly {
     /// the groups).
     constraint_colours: Vec<usize>,
     constraint_colour_start: Vec<usize>,
-    /// Local forces of every force at the current iterate.
-    forces: Vec<Local>,
-    /// Gradient of every constraint at the evaluation point.
-    gradients: Vec<Gradient>,
+    /// Local forces of every force at the current iterate, per force and touched particle
+    /// (the layout's `force_offsets`).
+    forces: Vec<Vec3>,
+    /// Gradient of every constraint at the evaluation point, per constraint and touched
+    /// particle (the layout's `constraint_offsets`).
+    gradients: Vec<Vec3>,
 }
 
 /// Where and with which weights one step's residual is evaluated.
@@ -186,16 +187,15 @@ impl SharedValues {
     }
 }
 
-/// Incidence lists: for each particle, entries `stride` e + x of the elements e touching it (as their
-/// particle x), in increasing e. Fixed particles are left out when `free_only`.
+/// Incidence lists: for each free particle, entries (e, i) of the elements e touching it, i its
+/// entry in the elements' per-particle tables (the elements' particle counts summed before e,
+/// plus its position among e's particles), in increasing e.
 fn incidence<'a>(
     particles: usize,
     elements: impl Iterator<Item = &'a [usize]> + Clone,
     dof: &[usize],
-    free_only: bool,
-    stride: usize,
-) -> (Vec<usize>, Vec<usize>) {
-    let keep = |p: usize| !free_only || dof[p] != NONE;
+) -> (Vec<usize>, Vec<[u32; 2]>) {
+    let keep = |p: usize| dof[p] != NONE;
     let mut start = vec![0usize; particles + 1];
     for parts in elements.clone() {
         for &p in parts.iter().filter(|&&p| keep(p)) {
@@ -206,12 +206,14 @@ fn incidence<'a>(
         start[i + 1] += start[i];
     }
     let mut next = start.clone();
-    let mut entries = vec![0usize; start[particles]];
+    let mut entries = vec![[0u32; 2]; start[particles]];
+    let mut offset = 0;
     for (e, parts) in elements.enumerate() {
         for (x, &p) in parts.iter().enumerate().filter(|&(_, &p)| keep(p)) {
-            entries[next[p]] = stride * e + x;
+            entries[next[p]] = [e as u32, (offset + x) as u32];
             next[p] += 1;
         }
+        offset += parts.len();
     }
     (start, entries)
 }
@@ -224,9 +226,7 @@ fn colour_chunks<'a>(
     elements: impl Iterator<Item = &'a [usize]> + Clone,
     dof: &[usize],
 ) -> (Vec<usize>, Vec<usize>) {
-    // Any stride serves: the colouring reads only which element an entry is.
-    let stride = MAX_FORCE_PARTICLES;
-    let (start, entries) = incidence(particles, elements.clone(), dof, true, stride);
+    let (start, entries) = incidence(particles, elements.clone(), dof);
     let chunks = elements.clone().count().div_ceil(CHUNK);
     let mut colours = vec![0usize; chunks];
     let mut taken: Vec<usize> = Vec::new();
@@ -237,7 +237,7 @@ fn colour_chunks<'a>(
         while let Some((_, ps)) = parts.next_if(|&(e, _)| e / CHUNK == k) {
             for &p in ps.iter().filter(|&&p| dof[p] != NONE) {
                 for &entry in &entries[start[p]..start[p + 1]] {
-                    let other = entry / stride / CHUNK;
+                    let other = entry[0] as usize / CHUNK;
                     if other < k {
                         taken.push(colours[other]);
                     }
@@ -278,15 +278,10 @@ impl ParallelAssembly {
         let free = (0..n).filter(|&i| dof[i] != NONE).collect();
         let forces = system.forces();
         let constraints = system.constraints();
-        let (force_start, force_incidence) = incidence(
-            n,
-            forces.iter().map(|f| f.particles()),
-            dof,
-            true,
-            FORCE_STRIDE,
-        );
+        let (force_start, force_incidence) =
+            incidence(n, forces.iter().map(|f| f.particles()), dof);
         let (constraint_start, constraint_incidence) =
-            incidence(n, constraints.iter().map(|c| c.particles()), dof, true, 2);
+            incidence(n, constraints.iter().map(|c| c.particles()), dof);
         let none: &[usize] = &[];
         let (force_colours, force_colour_start) = colour_chunks(
             n,
@@ -311,8 +306,8 @@ impl ParallelAssembly {
             force_colour_start,
             constraint_colours,
             constraint_colour_start,
-            forces: vec![Default::default(); forces.len()],
-            gradients: vec![Default::default(); constraints.len()],
+            forces: vec![[0.0; 3]; layout.force_offsets.particle_entries()],
+            gradients: vec![[0.0; 3]; layout.constraint_offsets.particle_entries()],
         }
     }
 
@@ -334,22 +329,30 @@ impl ParallelAssembly {
     ) {
         let m3 = 3 * layout.free;
         let (dynamics, constraint_rows) = r.split_at_mut(m3);
-        system
-            .forces()
-            .par_iter()
-            .zip(self.forces.par_iter_mut())
-            .with_min_len(MIN_TASK)
-            .for_each(|(f, out)| *out = f.force(at.q_eval, at.v_eval, at.t_eval));
-        system
-            .constraints()
-            .par_iter()
-            .zip(self.gradients.par_iter_mut())
-            .zip(constraint_rows.par_iter_mut())
-            .enumerate()
-            .with_min_len(MIN_TASK)
-            .for_each(|(c, ((con, grad), r))| {
-                *grad = con.gradient(at.q_eval, at.t_eval);
-                *r = at.scales[c] * con.residual(at.q_end, at.t_end);
+        let forces = system.forces();
+        split_by_elements(&mut self.forces, &layout.force_offsets)
+            .into_par_iter()
+            .for_each(|(first, out)| {
+                let mut i = 0;
+                for f in &forces[first..(first + MIN_TASK).min(forces.len())] {
+                    let fl = f.force(at.q_eval, at.v_eval, at.t_eval);
+                    out[i..i + fl.len()].copy_from_slice(&fl);
+                    i += fl.len();
+                }
+            });
+        let constraints = system.constraints();
+        split_by_elements(&mut self.gradients, &layout.constraint_offsets)
+            .into_par_iter()
+            .zip(constraint_rows.par_chunks_mut(MIN_TASK))
+            .for_each(|((first, out), rows)| {
+                let mut i = 0;
+                for (c, r) in (first..).zip(rows.iter_mut()) {
+                    let con = &constraints[c];
+                    let grad = con.gradient(at.q_eval, at.t_eval);
+                    out[i..i + grad.len()].copy_from_slice(&grad);
+                    i += grad.len();
+                    *r = at.scales[c] * con.residual(at.q_end, at.t_end);
+                }
             });
         let sigma = at.sigma;
         let this = &*self;
@@ -359,18 +362,17 @@ impl ParallelAssembly {
             .with_min_len(MIN_TASK)
             .for_each(|(out, &i)| {
                 out.copy_from_slice(&row.rows(i));
-                for &e in &this.force_incidence[this.force_start[i]..this.force_start[i + 1]] {
-                    let fl = &this.forces[e / FORCE_STRIDE][e % FORCE_STRIDE];
+                for &[_, e] in &this.force_incidence[this.force_start[i]..this.force_start[i + 1]] {
+                    let fl = &this.forces[e as usize];
                     for k in 0..3 {
                         out[k] -= sigma * fl[k];
                     }
                 }
                 let incident = &this.constraint_incidence
                     [this.constraint_start[i]..this.constraint_start[i + 1]];
-                for &e in incident {
-                    let (c, x) = (e / 2, e % 2);
-                    let grad = &this.gradients[c][x];
-                    let weight = sigma * at.lambda[c];
+                for &[c, e] in incident {
+                    let grad = &this.gradients[e as usize];
+                    let weight = sigma * at.lambda[c as usize];
                     for k in 0..3 {
                         out[k] -= weight * grad[k];
                     }
@@ -408,12 +410,13 @@ impl ParallelAssembly {
                     if !f.has_jacobian() {
                         continue;
                     }
-                    let mut dq: Jacobian = Default::default();
-                    let mut dv: Jacobian = Default::default();
+                    let n = f.particles().len();
+                    let mut dq = Jacobian::zeros(n);
+                    let mut dv = Jacobian::zeros(n);
                     f.add_jacobian(at.q_eval, at.v_eval, at.t_eval, &mut dq, &mut dv);
-                    let blocks = &layout.force_block[fi];
+                    let blocks = &layout.force_block[layout.force_offsets.pairs(fi)];
                     let (wq, wv) = ((at.force_dq, &dq), (at.force_dv, &dv));
-                    add_force_blocks(f.particles().len(), blocks, blocks, wq, wv, |b, s, m| {
+                    add_force_blocks(blocks, blocks, wq, wv, |b, s, m| {
                         // SAFETY: the blocks of this force, in rows of this chunk's free
                         // particles, which no other chunk of this colour touches (see
                         // `SharedValues`).
@@ -431,41 +434,41 @@ impl ParallelAssembly {
                 let end = (chunk * CHUNK + CHUNK).min(constraints.len());
                 for c in chunk * CHUNK..end {
                     let con = &constraints[c];
-                    let n = con.particles().len();
-                    let mut hess: Hessian = Default::default();
+                    let mut hess = Hessian::zeros(con.particles().len());
                     con.add_hessian(at.q_eval, at.t_eval, at.hessian * at.lambda[c], &mut hess);
-                    let s = at.scales[c];
                     let grad_eval = con.gradient(at.q_eval, at.t_eval);
                     let grad_end = if same_point {
-                        grad_eval
+                        None
                     } else {
-                        con.gradient(at.q_end, at.t_end)
+                        Some(con.gradient(at.q_end, at.t_end))
                     };
-                    for x in 0..n {
-                        for y in 0..n {
-                            // SAFETY: rows of this chunk's free particles, which no other chunk
-                            // of this colour touches (see `SharedValues`).
-                            unsafe {
-                                shared.add_block(
-                                    &layout.constraint_hessian[c][x][y],
-                                    1.0,
-                                    &hess[x][y],
-                                )
-                            };
-                        }
-                    }
-                    for x in 0..n {
-                        for k in 0..3 {
-                            // SAFETY: the column entry is in a row of this constraint's particle
-                            // x (as above); the row entry is in this constraint's own row.
-                            unsafe {
-                                shared.add(layout.constraint_column[c][x][k], -s * grad_eval[x][k]);
-                                shared.add(layout.constraint_row[c][x][k], s * grad_end[x][k]);
-                            }
-                        }
-                    }
+                    let grads = (&grad_eval[..], grad_end.as_deref().unwrap_or(&grad_eval));
+                    layout.add_constraint_blocks(c, &hess, at.scales[c], grads, |slot, v| {
+                        // SAFETY: the Hessian blocks and the column entries are in rows of this
+                        // chunk's free particles, which no other chunk of this colour touches;
+                        // the row entries are in this constraint's own row (see
+                        // `SharedValues`).
+                        unsafe { shared.add(slot, v) }
+                    });
                 }
             });
         }
     }
+}
+
+/// The per-particle table `values` of `offsets`' elements cut into the pieces of [`MIN_TASK`]
+/// consecutive elements (contiguous in the table), each with its first element: the tasks of
+/// the residual's element pass, each writing its own piece.
+fn split_by_elements<'a>(
+    mut values: &'a mut [Vec3],
+    offsets: &ElementOffsets,
+) -> Vec<(usize, &'a mut [Vec3])> {
+    let mut pieces = Vec::with_capacity(offsets.len().div_ceil(MIN_TASK));
+    for first in (0..offsets.len()).step_by(MIN_TASK) {
+        let entries = offsets.particles_of(first..(first + MIN_TASK).min(offsets.len()));
+        let (piece, rest) = std::mem::take(&mut values).split_at_mut(entries.len());
+        pieces.push((first, piece));
+        values = rest;
+    }
+    pieces
 }

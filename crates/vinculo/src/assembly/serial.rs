@@ -77,13 +77,12 @@ impl Layout {
             if !f.has_jacobian() {
                 continue;
             }
-            let mut dq: Jacobian = Default::default();
-            let mut dv: Jacobian = Default::default();
-            f.add_jacobian(at.q_eval, at.v_eval, at.t_eval, &mut dq, &mut dv);
-            let blocks = &self.force_block[fi];
             let n = f.particles().len();
+            let mut dq = Jacobian::zeros(n);
+            let mut dv = Jacobian::zeros(n);
+            f.add_jacobian(at.q_eval, at.v_eval, at.t_eval, &mut dq, &mut dv);
+            let blocks = &self.force_block[self.force_offsets.pairs(fi)];
             add_force_blocks(
-                n,
                 blocks,
                 blocks,
                 (at.force_dq, &dq),
@@ -93,16 +92,18 @@ impl Layout {
         }
         let same_point = at.same_point();
         for (c, con) in system.constraints().iter().enumerate() {
-            let n = con.particles().len();
-            let mut hess: Hessian = Default::default();
+            let mut hess = Hessian::zeros(con.particles().len());
             con.add_hessian(at.q_eval, at.t_eval, at.hessian * at.lambda[c], &mut hess);
             let grad_eval = con.gradient(at.q_eval, at.t_eval);
             let grad_end = if same_point {
-                grad_eval
+                None
             } else {
-                con.gradient(at.q_end, at.t_end)
+                Some(con.gradient(at.q_end, at.t_end))
             };
-            self.add_constraint_blocks(values, c, n, &hess, at.scales[c], &grad_eval, &grad_end);
+            let grads = (&grad_eval[..], grad_end.as_deref().unwrap_or(&grad_eval));
+            self.add_constraint_blocks(c, &hess, at.scales[c], grads, |slot, v| {
+                super::add(values, slot, v)
+            });
         }
     }
 }

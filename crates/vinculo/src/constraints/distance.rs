@@ -13,6 +13,7 @@
 
 use super::{Gradient, Hessian};
 use crate::math::{diag, dot, sub, Vec3};
+use smallvec::smallvec;
 
 /// |q_i - q_j| = L.
 #[derive(Debug, Clone, PartialEq)]
@@ -35,7 +36,7 @@ impl Distance {
 
     pub(crate) fn gradient(&self, q: &[Vec3], _t: f64) -> Gradient {
         let d = sub(q[self.particles[0]], q[self.particles[1]]);
-        [
+        smallvec![
             [-2.0 * d[0], -2.0 * d[1], -2.0 * d[2]],
             [2.0 * d[0], 2.0 * d[1], 2.0 * d[2]],
         ]
@@ -46,7 +47,7 @@ impl Distance {
         let d = sub(q[self.particles[0]], q[self.particles[1]]);
         let phi = self.length * self.length - dot(d, d);
         let g = [-2.0 * d[0], -2.0 * d[1], -2.0 * d[2]];
-        (phi, [g, [-g[0], -g[1], -g[2]]])
+        (phi, smallvec![g, [-g[0], -g[1], -g[2]]])
     }
 
     pub(crate) fn add_hessian(&self, _q: &[Vec3], _t: f64, w: f64, out: &mut Hessian) {

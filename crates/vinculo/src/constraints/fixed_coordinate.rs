@@ -9,6 +9,7 @@
 use super::{Gradient, Hessian};
 use crate::laws::Law;
 use crate::math::Vec3;
+use smallvec::smallvec;
 
 /// q[axis] = c(t).
 #[derive(Debug, Clone, PartialEq)]
@@ -31,9 +32,9 @@ impl FixedCoordinate {
     }
 
     pub(crate) fn gradient(&self, _q: &[Vec3], _t: f64) -> Gradient {
-        let mut g = [[0.0; 3]; 2];
-        g[0][self.axis] = 1.0;
-        g
+        let mut g = [0.0; 3];
+        g[self.axis] = 1.0;
+        smallvec![g]
     }
 
     pub(crate) fn add_hessian(&self, _q: &[Vec3], _t: f64, _w: f64, _out: &mut Hessian) {}

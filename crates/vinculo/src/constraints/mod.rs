@@ -1,14 +1,20 @@
 //! Constraints Phi(q, t) = 0, one equation each, enforced with a Lagrange multiplier.
 //!
 //! Contract of a constraint (one file per kind):
-//! - `particles()`: the particles it touches (one or two);
+//! - `particles()`: the particles it touches (any number n >= 1);
 //! - `residual(q, t)`: Phi;
-//! - `gradient(q, t)`: dPhi/dq_p for each touched particle p (a row 3-vector each);
-//! - `add_hessian(w, out)`: adds w d2Phi/dq_p dq_r for each pair of touched particles;
+//! - `gradient(q, t)`: dPhi/dq_p for each touched particle p (a row 3-vector each, n in all);
+//! - `add_hessian(w, out)`: adds w d2Phi/dq_p dq_r for each ordered pair of touched particles
+//!   (n x n blocks);
 //! - `phi_t(q, t)`: the partial time derivative, so that Phi' = Phi_q v + Phi_t;
 //! - `gamma(q, v, t)`: the part of Phi'' that does not contain the accelerations,
 //!   Phi'' = Phi_q a + gamma;
 //! - `scale()`: s such that s Phi is a length (it scales rows and multipliers of the linear solve).
+//!
+//! The local values are [`crate::local`]'s: whatever n is, the one assembler places them through
+//! the constraint's slot tables, so a kind over three or more particles (a point-on-line
+//! constraint, a point of a rigid body) is one file like the others. A kind with several
+//! equations (a joint) adds one equation per row, each with its own multiplier.
 //!
 //! `q` and `v` are the positions and velocities of every particle of the system (fixed ones
 //! included). Each kind's doc comment derives its terms; tests check them against finite
@@ -31,12 +37,13 @@ pub use point_distance::PointDistance;
 pub use redundancy::{find_redundant, MAX_ENTRIES, RANK_TOLERANCE};
 pub use user::{ConstraintCall, ConstraintGroup, UserConstraint, UserConstraints};
 
-use crate::math::{Mat3, Vec3};
+use crate::local::{Blocks, PerParticle};
+use crate::math::Vec3;
 
 /// Gradient blocks of one equation, one row 3-vector per touched particle.
-pub type Gradient = [Vec3; 2];
+pub type Gradient = PerParticle;
 /// Hessian blocks of one equation, [p][r] = d2Phi/dq_p dq_r.
-pub type Hessian = [[Mat3; 2]; 2];
+pub type Hessian = Blocks;
 
 /// Every built-in constraint kind, dispatched statically.
 #[derive(Debug, Clone, PartialEq)]
@@ -183,8 +190,8 @@ pub(crate) mod fd {
         let parts = c.particles().to_vec();
         let g = c.gradient(q, t);
         // The combined evaluation is the same as the separate ones, bit for bit.
-        assert_eq!(c.residual_and_gradient(q, t), (c.residual(q, t), g));
-        let mut hess: Hessian = Default::default();
+        assert_eq!(c.residual_and_gradient(q, t), (c.residual(q, t), g.clone()));
+        let mut hess = Hessian::zeros(parts.len());
         c.add_hessian(q, t, 1.0, &mut hess);
         for (a, &pa) in parts.iter().enumerate() {
             for k in 0..3 {

@@ -12,6 +12,7 @@
 use super::{Gradient, Hessian};
 use crate::laws::VectorLaw;
 use crate::math::{dot, sub, Vec3};
+use smallvec::smallvec;
 
 /// n(t).(q - p0(t)) = 0.
 #[derive(Debug, Clone, PartialEq)]
@@ -39,7 +40,7 @@ impl Plane {
     }
 
     pub(crate) fn gradient(&self, _q: &[Vec3], t: f64) -> Gradient {
-        [self.normal.value(t), [0.0; 3]]
+        smallvec![self.normal.value(t)]
     }
 
     pub(crate) fn add_hessian(&self, _q: &[Vec3], _t: f64, _w: f64, _out: &mut Hessian) {}

@@ -11,6 +11,7 @@
 use super::{Gradient, Hessian};
 use crate::laws::VectorLaw;
 use crate::math::{dot, sub, Vec3};
+use smallvec::smallvec;
 
 /// |q - p(t)| = L.
 #[derive(Debug, Clone, PartialEq)]
@@ -35,7 +36,7 @@ impl PointDistance {
 
     pub(crate) fn gradient(&self, q: &[Vec3], t: f64) -> Gradient {
         let d = sub(q[self.particles[0]], self.point.value(t));
-        [[-2.0 * d[0], -2.0 * d[1], -2.0 * d[2]], [0.0; 3]]
+        smallvec![[-2.0 * d[0], -2.0 * d[1], -2.0 * d[2]]]
     }
 
     pub(crate) fn add_hessian(&self, _q: &[Vec3], _t: f64, w: f64, out: &mut Hessian) {

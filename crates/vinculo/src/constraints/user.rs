@@ -1,6 +1,6 @@
 //! Constraints computed by user functions for a whole group of elements at once.
 //!
-//! A group has k elements of arity a (one or two particles each), one equation each, and a
+//! A group has k elements of arity a (a particles each, any a >= 1), one equation each, and a
 //! [`ConstraintGroup`] that evaluates, for positions q (k x a x 3) at time t:
 //! - Phi: k values (always supplied);
 //! - the gradient dPhi/dq: k x a x 3;
@@ -30,7 +30,9 @@
 
 use super::{Gradient, Hessian};
 use crate::math::Vec3;
-use crate::user::{central_steps, forward_steps, CallCount, GroupState, UserFailure};
+use crate::user::{
+    central_steps, forward_steps, CallCount, GroupElements, GroupState, UserFailure,
+};
 use std::sync::{Arc, Mutex, MutexGuard};
 
 /// The user functions of a constraint group.
@@ -95,10 +97,8 @@ pub trait ConstraintGroup: Send + Sync {
 pub struct UserConstraints {
     /// The group's name (used in messages).
     pub name: String,
-    /// Particles per element (1 or 2).
-    pub arity: usize,
-    /// Each element's particles (the second unused for arity 1).
-    pub elements: Vec<[usize; 2]>,
+    /// Each element's particles (any number per element, the same for all).
+    pub elements: GroupElements,
     /// s such that s Phi is a length.
     pub scale: f64,
     functions: Box<dyn ConstraintGroup>,
@@ -112,7 +112,7 @@ impl std::fmt::Debug for UserConstraints {
             "UserConstraints({:?}, {} elements of arity {})",
             self.name,
             self.elements.len(),
-            self.arity
+            self.elements.arity()
         )
     }
 }
@@ -121,14 +121,12 @@ impl UserConstraints {
     /// A group over `elements` (the caller has checked the indices, arity and scale).
     pub fn new(
         name: String,
-        arity: usize,
-        elements: Vec<[usize; 2]>,
+        elements: GroupElements,
         scale: f64,
         functions: Box<dyn ConstraintGroup>,
     ) -> UserConstraints {
         UserConstraints {
             name,
-            arity,
             elements,
             scale,
             functions,
@@ -160,7 +158,7 @@ impl UserConstraints {
     }
 
     fn width(&self) -> usize {
-        3 * self.arity
+        3 * self.elements.arity()
     }
 
     /// Evaluates `call` over the group at the inputs `q` (and `v` for gamma), k x a x 3, outside
@@ -335,7 +333,6 @@ impl UserConstraints {
             call as usize,
             call.width(self.width()),
             &self.elements,
-            self.arity,
             e,
             q,
             v,
@@ -353,22 +350,16 @@ pub struct UserConstraint {
     pub group: Arc<UserConstraints>,
     /// The element's position in the group.
     pub element: usize,
-    particles: [usize; 2],
 }
 
 impl UserConstraint {
     /// Element `element` of `group`.
     pub fn new(group: Arc<UserConstraints>, element: usize) -> UserConstraint {
-        let particles = group.elements[element];
-        UserConstraint {
-            group,
-            element,
-            particles,
-        }
+        UserConstraint { group, element }
     }
 
     pub(crate) fn particles(&self) -> &[usize] {
-        &self.particles[..self.group.arity]
+        self.group.elements.get(self.element)
     }
 
     pub(crate) fn residual(&self, q: &[Vec3], t: f64) -> f64 {
@@ -377,19 +368,14 @@ impl UserConstraint {
     }
 
     pub(crate) fn gradient(&self, q: &[Vec3], t: f64) -> Gradient {
-        let arity = self.group.arity;
         self.group
             .value(ConstraintCall::Gradient, self.element, q, None, t, |x| {
-                let mut g: Gradient = [[0.0; 3]; 2];
-                for p in 0..arity {
-                    g[p].copy_from_slice(&x[3 * p..3 * p + 3]);
-                }
-                g
+                x.chunks_exact(3).map(|g| [g[0], g[1], g[2]]).collect()
             })
     }
 
     pub(crate) fn add_hessian(&self, q: &[Vec3], t: f64, w: f64, out: &mut Hessian) {
-        let arity = self.group.arity;
+        let arity = self.group.elements.arity();
         let n = 3 * arity;
         self.group
             .value(ConstraintCall::Hessian, self.element, q, None, t, |x| {

@@ -3,6 +3,7 @@
 use super::{Jacobian, Local};
 use crate::laws::VectorLaw;
 use crate::math::Vec3;
+use smallvec::smallvec;
 
 /// f = F(t) on one particle.
 #[derive(Debug, Clone, PartialEq)]
@@ -19,7 +20,7 @@ impl AppliedForce {
     }
 
     pub(crate) fn force(&self, _q: &[Vec3], _v: &[Vec3], t: f64) -> Local {
-        [self.force.value(t), [0.0; 3], [0.0; 3]]
+        smallvec![self.force.value(t)]
     }
 
     pub(crate) fn add_jacobian(

@@ -48,7 +48,10 @@ impl Bending {
 
     pub(crate) fn force(&self, q: &[Vec3], _v: &[Vec3], _t: f64) -> Local {
         let d = self.difference(q);
-        WEIGHTS.map(|w| scale(-self.stiffness * w, d))
+        WEIGHTS
+            .iter()
+            .map(|&w| scale(-self.stiffness * w, d))
+            .collect()
     }
 
     pub(crate) fn add_jacobian(

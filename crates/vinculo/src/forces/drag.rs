@@ -6,6 +6,7 @@
 
 use super::{Jacobian, Local};
 use crate::math::{add_mat, diag, norm, outer, scale, Vec3};
+use smallvec::smallvec;
 
 /// f = -c v.
 #[derive(Debug, Clone, PartialEq)]
@@ -22,11 +23,7 @@ impl LinearDrag {
     }
 
     pub(crate) fn force(&self, _q: &[Vec3], v: &[Vec3], _t: f64) -> Local {
-        [
-            scale(-self.coefficient, v[self.particles[0]]),
-            [0.0; 3],
-            [0.0; 3],
-        ]
+        smallvec![scale(-self.coefficient, v[self.particles[0]])]
     }
 
     pub(crate) fn add_jacobian(
@@ -57,7 +54,7 @@ impl QuadraticDrag {
 
     pub(crate) fn force(&self, _q: &[Vec3], v: &[Vec3], _t: f64) -> Local {
         let u = v[self.particles[0]];
-        [scale(-self.coefficient * norm(u), u), [0.0; 3], [0.0; 3]]
+        smallvec![scale(-self.coefficient * norm(u), u)]
     }
 
     pub(crate) fn add_jacobian(

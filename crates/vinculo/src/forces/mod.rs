@@ -1,13 +1,15 @@
 //! Applied forces f(q, v, t) with their analytic Jacobians df/dq and df/dv.
 //!
 //! Contract of a force element (one file per kind):
-//! - `particles()`: the particles it acts on (one or two);
+//! - `particles()`: the particles it acts on (any number n >= 1);
 //! - `force(q, v, t)`: the applied force on each touched particle;
-//! - `add_jacobian(q, v, t, dq, dv)`: adds df_p/dq_r and df_p/dv_r for each pair of touched
-//!   particles;
+//! - `add_jacobian(q, v, t, dq, dv)`: adds df_p/dq_r and df_p/dv_r for each ordered pair of
+//!   touched particles (n x n blocks each);
 //! - `potential(q)`: the potential energy for conservative elements (0 for dissipative ones).
 //!
 //! - `added_mass()`: mass added to a particle's inertia (fluid elements only).
+//!
+//! The local values are [`crate::local`]'s, placed by the one assembler whatever n is.
 //!
 //! Uniform gravity acts on every particle and lives in the [`System`](crate::model::System) itself.
 //! The residual of the dynamics uses F = -f (`docs/theory/formulation.md`), so the assembler subtracts these.
@@ -29,14 +31,13 @@ pub use morison::{Morison, MorisonSpec};
 pub use spring_damper::SpringDamper;
 pub use user::{ForceGroup, UserForce, UserForces};
 
-use crate::math::{Mat3, Vec3};
+use crate::local::{Blocks, PerParticle};
+use crate::math::Vec3;
 
-/// Most particles a force kind acts on (a bending force acts on three).
-pub const MAX_FORCE_PARTICLES: usize = 3;
-/// Forces on the touched particles (entries past the force's own particles are zero).
-pub type Local = [Vec3; MAX_FORCE_PARTICLES];
-/// Jacobian blocks [p][r] = df_p/dx_r.
-pub type Jacobian = [[Mat3; MAX_FORCE_PARTICLES]; MAX_FORCE_PARTICLES];
+/// Forces on the touched particles, one per particle in the order of `particles()`.
+pub type Local = PerParticle;
+/// Jacobian blocks [p][r] = df_p/dx_r between the touched particles.
+pub type Jacobian = Blocks;
 
 /// Every built-in force kind, dispatched statically.
 #[derive(Debug, Clone, PartialEq)]
@@ -158,8 +159,8 @@ pub(crate) mod fd {
     pub fn check(f: &Force, q: &[Vec3], v: &[Vec3], t: f64) {
         let h = 1e-6;
         let parts = f.particles().to_vec();
-        let mut dq: Jacobian = Default::default();
-        let mut dv: Jacobian = Default::default();
+        let mut dq = Jacobian::zeros(parts.len());
+        let mut dv = Jacobian::zeros(parts.len());
         f.add_jacobian(q, v, t, &mut dq, &mut dv);
         for (r, &pr) in parts.iter().enumerate() {
             for k in 0..3 {

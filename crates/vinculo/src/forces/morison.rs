@@ -22,6 +22,7 @@
 use super::{Jacobian, Local};
 use crate::laws::VectorLaw;
 use crate::math::{add_mat, diag, norm, outer, scale, sub, Vec3};
+use smallvec::smallvec;
 
 /// The fluid and body data of a [`Morison`] element, as given to
 /// [`System::add_morison`](crate::model::System::add_morison).
@@ -88,7 +89,7 @@ impl Morison {
         let f = std::array::from_fn(|k| {
             mf * (a[k] - self.gravity[k]) + self.added_mass() * a[k] + drag[k]
         });
-        [f, [0.0; 3], [0.0; 3]]
+        smallvec![f]
     }
 
     pub(crate) fn add_jacobian(

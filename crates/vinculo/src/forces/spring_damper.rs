@@ -12,6 +12,7 @@
 
 use super::{Jacobian, Local};
 use crate::math::{add_mat, diag, dot, norm, outer, scale, scale_mat, sub, Mat3, Vec3};
+use smallvec::smallvec;
 
 /// Spring of stiffness k and rest length L0 with a parallel dashpot c.
 #[derive(Debug, Clone, PartialEq)]
@@ -43,7 +44,7 @@ impl SpringDamper {
 
     pub(crate) fn force(&self, q: &[Vec3], v: &[Vec3], _t: f64) -> Local {
         let (e, _, _, tension) = self.axial(q, v);
-        [scale(-tension, e), scale(tension, e), [0.0; 3]]
+        smallvec![scale(-tension, e), scale(tension, e)]
     }
 
     pub(crate) fn add_jacobian(

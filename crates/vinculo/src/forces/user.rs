@@ -1,6 +1,6 @@
 //! Forces computed by a user function for a whole group of elements at once.
 //!
-//! A group has k elements of arity a (one or two particles each) and a [`ForceGroup`], which
+//! A group has k elements of arity a (a particles each, any a >= 1) and a [`ForceGroup`], which
 //! maps the positions and velocities of every element's particles, arrays k x a x 3, to the
 //! forces on them, k x a x 3, and optionally to the Jacobians df/dq and df/dv, k x 3a x 3a
 //! (row 3p + l: component l of the force on the element's particle p; column 3r + m: coordinate
@@ -20,9 +20,9 @@
 //!
 //! See [`crate::user`] for the batching, caching and failure rules.
 
-use super::{Jacobian, Local, MAX_FORCE_PARTICLES};
+use super::{Jacobian, Local};
 use crate::math::Vec3;
-use crate::user::{forward_steps, CallCount, GroupState, UserFailure};
+use crate::user::{forward_steps, CallCount, GroupElements, GroupState, UserFailure};
 use std::sync::{Arc, Mutex, MutexGuard};
 
 /// The user functions of a force group (no Python in the core: the bindings implement it).
@@ -54,10 +54,8 @@ const JACOBIAN: usize = 1;
 pub struct UserForces {
     /// The group's name (used in messages).
     pub name: String,
-    /// Particles per element (1 or 2).
-    pub arity: usize,
-    /// Each element's particles (the second unused for arity 1).
-    pub elements: Vec<[usize; 2]>,
+    /// Each element's particles (any number per element, the same for all).
+    pub elements: GroupElements,
     functions: Box<dyn ForceGroup>,
     state: Mutex<GroupState<2>>,
 }
@@ -69,7 +67,7 @@ impl std::fmt::Debug for UserForces {
             "UserForces({:?}, {} elements of arity {})",
             self.name,
             self.elements.len(),
-            self.arity
+            self.elements.arity()
         )
     }
 }
@@ -78,13 +76,11 @@ impl UserForces {
     /// A group over `elements` (the caller has checked the indices and the arity).
     pub fn new(
         name: String,
-        arity: usize,
-        elements: Vec<[usize; 2]>,
+        elements: GroupElements,
         functions: Box<dyn ForceGroup>,
     ) -> UserForces {
         UserForces {
             name,
-            arity,
             elements,
             functions,
             state: Mutex::new(GroupState::new()),
@@ -147,7 +143,7 @@ impl UserForces {
 
     /// Number of coordinates of one element, 3a.
     fn width(&self) -> usize {
-        3 * self.arity
+        3 * self.elements.arity()
     }
 
     /// One call of the force function over the group.
@@ -220,22 +216,16 @@ pub struct UserForce {
     pub group: Arc<UserForces>,
     /// The element's position in the group.
     pub element: usize,
-    particles: [usize; 2],
 }
 
 impl UserForce {
     /// Element `element` of `group`.
     pub fn new(group: Arc<UserForces>, element: usize) -> UserForce {
-        let particles = group.elements[element];
-        UserForce {
-            group,
-            element,
-            particles,
-        }
+        UserForce { group, element }
     }
 
     pub(crate) fn particles(&self) -> &[usize] {
-        &self.particles[..self.group.arity]
+        self.group.elements.get(self.element)
     }
 
     pub(crate) fn force(&self, q: &[Vec3], v: &[Vec3], t: f64) -> Local {
@@ -245,19 +235,12 @@ impl UserForce {
             FORCE,
             n,
             &g.elements,
-            g.arity,
             self.element,
             q,
             Some(v),
             t,
             |st, qg, vg| g.call_force(st, t, qg, vg),
-            |f| {
-                let mut out: Local = [[0.0; 3]; MAX_FORCE_PARTICLES];
-                for p in 0..g.arity {
-                    out[p].copy_from_slice(&f[3 * p..3 * p + 3]);
-                }
-                out
-            },
+            |f| f.chunks_exact(3).map(|x| [x[0], x[1], x[2]]).collect(),
         )
     }
 
@@ -271,12 +254,11 @@ impl UserForce {
     ) {
         let g = &*self.group;
         let n = g.width();
-        let arity = g.arity;
+        let arity = g.elements.arity();
         g.lock().lookup(
             JACOBIAN,
             2 * n * n,
             &g.elements,
-            arity,
             self.element,
             q,
             Some(v),

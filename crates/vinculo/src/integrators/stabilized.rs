@@ -288,7 +288,7 @@ impl StabilizedWorkspace {
 /// part of gamma in v (module documentation). `probe` is a zero velocity field of the system's
 /// size, left zero.
 pub fn phi_qt(con: &Constraint, q: &[Vec3], t: f64, probe: &mut [Vec3]) -> Gradient {
-    let mut out: Gradient = Default::default();
+    let mut out: Gradient = smallvec::smallvec![[0.0; 3]; con.particles().len()];
     for (x, &p) in con.particles().iter().enumerate() {
         for j in 0..3 {
             probe[p][j] = 1.0;
@@ -394,41 +394,44 @@ impl NewtonProblem for StabilizedProblem<'_> {
             if !f.has_jacobian() {
                 continue;
             }
-            let mut dq: Jacobian = Default::default();
-            let mut dv: Jacobian = Default::default();
+            let n = f.particles().len();
+            let mut dq = Jacobian::zeros(n);
+            let mut dv = Jacobian::zeros(n);
             f.add_jacobian(self.q_eval, self.v_eval, rule.t_eval, &mut dq, &mut dv);
             let (wq, wv) = (-rule.sigma * rule.w, -rule.sigma * rule.w / rule.kappa);
-            let (blocks_q, blocks_v) = (&layout.force_q[fi], &layout.force_v[fi]);
-            add_force_blocks(
-                f.particles().len(),
-                blocks_q,
-                blocks_v,
-                (wq, &dq),
-                (wv, &dv),
-                |b, s, m| add_block(values, b, s, m),
-            );
+            let pairs = layout.force_offsets.pairs(fi);
+            let (blocks_q, blocks_v) = (&layout.force_q[pairs.clone()], &layout.force_v[pairs]);
+            add_force_blocks(blocks_q, blocks_v, (wq, &dq), (wv, &dv), |b, s, m| {
+                add_block(values, b, s, m)
+            });
         }
         for (c, con) in system.constraints().iter().enumerate() {
             let parts = con.particles();
             let n = parts.len();
             let s = self.scales[c];
-            let mut dyn_hess: Hessian = Default::default();
+            let mut dyn_hess = Hessian::zeros(n);
             let w_lambda = -rule.sigma * rule.w * b.lambda[c];
             con.add_hessian(self.q_eval, rule.t_eval, w_lambda, &mut dyn_hess);
-            let mut hess: Hessian = Default::default();
+            let mut hess = Hessian::zeros(n);
             con.add_hessian(&b.q, rule.t_end, 1.0, &mut hess);
             let grad_e = con.gradient(self.q_eval, rule.t_eval);
             let grad_1 = con.gradient(&b.q, rule.t_end);
             let qt = phi_qt(con, &b.q, rule.t_end, self.probe);
+            let pairs = layout.constraint_offsets.pairs(c);
+            let (dynamic_hessian, kinematic_hessian) = (
+                &layout.dynamic_hessian[pairs.clone()],
+                &layout.kinematic_hessian[pairs],
+            );
+            let strips = layout.constraint_offsets.particles(c);
+            let kinematic_mu = &layout.kinematic_mu[strips.clone()];
+            let dynamic_lambda = &layout.dynamic_lambda[strips.clone()];
+            let position_row = &layout.position_row[strips.clone()];
+            let velocity_row_v = &layout.velocity_row_v[strips.clone()];
+            let velocity_row_q = &layout.velocity_row_q[strips];
             for x in 0..n {
                 for y in 0..n {
-                    add_block(
-                        values,
-                        &layout.dynamic_hessian[c][x][y],
-                        1.0,
-                        &dyn_hess[x][y],
-                    );
-                    let kin = &layout.kinematic_hessian[c][x][y];
+                    add_block(values, &dynamic_hessian[x * n + y], 1.0, &dyn_hess[x][y]);
+                    let kin = &kinematic_hessian[x * n + y];
                     add_block(values, kin, -self.mu[c], &hess[x][y]);
                 }
                 // d(G v)/dq_x = sum_y H[x][y] v_y.
@@ -442,12 +445,12 @@ impl NewtonProblem for StabilizedProblem<'_> {
                     }
                 }
                 for k in 0..3 {
-                    add(values, layout.kinematic_mu[c][x][k], -s * grad_1[x][k]);
-                    add(values, layout.dynamic_lambda[c][x][k], -s * grad_e[x][k]);
-                    add(values, layout.position_row[c][x][k], s * grad_1[x][k]);
-                    add(values, layout.velocity_row_v[c][x][k], s * grad_1[x][k]);
+                    add(values, kinematic_mu[x][k], -s * grad_1[x][k]);
+                    add(values, dynamic_lambda[x][k], -s * grad_e[x][k]);
+                    add(values, position_row[x][k], s * grad_1[x][k]);
+                    add(values, velocity_row_v[x][k], s * grad_1[x][k]);
                     let dq = s * rule.kappa * dpsi[k];
-                    add(values, layout.velocity_row_q[c][x][k], dq);
+                    add(values, velocity_row_q[x][k], dq);
                 }
             }
         }

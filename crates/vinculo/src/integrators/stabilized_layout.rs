@@ -29,16 +29,16 @@
 //! kinematics, which would bring G G^T and f_v G^T fill between neighbouring elements) keeps
 //! every block local.
 
-use crate::assembly::{number_particles, Block, ForceBlocks, Pattern, Slot, NONE, NO_SLOT};
-use crate::forces::MAX_FORCE_PARTICLES;
+use crate::assembly::{
+    number_particles, push_column, push_pair_blocks, push_row, Block, ElementOffsets, Pattern,
+    Slot, NONE, NO_SLOT,
+};
 use crate::model::System;
 
-/// Slots of a constraint's 3-vector row or column, per touched particle.
-pub type Strip = [[Slot; 3]; 2];
-/// Slots of 3x3 blocks between the (at most two) particles an element touches.
-pub type PairBlocks = [[Block; 2]; 2];
-
-/// Where each element writes in the stabilised iteration matrix.
+/// Where each element writes in the stabilised iteration matrix. The per-constraint and
+/// per-force tables hold one entry per touched particle (the strips of 3 slots) or per ordered
+/// pair of touched particles (the blocks), from the element's offsets
+/// ([`crate::assembly::ElementOffsets`]).
 #[derive(Debug, Clone)]
 pub struct StabilizedLayout {
     /// First position unknown of each particle (NONE for fixed particles); its velocity unknowns
@@ -56,24 +56,28 @@ pub struct StabilizedLayout {
     pub kinematic_v: Vec<[Slot; 3]>,
     /// Per particle: dynamic rows, velocity columns (the mass).
     pub dynamic_v: Vec<Block>,
-    /// Per constraint: kinematic rows, position columns, between its particles (mu Hessian).
-    pub kinematic_hessian: Vec<PairBlocks>,
-    /// Per constraint: dynamic rows, position columns, between its particles (lambda Hessian).
-    pub dynamic_hessian: Vec<PairBlocks>,
-    /// Per constraint: kinematic rows of its particles, its mu column.
-    pub kinematic_mu: Vec<Strip>,
-    /// Per constraint: dynamic rows of its particles, its lambda column.
-    pub dynamic_lambda: Vec<Strip>,
-    /// Per constraint: its position row, position columns of its particles.
-    pub position_row: Vec<Strip>,
-    /// Per constraint: its velocity row, position columns of its particles.
-    pub velocity_row_q: Vec<Strip>,
-    /// Per constraint: its velocity row, velocity columns of its particles.
-    pub velocity_row_v: Vec<Strip>,
-    /// Per force: dynamic rows, position columns.
-    pub force_q: Vec<ForceBlocks>,
-    /// Per force: dynamic rows, velocity columns.
-    pub force_v: Vec<ForceBlocks>,
+    /// Where each constraint's entries start in the tables below.
+    pub constraint_offsets: ElementOffsets,
+    /// Per constraint and pair of its particles: kinematic rows, position columns (mu Hessian).
+    pub kinematic_hessian: Vec<Block>,
+    /// Per constraint and pair of its particles: dynamic rows, position columns (lambda Hessian).
+    pub dynamic_hessian: Vec<Block>,
+    /// Per constraint and particle: kinematic rows of the particle, its mu column.
+    pub kinematic_mu: Vec<[Slot; 3]>,
+    /// Per constraint and particle: dynamic rows of the particle, its lambda column.
+    pub dynamic_lambda: Vec<[Slot; 3]>,
+    /// Per constraint and particle: its position row, position columns of the particle.
+    pub position_row: Vec<[Slot; 3]>,
+    /// Per constraint and particle: its velocity row, position columns of the particle.
+    pub velocity_row_q: Vec<[Slot; 3]>,
+    /// Per constraint and particle: its velocity row, velocity columns of the particle.
+    pub velocity_row_v: Vec<[Slot; 3]>,
+    /// Where each force's entries start in the tables below.
+    pub force_offsets: ElementOffsets,
+    /// Per force and pair of its particles: dynamic rows, position columns.
+    pub force_q: Vec<Block>,
+    /// Per force and pair of its particles: dynamic rows, velocity columns.
+    pub force_v: Vec<Block>,
 }
 
 impl StabilizedLayout {
@@ -135,40 +139,6 @@ impl StabilizedLayout {
         let pattern = Pattern::new(n, entries, n <= dense_limit);
         let slot = |row: usize, col: usize| pattern.slot32(row, col);
         let block_slots = |a: usize, b: usize| pattern.block_slots(a, b);
-        // Blocks between an element's particles: rows shifted by `row`, columns by `col`.
-        let pair_blocks = |parts: &[usize], row: usize, col: usize| -> PairBlocks {
-            let mut out = [[[NO_SLOT; 9]; 2]; 2];
-            for (x, &a) in parts.iter().enumerate() {
-                for (y, &b) in parts.iter().enumerate() {
-                    out[x][y] = block_slots(shift(dof[a], row), shift(dof[b], col));
-                }
-            }
-            out
-        };
-        // A constraint's column (its particles' rows, shifted) and row (their columns, shifted).
-        let column = |parts: &[usize], row_shift: usize, col: usize| -> Strip {
-            let mut out = [[NO_SLOT; 3]; 2];
-            for (x, &p) in parts.iter().enumerate() {
-                if dof[p] != NONE {
-                    for r in 0..3 {
-                        out[x][r] = slot(dof[p] + row_shift + r, col);
-                    }
-                }
-            }
-            out
-        };
-        let row = |parts: &[usize], row: usize, col_shift: usize| -> Strip {
-            let mut out = [[NO_SLOT; 3]; 2];
-            for (x, &p) in parts.iter().enumerate() {
-                if dof[p] != NONE {
-                    for c in 0..3 {
-                        out[x][c] = slot(row, dof[p] + col_shift + c);
-                    }
-                }
-            }
-            out
-        };
-
         let kinematic_q = dof.iter().map(|&d| block_slots(d, d)).collect();
         let kinematic_v = dof
             .iter()
@@ -185,74 +155,55 @@ impl StabilizedLayout {
             .map(|&d| block_slots(shift(d, vel), shift(d, vel)))
             .collect();
         let cons = system.constraints();
+        let constraint_offsets = ElementOffsets::new(cons.iter().map(|c| c.particles()));
+        let pairs = || Vec::with_capacity(constraint_offsets.pair_entries());
+        let strips = || Vec::with_capacity(constraint_offsets.particle_entries());
+        let (mut kinematic_hessian, mut dynamic_hessian) = (pairs(), pairs());
+        let (mut kinematic_mu, mut dynamic_lambda) = (strips(), strips());
+        let (mut position_row, mut velocity_row_q, mut velocity_row_v) =
+            (strips(), strips(), strips());
+        for (k, c) in cons.iter().enumerate() {
+            let parts = c.particles();
+            push_pair_blocks(&mut kinematic_hessian, &pattern, parts, &dof, (0, 0));
+            push_pair_blocks(&mut dynamic_hessian, &pattern, parts, &dof, (vel, 0));
+            push_column(&mut kinematic_mu, &pattern, parts, &dof, (0, mu + k));
+            push_column(&mut dynamic_lambda, &pattern, parts, &dof, (vel, lam + k));
+            push_row(&mut position_row, &pattern, parts, &dof, (lam + k, 0));
+            push_row(&mut velocity_row_q, &pattern, parts, &dof, (mu + k, 0));
+            push_row(&mut velocity_row_v, &pattern, parts, &dof, (mu + k, vel));
+        }
         let forces = system.forces();
-        let no_blocks = [[[NO_SLOT; 9]; MAX_FORCE_PARTICLES]; MAX_FORCE_PARTICLES];
-        let force_blocks = |parts: &[usize], row: usize, col: usize| -> ForceBlocks {
-            let mut out = no_blocks;
-            for (x, &a) in parts.iter().enumerate() {
-                for (y, &b) in parts.iter().enumerate() {
-                    out[x][y] = block_slots(shift(dof[a], row), shift(dof[b], col));
-                }
+        let force_offsets = ElementOffsets::new(forces.iter().map(|f| f.particles()));
+        let (mut force_q, mut force_v) = (
+            Vec::with_capacity(force_offsets.pair_entries()),
+            Vec::with_capacity(force_offsets.pair_entries()),
+        );
+        for f in forces {
+            let parts = f.particles();
+            if f.has_jacobian() {
+                push_pair_blocks(&mut force_q, &pattern, parts, &dof, (vel, 0));
+                push_pair_blocks(&mut force_v, &pattern, parts, &dof, (vel, vel));
+            } else {
+                let none = std::iter::repeat_n([NO_SLOT; 9], parts.len() * parts.len());
+                force_q.extend(none.clone());
+                force_v.extend(none);
             }
-            out
-        };
+        }
         StabilizedLayout {
             kinematic_q,
             kinematic_v,
             dynamic_v,
-            kinematic_hessian: cons
-                .iter()
-                .map(|c| pair_blocks(c.particles(), 0, 0))
-                .collect(),
-            dynamic_hessian: cons
-                .iter()
-                .map(|c| pair_blocks(c.particles(), vel, 0))
-                .collect(),
-            kinematic_mu: cons
-                .iter()
-                .enumerate()
-                .map(|(k, c)| column(c.particles(), 0, mu + k))
-                .collect(),
-            dynamic_lambda: cons
-                .iter()
-                .enumerate()
-                .map(|(k, c)| column(c.particles(), vel, lam + k))
-                .collect(),
-            position_row: cons
-                .iter()
-                .enumerate()
-                .map(|(k, c)| row(c.particles(), lam + k, 0))
-                .collect(),
-            velocity_row_q: cons
-                .iter()
-                .enumerate()
-                .map(|(k, c)| row(c.particles(), mu + k, 0))
-                .collect(),
-            velocity_row_v: cons
-                .iter()
-                .enumerate()
-                .map(|(k, c)| row(c.particles(), mu + k, vel))
-                .collect(),
-            force_q: forces
-                .iter()
-                .map(|f| {
-                    if f.has_jacobian() {
-                        force_blocks(f.particles(), vel, 0)
-                    } else {
-                        no_blocks
-                    }
-                })
-                .collect(),
-            force_v: forces
-                .iter()
-                .map(|f| {
-                    if f.has_jacobian() {
-                        force_blocks(f.particles(), vel, vel)
-                    } else {
-                        no_blocks
-                    }
-                })
-                .collect(),
+            constraint_offsets,
+            kinematic_hessian,
+            dynamic_hessian,
+            kinematic_mu,
+            dynamic_lambda,
+            position_row,
+            velocity_row_q,
+            velocity_row_v,
+            force_offsets,
+            force_q,
+            force_v,
             dof,
             free,
             constraints: m,

@@ -11,56 +11,49 @@ use super::System;
 use crate::constraints::{Constraint, ConstraintGroup, UserConstraint, UserConstraints};
 use crate::error::{positive, Error, Result};
 use crate::forces::{Force, ForceGroup, UserForce, UserForces};
+use crate::user::GroupElements;
 use std::sync::Arc;
 
 impl System {
-    /// Checks a group's elements: arity 1 or 2, at least one element, particle indices in
-    /// range, two different particles per element of arity 2.
-    fn check_elements(&self, what: &str, elements: &[[usize; 2]], arity: usize) -> Result<()> {
-        if !(arity == 1 || arity == 2) {
-            return Err(Error::InvalidParameter {
-                name: format!("arity of {what}"),
-                value: arity as f64,
-                expected: "must be 1 (one particle per element) or 2 (two particles)".into(),
-            });
-        }
+    /// Checks a group's elements: at least one element, particle indices in range, no particle
+    /// twice in one element.
+    fn check_elements(&self, what: &str, elements: &GroupElements) -> Result<()> {
         if elements.is_empty() {
             return Err(Error::InvalidParameter {
                 name: format!("number of elements of {what}"),
                 value: 0.0,
-                expected: "must be >= 1: give at least one particle (or pair)".into(),
+                expected: "must be >= 1: give the particles of at least one element".into(),
             });
         }
         let count = self.particles().len();
-        for e in elements {
-            for &p in &e[..arity] {
+        for e in elements.iter() {
+            for (x, &p) in e.iter().enumerate() {
                 if p >= count {
                     return Err(Error::UnknownParticle { index: p, count });
                 }
-            }
-            if arity == 2 && e[0] == e[1] {
-                return Err(Error::SameParticle {
-                    what: what.into(),
-                    particle: e[0],
-                });
+                if e[..x].contains(&p) {
+                    return Err(Error::SameParticle {
+                        what: what.into(),
+                        particle: p,
+                    });
+                }
             }
         }
         Ok(())
     }
 
-    /// Adds a group of `elements.len()` force elements of `arity` particles each (the second
-    /// index is ignored for arity 1), computed by `functions` for the whole group at once.
-    /// `name` names it in messages (default "force group N").
+    /// Adds a group of `elements.len()` force elements, `elements.arity()` particles each
+    /// (any number), computed by `functions` for the whole group at once. `name` names it in
+    /// messages (default "force group N").
     pub fn add_user_force_group(
         &mut self,
-        elements: Vec<[usize; 2]>,
-        arity: usize,
+        elements: GroupElements,
         functions: Box<dyn ForceGroup>,
         name: Option<String>,
     ) -> Result<Arc<UserForces>> {
         let name = name.unwrap_or_else(|| format!("force group {}", self.user_forces.len()));
-        self.check_elements(&format!("user force group '{name}'"), &elements, arity)?;
-        let group = Arc::new(UserForces::new(name, arity, elements, functions));
+        self.check_elements(&format!("user force group '{name}'"), &elements)?;
+        let group = Arc::new(UserForces::new(name, elements, functions));
         for e in 0..group.elements.len() {
             self.forces
                 .push(Force::User(UserForce::new(group.clone(), e)));
@@ -74,8 +67,7 @@ impl System {
     /// index of its first equation (the others follow in element order).
     pub fn add_user_constraint_group(
         &mut self,
-        elements: Vec<[usize; 2]>,
-        arity: usize,
+        elements: GroupElements,
         functions: Box<dyn ConstraintGroup>,
         scale: f64,
         name: Option<String>,
@@ -83,19 +75,17 @@ impl System {
         let name =
             name.unwrap_or_else(|| format!("constraint group {}", self.user_constraints.len()));
         let what = format!("user constraint group '{name}'");
-        self.check_elements(&what, &elements, arity)?;
+        self.check_elements(&what, &elements)?;
         let scale = positive(format!("scale of {what}"), scale)?;
         for (e, parts) in elements.iter().enumerate() {
-            if parts[..arity].iter().all(|&p| self.particles()[p].fixed) {
+            if parts.iter().all(|&p| self.particles()[p].fixed) {
                 return Err(Error::ConstraintOnFixedParticles {
                     what: format!("element {e} of {what}"),
                 });
             }
         }
         let first = self.constraints.len();
-        let group = Arc::new(UserConstraints::new(
-            name, arity, elements, scale, functions,
-        ));
+        let group = Arc::new(UserConstraints::new(name, elements, scale, functions));
         for e in 0..group.elements.len() {
             self.push_constraint(Constraint::User(UserConstraint::new(group.clone(), e)))?;
         }
