@@ -31,9 +31,9 @@ fn fill_saddle(system: &System, ws: &mut StepWorkspace, q: &[Vec3], t: f64) {
         let g = con.gradient(q, t);
         // The saddle matrix has no Hessian term: zero blocks.
         let none = crate::local::Blocks::zeros(g.len());
-        layout.add_constraint_blocks(c, &none, ws.scales[c], (&g, &g), |slot, v| {
-            add(values, slot, v)
-        });
+        let add_block = |v: &mut [f64], b: &_, m: &_| crate::assembly::add_block(v, b, 1.0, m);
+        let values: &mut [f64] = values;
+        layout.add_constraint_blocks(values, (c, &none), ws.scales[c], (&g, &g), add_block, add);
     }
 }
 

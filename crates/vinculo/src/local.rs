@@ -20,6 +20,62 @@ pub const INLINE: usize = 4;
 /// One 3-vector per touched particle, in the order of the element's `particles()`.
 pub type PerParticle = SmallVec<[Vec3; INLINE]>;
 
+/// An element's per-particle values as its kind computes them: a fixed-size array on the stack
+/// for the built-in kinds (one to three particles), a [`PerParticle`] for the others (user
+/// groups). Read as a slice; the assembler's hot loops take it without copying.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Rows {
+    /// One particle.
+    One([Vec3; 1]),
+    /// Two particles.
+    Two([Vec3; 2]),
+    /// Three particles.
+    Three([Vec3; 3]),
+    /// Any number of particles (on the heap: only user groups, whose evaluation costs far more).
+    Any(Vec<Vec3>),
+}
+
+impl std::ops::Deref for Rows {
+    type Target = [Vec3];
+    #[inline(always)]
+    fn deref(&self) -> &[Vec3] {
+        match self {
+            Rows::One(x) => x,
+            Rows::Two(x) => x,
+            Rows::Three(x) => x,
+            Rows::Any(x) => x,
+        }
+    }
+}
+
+impl From<[Vec3; 1]> for Rows {
+    #[inline(always)]
+    fn from(x: [Vec3; 1]) -> Rows {
+        Rows::One(x)
+    }
+}
+
+impl From<[Vec3; 2]> for Rows {
+    #[inline(always)]
+    fn from(x: [Vec3; 2]) -> Rows {
+        Rows::Two(x)
+    }
+}
+
+impl From<[Vec3; 3]> for Rows {
+    #[inline(always)]
+    fn from(x: [Vec3; 3]) -> Rows {
+        Rows::Three(x)
+    }
+}
+
+impl From<PerParticle> for Rows {
+    #[inline(always)]
+    fn from(x: PerParticle) -> Rows {
+        Rows::Any(x.into_vec())
+    }
+}
+
 /// One 3x3 block per ordered pair (x, y) of an element's touched particles: `b[x][y]` is the
 /// block of particle x's rows and particle y's columns.
 #[derive(Debug, Clone, PartialEq)]
@@ -38,6 +94,18 @@ impl Blocks {
         }
     }
 
+    /// The blocks in one slice, x-major: block (x, y) is entry x n + y.
+    #[inline(always)]
+    pub fn as_slice(&self) -> &[Mat3] {
+        &self.data
+    }
+
+    /// The blocks in one mutable slice, x-major.
+    #[inline(always)]
+    pub fn as_mut_slice(&mut self) -> &mut [Mat3] {
+        &mut self.data
+    }
+
     /// Number of touched particles n.
     #[inline]
     pub fn particles(&self) -> usize {
@@ -52,12 +120,17 @@ impl Blocks {
         }
     }
 
-    /// Resizes to n x n zero blocks.
+    /// Makes these n x n zero blocks, reusing the storage (the assembler keeps one buffer for
+    /// all its elements).
     #[inline]
     pub fn reset(&mut self, n: usize) {
-        self.n = n;
-        self.data.clear();
-        self.data.resize(n * n, [[0.0; 3]; 3]);
+        if n == self.n {
+            self.clear();
+        } else {
+            self.n = n;
+            self.data.clear();
+            self.data.resize(n * n, [[0.0; 3]; 3]);
+        }
     }
 }
 

@@ -189,41 +189,33 @@ impl Layout {
 }
 
 impl Layout {
-    /// Adds constraint `c`'s part of the iteration matrix: its Hessian-term blocks `hess` between
-    /// its touched particles, `-s grad_column` into its multiplier's column (the -Phi_q^T
-    /// block) and `s grad_row` into its row (the Phi_q block), through `add` (which adds a value
-    /// at a slot). The schemes differ only in where they evaluate the two gradients and the
-    /// Hessian.
+    /// Adds constraint `c`'s part of the iteration matrix `values`: its Hessian-term blocks
+    /// `hess` between its touched particles (through `add_block`, which adds a 3x3 matrix into
+    /// a block), `-s grad_column` into its multiplier's column (the -Phi_q^T block) and
+    /// `s grad_row` into its row (the Phi_q block), through `add` (which adds a value at a slot,
+    /// nothing at an absent one). The schemes differ only in where they evaluate the two
+    /// gradients and the Hessian.
     #[inline(always)]
-    pub fn add_constraint_blocks(
+    pub fn add_constraint_blocks<V: ?Sized>(
         &self,
-        c: usize,
-        hess: &crate::local::Blocks,
+        values: &mut V,
+        (c, hess): (usize, &crate::local::Blocks),
         s: f64,
         (grad_column, grad_row): (&[crate::math::Vec3], &[crate::math::Vec3]),
-        mut add: impl FnMut(Slot, f64),
+        add_block: impl Fn(&mut V, &Block, &crate::math::Mat3),
+        add: impl Fn(&mut V, Slot, f64),
     ) {
-        let n = hess.particles();
         let blocks = &self.constraint_hessian[self.constraint_offsets.pairs(c)];
-        for x in 0..n {
-            for y in 0..n {
-                let (b, m) = (&blocks[x * n + y], &hess[x][y]);
-                if b[0] != NO_SLOT {
-                    for r in 0..3 {
-                        for k in 0..3 {
-                            add(b[3 * r + k], m[r][k]);
-                        }
-                    }
-                }
-            }
+        for (b, m) in blocks.iter().zip(hess.as_slice()) {
+            add_block(values, b, m);
         }
         let range = self.constraint_offsets.particles(c);
         let columns = &self.constraint_column[range.clone()];
         let rows = &self.constraint_row[range];
-        for x in 0..n {
+        for (x, (column, row)) in columns.iter().zip(rows).enumerate() {
             for k in 0..3 {
-                add(columns[x][k], -s * grad_column[x][k]);
-                add(rows[x][k], s * grad_row[x][k]);
+                add(values, column[k], -s * grad_column[x][k]);
+                add(values, row[k], s * grad_row[x][k]);
             }
         }
     }
@@ -310,12 +302,10 @@ pub fn add_force_blocks(
     (wv, dv): (f64, &crate::forces::Jacobian),
     mut add: impl FnMut(&Block, f64, &crate::math::Mat3),
 ) {
-    let n = dq.particles();
-    for x in 0..n {
-        for y in 0..n {
-            add(&blocks_q[x * n + y], wq, &dq[x][y]);
-            add(&blocks_v[x * n + y], wv, &dv[x][y]);
-        }
+    let pairs = blocks_q.iter().zip(blocks_v);
+    for ((bq, bv), (mq, mv)) in pairs.zip(dq.as_slice().iter().zip(dv.as_slice())) {
+        add(bq, wq, mq);
+        add(bv, wv, mv);
     }
 }
 

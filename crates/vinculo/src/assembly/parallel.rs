@@ -335,9 +335,10 @@ impl ParallelAssembly {
             .for_each(|(first, out)| {
                 let mut i = 0;
                 for f in &forces[first..(first + MIN_TASK).min(forces.len())] {
-                    let fl = f.force(at.q_eval, at.v_eval, at.t_eval);
-                    out[i..i + fl.len()].copy_from_slice(&fl);
-                    i += fl.len();
+                    f.with_force(at.q_eval, at.v_eval, at.t_eval, |fl| {
+                        out[i..i + fl.len()].copy_from_slice(fl);
+                        i += fl.len();
+                    });
                 }
             });
         let constraints = system.constraints();
@@ -348,9 +349,10 @@ impl ParallelAssembly {
                 let mut i = 0;
                 for (c, r) in (first..).zip(rows.iter_mut()) {
                     let con = &constraints[c];
-                    let grad = con.gradient(at.q_eval, at.t_eval);
-                    out[i..i + grad.len()].copy_from_slice(&grad);
-                    i += grad.len();
+                    con.with_gradient(at.q_eval, at.t_eval, |grad| {
+                        out[i..i + grad.len()].copy_from_slice(grad);
+                        i += grad.len();
+                    });
                     *r = at.scales[c] * con.residual(at.q_end, at.t_end);
                 }
             });
@@ -406,13 +408,14 @@ impl ParallelAssembly {
                 &self.force_colours[self.force_colour_start[g]..self.force_colour_start[g + 1]];
             group.par_iter().for_each(|&chunk| {
                 let end = (chunk * CHUNK + CHUNK).min(forces.len());
+                let (mut dq, mut dv) = (Jacobian::zeros(0), Jacobian::zeros(0));
                 for (fi, f) in forces.iter().enumerate().take(end).skip(chunk * CHUNK) {
                     if !f.has_jacobian() {
                         continue;
                     }
                     let n = f.particles().len();
-                    let mut dq = Jacobian::zeros(n);
-                    let mut dv = Jacobian::zeros(n);
+                    dq.reset(n);
+                    dv.reset(n);
                     f.add_jacobian(at.q_eval, at.v_eval, at.t_eval, &mut dq, &mut dv);
                     let blocks = &layout.force_block[layout.force_offsets.pairs(fi)];
                     let (wq, wv) = ((at.force_dq, &dq), (at.force_dv, &dv));
@@ -432,23 +435,45 @@ impl ParallelAssembly {
                 [self.constraint_colour_start[g]..self.constraint_colour_start[g + 1]];
             group.par_iter().for_each(|&chunk| {
                 let end = (chunk * CHUNK + CHUNK).min(constraints.len());
+                let mut hess = Hessian::zeros(0);
                 for c in chunk * CHUNK..end {
                     let con = &constraints[c];
-                    let mut hess = Hessian::zeros(con.particles().len());
+                    hess.reset(con.particles().len());
                     con.add_hessian(at.q_eval, at.t_eval, at.hessian * at.lambda[c], &mut hess);
-                    let grad_eval = con.gradient(at.q_eval, at.t_eval);
-                    let grad_end = if same_point {
-                        None
-                    } else {
-                        Some(con.gradient(at.q_end, at.t_end))
+                    // SAFETY (both): the Hessian blocks and the column entries are in rows of
+                    // this chunk's free particles, which no other chunk of this colour touches;
+                    // the row entries are in this constraint's own row (see `SharedValues`).
+                    let add_block = |v: &mut &SharedValues, b: &Block, m: &Mat3| unsafe {
+                        v.add_block(b, 1.0, m)
                     };
-                    let grads = (&grad_eval[..], grad_end.as_deref().unwrap_or(&grad_eval));
-                    layout.add_constraint_blocks(c, &hess, at.scales[c], grads, |slot, v| {
-                        // SAFETY: the Hessian blocks and the column entries are in rows of this
-                        // chunk's free particles, which no other chunk of this colour touches;
-                        // the row entries are in this constraint's own row (see
-                        // `SharedValues`).
-                        unsafe { shared.add(slot, v) }
+                    let add = |v: &mut &SharedValues, slot, x| unsafe { v.add(slot, x) };
+                    let s = at.scales[c];
+                    let mut target = shared;
+                    con.with_gradient(at.q_eval, at.t_eval, |grad_eval| {
+                        let blocks = (c, &hess);
+                        if same_point {
+                            let grads = (grad_eval, grad_eval);
+                            layout.add_constraint_blocks(
+                                &mut target,
+                                blocks,
+                                s,
+                                grads,
+                                add_block,
+                                add,
+                            );
+                        } else {
+                            con.with_gradient(at.q_end, at.t_end, |grad_end| {
+                                let grads = (grad_eval, grad_end);
+                                layout.add_constraint_blocks(
+                                    &mut target,
+                                    blocks,
+                                    s,
+                                    grads,
+                                    add_block,
+                                    add,
+                                );
+                            });
+                        }
                     });
                 }
             });

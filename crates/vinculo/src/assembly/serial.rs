@@ -4,9 +4,10 @@
 //! residual equals this one bit for bit.
 
 use super::JacobianTerms;
-use super::{add_force_blocks, InertiaRows, Layout, ResidualTerms, NONE};
+use super::{add_force_blocks, Block, InertiaRows, Layout, ResidualTerms, NONE};
 use crate::constraints::Hessian;
 use crate::forces::Jacobian;
+use crate::math::{Mat3, Vec3};
 use crate::model::System;
 
 impl Layout {
@@ -28,35 +29,26 @@ impl Layout {
             }
         }
         for f in system.forces() {
-            let fl = f.force(at.q_eval, at.v_eval, at.t_eval);
-            for (x, &p) in f.particles().iter().enumerate() {
-                let d = self.dof[p];
-                if d != NONE {
-                    for k in 0..3 {
-                        r[d + k] -= sigma * fl[x][k];
-                    }
-                }
-            }
+            f.with_force(at.q_eval, at.v_eval, at.t_eval, |fl| {
+                self.subtract_rows(r, f.particles(), sigma, fl)
+            });
         }
         let same_point = at.same_point();
         let m3 = 3 * self.free;
         for (c, con) in system.constraints().iter().enumerate() {
-            let (phi, grad) = if same_point {
-                con.residual_and_gradient(at.q_end, at.t_end)
-            } else {
-                let grad = con.gradient(at.q_eval, at.t_eval);
-                (con.residual(at.q_end, at.t_end), grad)
-            };
             let weight = sigma * at.lambda[c];
-            for (x, &p) in con.particles().iter().enumerate() {
-                let d = self.dof[p];
-                if d != NONE {
-                    let row = &mut r[d..d + 3];
-                    for k in 0..3 {
-                        row[k] -= weight * grad[x][k];
-                    }
-                }
-            }
+            let parts = con.particles();
+            let phi = if same_point {
+                con.with_residual_and_gradient(at.q_end, at.t_end, |phi, grad| {
+                    self.subtract_rows(r, parts, weight, grad);
+                    phi
+                })
+            } else {
+                con.with_gradient(at.q_eval, at.t_eval, |grad| {
+                    self.subtract_rows(r, parts, weight, grad)
+                });
+                con.residual(at.q_end, at.t_end)
+            };
             r[m3 + c] = at.scales[c] * phi;
         }
     }
@@ -73,13 +65,15 @@ impl Layout {
         for i in 0..self.dof.len() {
             self.add_to_particle_diagonal(values, i, mass(i));
         }
+        // One buffer of local blocks for all elements, reset to each one's size.
+        let (mut dq, mut dv) = (Jacobian::zeros(0), Jacobian::zeros(0));
         for (fi, f) in system.forces().iter().enumerate() {
             if !f.has_jacobian() {
                 continue;
             }
             let n = f.particles().len();
-            let mut dq = Jacobian::zeros(n);
-            let mut dv = Jacobian::zeros(n);
+            dq.reset(n);
+            dv.reset(n);
             f.add_jacobian(at.q_eval, at.v_eval, at.t_eval, &mut dq, &mut dv);
             let blocks = &self.force_block[self.force_offsets.pairs(fi)];
             add_force_blocks(
@@ -91,19 +85,44 @@ impl Layout {
             );
         }
         let same_point = at.same_point();
+        let mut hess = Hessian::zeros(0);
         for (c, con) in system.constraints().iter().enumerate() {
-            let mut hess = Hessian::zeros(con.particles().len());
+            hess.reset(con.particles().len());
             con.add_hessian(at.q_eval, at.t_eval, at.hessian * at.lambda[c], &mut hess);
-            let grad_eval = con.gradient(at.q_eval, at.t_eval);
-            let grad_end = if same_point {
-                None
-            } else {
-                Some(con.gradient(at.q_end, at.t_end))
-            };
-            let grads = (&grad_eval[..], grad_end.as_deref().unwrap_or(&grad_eval));
-            self.add_constraint_blocks(c, &hess, at.scales[c], grads, |slot, v| {
-                super::add(values, slot, v)
+            let add_block = |v: &mut [f64], b: &Block, m: &Mat3| super::add_block(v, b, 1.0, m);
+            let s = at.scales[c];
+            con.with_gradient(at.q_eval, at.t_eval, |grad_eval| {
+                if same_point {
+                    let grads = (grad_eval, grad_eval);
+                    self.add_constraint_blocks(values, (c, &hess), s, grads, add_block, super::add);
+                } else {
+                    con.with_gradient(at.q_end, at.t_end, |grad_end| {
+                        let grads = (grad_eval, grad_end);
+                        self.add_constraint_blocks(
+                            values,
+                            (c, &hess),
+                            s,
+                            grads,
+                            add_block,
+                            super::add,
+                        );
+                    });
+                }
             });
+        }
+    }
+
+    /// Subtracts `weight rows[x]` from the dynamics rows of each free particle `parts[x]`.
+    #[inline(always)]
+    fn subtract_rows(&self, r: &mut [f64], parts: &[usize], weight: f64, rows: &[Vec3]) {
+        for (x, &p) in parts.iter().enumerate() {
+            let d = self.dof[p];
+            if d != NONE {
+                let row = &mut r[d..d + 3];
+                for k in 0..3 {
+                    row[k] -= weight * rows[x][k];
+                }
+            }
         }
     }
 }

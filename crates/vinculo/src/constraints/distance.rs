@@ -11,9 +11,8 @@
 //! The constraint force on i is Phi_q^T lambda = -2 lambda d: lambda > 0 pulls i towards j, and the
 //! tension of the link is 2 lambda L.
 
-use super::{Gradient, Hessian};
-use crate::math::{diag, dot, sub, Vec3};
-use smallvec::smallvec;
+use super::Hessian;
+use crate::math::{dot, sub, Vec3};
 
 /// |q_i - q_j| = L.
 #[derive(Debug, Clone, PartialEq)]
@@ -34,30 +33,29 @@ impl Distance {
         self.length * self.length - dot(d, d)
     }
 
-    pub(crate) fn gradient(&self, q: &[Vec3], _t: f64) -> Gradient {
+    pub(crate) fn gradient(&self, q: &[Vec3], _t: f64) -> [Vec3; 2] {
         let d = sub(q[self.particles[0]], q[self.particles[1]]);
-        smallvec![
+        [
             [-2.0 * d[0], -2.0 * d[1], -2.0 * d[2]],
             [2.0 * d[0], 2.0 * d[1], 2.0 * d[2]],
         ]
     }
 
     #[inline]
-    pub(crate) fn residual_and_gradient(&self, q: &[Vec3]) -> (f64, Gradient) {
+    pub(crate) fn residual_and_gradient(&self, q: &[Vec3]) -> (f64, [Vec3; 2]) {
         let d = sub(q[self.particles[0]], q[self.particles[1]]);
         let phi = self.length * self.length - dot(d, d);
         let g = [-2.0 * d[0], -2.0 * d[1], -2.0 * d[2]];
-        (phi, smallvec![g, [-g[0], -g[1], -g[2]]])
+        (phi, [g, [-g[0], -g[1], -g[2]]])
     }
 
+    #[inline]
     pub(crate) fn add_hessian(&self, _q: &[Vec3], _t: f64, w: f64, out: &mut Hessian) {
-        for a in 0..2 {
-            for b in 0..2 {
-                let s = if a == b { -2.0 * w } else { 2.0 * w };
-                let h = diag(s);
-                for r in 0..3 {
-                    out[a][b][r][r] += h[r][r];
-                }
+        // Blocks (i, i), (i, j), (j, i), (j, j): -2 w I, 2 w I, 2 w I, -2 w I.
+        for (k, block) in out.as_mut_slice().iter_mut().enumerate() {
+            let s = if k == 0 || k == 3 { -2.0 * w } else { 2.0 * w };
+            for r in 0..3 {
+                block[r][r] += s;
             }
         }
     }

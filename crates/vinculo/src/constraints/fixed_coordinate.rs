@@ -6,10 +6,9 @@
 //! - gamma = -c''
 //! - scale 1.
 
-use super::{Gradient, Hessian};
+use super::Hessian;
 use crate::laws::Law;
 use crate::math::Vec3;
-use smallvec::smallvec;
 
 /// q[axis] = c(t).
 #[derive(Debug, Clone, PartialEq)]
@@ -31,10 +30,10 @@ impl FixedCoordinate {
         q[self.particles[0]][self.axis] - self.value.value(t)
     }
 
-    pub(crate) fn gradient(&self, _q: &[Vec3], _t: f64) -> Gradient {
+    pub(crate) fn gradient(&self, _q: &[Vec3], _t: f64) -> [Vec3; 1] {
         let mut g = [0.0; 3];
         g[self.axis] = 1.0;
-        smallvec![g]
+        [g]
     }
 
     pub(crate) fn add_hessian(&self, _q: &[Vec3], _t: f64, _w: f64, _out: &mut Hessian) {}

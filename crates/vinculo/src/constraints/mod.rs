@@ -37,7 +37,7 @@ pub use point_distance::PointDistance;
 pub use redundancy::{find_redundant, MAX_ENTRIES, RANK_TOLERANCE};
 pub use user::{ConstraintCall, ConstraintGroup, UserConstraint, UserConstraints};
 
-use crate::local::{Blocks, PerParticle};
+use crate::local::{Blocks, PerParticle, Rows};
 use crate::math::Vec3;
 
 /// Gradient blocks of one equation, one row 3-vector per touched particle.
@@ -88,11 +88,24 @@ impl Constraint {
     /// dPhi/dq for each touched particle.
     #[inline(always)]
     pub fn gradient(&self, q: &[Vec3], t: f64) -> Gradient {
-        dispatch!(self, c => c.gradient(q, t))
+        Gradient::from_slice(&self.gradient_rows(q, t))
+    }
+
+    /// dPhi/dq for each touched particle, on the stack for the built-in kinds.
+    #[inline(always)]
+    pub fn gradient_rows(&self, q: &[Vec3], t: f64) -> Rows {
+        dispatch!(self, c => c.gradient(q, t).into())
+    }
+
+    /// Calls `use_it` with dPhi/dq for each touched particle: the assembler's hot path, where
+    /// the built-in kinds hand over their gradients from the stack, whatever their size.
+    #[inline(always)]
+    pub fn with_gradient<R>(&self, q: &[Vec3], t: f64, use_it: impl FnOnce(&[Vec3]) -> R) -> R {
+        use_it(&self.gradient_rows(q, t))
     }
 
     /// Adds `w` times the Hessian d2Phi/dq2 to `out`.
-    #[inline]
+    #[inline(always)]
     pub fn add_hessian(&self, q: &[Vec3], t: f64, w: f64, out: &mut Hessian) {
         dispatch!(self, c => c.add_hessian(q, t, w, out))
     }
@@ -101,9 +114,25 @@ impl Constraint {
     /// share their work).
     #[inline]
     pub fn residual_and_gradient(&self, q: &[Vec3], t: f64) -> (f64, Gradient) {
+        self.with_residual_and_gradient(q, t, |phi, g| (phi, Gradient::from_slice(g)))
+    }
+
+    /// Calls `use_it` with Phi(q, t) and dPhi/dq (as [`Constraint::with_gradient`]).
+    #[inline(always)]
+    pub fn with_residual_and_gradient<R>(
+        &self,
+        q: &[Vec3],
+        t: f64,
+        use_it: impl FnOnce(f64, &[Vec3]) -> R,
+    ) -> R {
+        // Chains are made of distances: theirs is taken apart from the other kinds' (whose
+        // residual and gradient are evaluated one after the other).
         match self {
-            Constraint::Distance(c) => c.residual_and_gradient(q),
-            other => (other.residual(q, t), other.gradient(q, t)),
+            Constraint::Distance(c) => {
+                let (phi, g) = c.residual_and_gradient(q);
+                use_it(phi, &g)
+            }
+            other => use_it(other.residual(q, t), &other.gradient_rows(q, t)),
         }
     }
 

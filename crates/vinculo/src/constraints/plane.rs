@@ -9,10 +9,9 @@
 //!
 //! The constraint force is n lambda: with a unit normal, lambda is the normal force.
 
-use super::{Gradient, Hessian};
+use super::Hessian;
 use crate::laws::VectorLaw;
 use crate::math::{dot, sub, Vec3};
-use smallvec::smallvec;
 
 /// n(t).(q - p0(t)) = 0.
 #[derive(Debug, Clone, PartialEq)]
@@ -39,8 +38,8 @@ impl Plane {
         )
     }
 
-    pub(crate) fn gradient(&self, _q: &[Vec3], t: f64) -> Gradient {
-        smallvec![self.normal.value(t)]
+    pub(crate) fn gradient(&self, _q: &[Vec3], t: f64) -> [Vec3; 1] {
+        [self.normal.value(t)]
     }
 
     pub(crate) fn add_hessian(&self, _q: &[Vec3], _t: f64, _w: f64, _out: &mut Hessian) {}

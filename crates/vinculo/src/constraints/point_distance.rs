@@ -8,10 +8,9 @@
 //! - Phi'' = -2 d.(a - p'') - 2 |v - p'|^2, so gamma = 2 d.p'' - 2 |v - p'|^2
 //! - scale 1/(2L).
 
-use super::{Gradient, Hessian};
+use super::Hessian;
 use crate::laws::VectorLaw;
 use crate::math::{dot, sub, Vec3};
-use smallvec::smallvec;
 
 /// |q - p(t)| = L.
 #[derive(Debug, Clone, PartialEq)]
@@ -34,9 +33,9 @@ impl PointDistance {
         self.length * self.length - dot(d, d)
     }
 
-    pub(crate) fn gradient(&self, q: &[Vec3], t: f64) -> Gradient {
+    pub(crate) fn gradient(&self, q: &[Vec3], t: f64) -> [Vec3; 1] {
         let d = sub(q[self.particles[0]], self.point.value(t));
-        smallvec![[-2.0 * d[0], -2.0 * d[1], -2.0 * d[2]]]
+        [[-2.0 * d[0], -2.0 * d[1], -2.0 * d[2]]]
     }
 
     pub(crate) fn add_hessian(&self, _q: &[Vec3], _t: f64, w: f64, out: &mut Hessian) {

@@ -1,9 +1,8 @@
 //! A prescribed force F(t) on one particle (constant or any law of time). Its Jacobian is zero.
 
-use super::{Jacobian, Local};
+use super::Jacobian;
 use crate::laws::VectorLaw;
 use crate::math::Vec3;
-use smallvec::smallvec;
 
 /// f = F(t) on one particle.
 #[derive(Debug, Clone, PartialEq)]
@@ -19,8 +18,8 @@ impl AppliedForce {
         &self.particles
     }
 
-    pub(crate) fn force(&self, _q: &[Vec3], _v: &[Vec3], t: f64) -> Local {
-        smallvec![self.force.value(t)]
+    pub(crate) fn force(&self, _q: &[Vec3], _v: &[Vec3], t: f64) -> [Vec3; 1] {
+        [self.force.value(t)]
     }
 
     pub(crate) fn add_jacobian(

@@ -20,7 +20,7 @@
 //! and, since d is linear in q, the Jacobian is constant: df_x/dq_y = -k w_x w_y I (a symmetric,
 //! negative semi-definite 9x9 matrix, as for any conservative force); df/dv = 0.
 
-use super::{Jacobian, Local};
+use super::Jacobian;
 use crate::math::{add_mat, diag, scale, Vec3};
 
 /// Weights of the three particles in the second difference d.
@@ -46,12 +46,9 @@ impl Bending {
         std::array::from_fn(|k| q[a][k] - 2.0 * q[b][k] + q[c][k])
     }
 
-    pub(crate) fn force(&self, q: &[Vec3], _v: &[Vec3], _t: f64) -> Local {
+    pub(crate) fn force(&self, q: &[Vec3], _v: &[Vec3], _t: f64) -> [Vec3; 3] {
         let d = self.difference(q);
-        WEIGHTS
-            .iter()
-            .map(|&w| scale(-self.stiffness * w, d))
-            .collect()
+        WEIGHTS.map(|w| scale(-self.stiffness * w, d))
     }
 
     pub(crate) fn add_jacobian(

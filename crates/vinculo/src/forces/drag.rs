@@ -4,9 +4,8 @@
 //! Quadratic: f = -c |v| v, df/dv = -c (|v| I + v v^T / |v|) (zero at v = 0, where f is C1).
 //! Neither depends on q.
 
-use super::{Jacobian, Local};
+use super::Jacobian;
 use crate::math::{add_mat, diag, norm, outer, scale, Vec3};
-use smallvec::smallvec;
 
 /// f = -c v.
 #[derive(Debug, Clone, PartialEq)]
@@ -22,8 +21,8 @@ impl LinearDrag {
         &self.particles
     }
 
-    pub(crate) fn force(&self, _q: &[Vec3], v: &[Vec3], _t: f64) -> Local {
-        smallvec![scale(-self.coefficient, v[self.particles[0]])]
+    pub(crate) fn force(&self, _q: &[Vec3], v: &[Vec3], _t: f64) -> [Vec3; 1] {
+        [scale(-self.coefficient, v[self.particles[0]])]
     }
 
     pub(crate) fn add_jacobian(
@@ -52,9 +51,9 @@ impl QuadraticDrag {
         &self.particles
     }
 
-    pub(crate) fn force(&self, _q: &[Vec3], v: &[Vec3], _t: f64) -> Local {
+    pub(crate) fn force(&self, _q: &[Vec3], v: &[Vec3], _t: f64) -> [Vec3; 1] {
         let u = v[self.particles[0]];
-        smallvec![scale(-self.coefficient * norm(u), u)]
+        [scale(-self.coefficient * norm(u), u)]
     }
 
     pub(crate) fn add_jacobian(

@@ -31,7 +31,7 @@ pub use morison::{Morison, MorisonSpec};
 pub use spring_damper::SpringDamper;
 pub use user::{ForceGroup, UserForce, UserForces};
 
-use crate::local::{Blocks, PerParticle};
+use crate::local::{Blocks, PerParticle, Rows};
 use crate::math::Vec3;
 
 /// Forces on the touched particles, one per particle in the order of `particles()`.
@@ -82,7 +82,26 @@ impl Force {
     /// Applied force on each touched particle.
     #[inline]
     pub fn force(&self, q: &[Vec3], v: &[Vec3], t: f64) -> Local {
-        dispatch!(self, f => f.force(q, v, t))
+        Local::from_slice(&self.force_rows(q, v, t))
+    }
+
+    /// Applied force on each touched particle, on the stack for the built-in kinds.
+    #[inline(always)]
+    pub fn force_rows(&self, q: &[Vec3], v: &[Vec3], t: f64) -> Rows {
+        dispatch!(self, f => f.force(q, v, t).into())
+    }
+
+    /// Calls `use_it` with the applied force on each touched particle: the assembler's hot path,
+    /// where the built-in kinds hand over their forces from the stack, whatever their size.
+    #[inline(always)]
+    pub fn with_force<R>(
+        &self,
+        q: &[Vec3],
+        v: &[Vec3],
+        t: f64,
+        use_it: impl FnOnce(&[Vec3]) -> R,
+    ) -> R {
+        use_it(&self.force_rows(q, v, t))
     }
 
     /// Adds df/dq into `dq` and df/dv into `dv`.

@@ -19,10 +19,9 @@
 //! d(c |r| r)/dr = c (|r| I + r r^T / |r|), and dr/db' = -I, so
 //! df/db' = -c (|r| I + r r^T / |r|) (zero at r = 0, where the drag is C1).
 
-use super::{Jacobian, Local};
+use super::Jacobian;
 use crate::laws::VectorLaw;
 use crate::math::{add_mat, diag, norm, outer, scale, sub, Vec3};
-use smallvec::smallvec;
 
 /// The fluid and body data of a [`Morison`] element, as given to
 /// [`System::add_morison`](crate::model::System::add_morison).
@@ -82,14 +81,14 @@ impl Morison {
         0.5 * self.density * self.drag_coefficient * self.area
     }
 
-    pub(crate) fn force(&self, _q: &[Vec3], v: &[Vec3], t: f64) -> Local {
+    pub(crate) fn force(&self, _q: &[Vec3], v: &[Vec3], t: f64) -> [Vec3; 1] {
         let (_, u, a) = self.fluid.eval(t);
         let mf = self.displaced_mass();
         let drag = self.drag_at(u, v[self.particles[0]]);
         let f = std::array::from_fn(|k| {
             mf * (a[k] - self.gravity[k]) + self.added_mass() * a[k] + drag[k]
         });
-        smallvec![f]
+        [f]
     }
 
     pub(crate) fn add_jacobian(

@@ -10,9 +10,8 @@
 //!
 //! Potential energy 1/2 k (l - L0)^2.
 
-use super::{Jacobian, Local};
+use super::Jacobian;
 use crate::math::{add_mat, diag, dot, norm, outer, scale, scale_mat, sub, Mat3, Vec3};
-use smallvec::smallvec;
 
 /// Spring of stiffness k and rest length L0 with a parallel dashpot c.
 #[derive(Debug, Clone, PartialEq)]
@@ -42,9 +41,9 @@ impl SpringDamper {
         (e, l, w, tension)
     }
 
-    pub(crate) fn force(&self, q: &[Vec3], v: &[Vec3], _t: f64) -> Local {
+    pub(crate) fn force(&self, q: &[Vec3], v: &[Vec3], _t: f64) -> [Vec3; 2] {
         let (e, _, _, tension) = self.axial(q, v);
-        smallvec![scale(-tension, e), scale(tension, e)]
+        [scale(-tension, e), scale(tension, e)]
     }
 
     pub(crate) fn add_jacobian(
