@@ -1,4 +1,4 @@
-"""The keyword options of a run, the same for :func:`vinculo.simulate` and :class:`vinculo.Simulation`."""
+"""The keyword options of a run, the same for :func:`vinculo.simulate` and `vinculo.Simulation`."""
 
 from __future__ import annotations
 

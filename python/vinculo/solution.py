@@ -112,7 +112,9 @@ class Solution:
     scheme: str = ""
     steps_taken: int = 0
     steps_rejected: int = 0
-    accepted_step_sizes: np.ndarray = field(default_factory=lambda: _read_only(np.empty(0), np.float64))
+    accepted_step_sizes: np.ndarray = field(
+        default_factory=lambda: _read_only(np.empty(0), np.float64)
+    )
     formulation: str = ""
 
     @classmethod
@@ -128,7 +130,9 @@ class Solution:
             ``result.error``.
         """
         arrays = {
-            name: _read_only(getattr(result, name), np.int64 if name == "newton_iterations" else np.float64)
+            name: _read_only(
+                getattr(result, name), np.int64 if name == "newton_iterations" else np.float64
+            )
             for name in _ARRAY_FIELDS
         }
         return cls(
