@@ -21,7 +21,7 @@ pub fn raise(py: Python<'_>, class: &str, message: String, details: Bound<'_, Py
 }
 
 /// The details each variant carries, as keyword arguments.
-pub fn details<'py>(py: Python<'py>, e: &Error) -> PyResult<Bound<'py, PyDict>> {
+fn details<'py>(py: Python<'py>, e: &Error) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     match e {
         Error::InvalidParameter { name, value, .. } => {
