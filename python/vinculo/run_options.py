@@ -18,13 +18,9 @@ class RunOptions:
     """How a run steps: the keyword options of :func:`vinculo.simulate` and
     :class:`vinculo.Simulation` (both take them as keyword arguments, with these names and
     defaults, and pass them to the compiled core as one ``RunSettings``, which checks every value's
-    range).
-
-    The equations ``M v' + F(q, v, t) - Phi_q^T lambda = 0``, ``v = q'``, ``Phi(q, t) = 0`` are
-    discretised by the scheme named by ``scheme`` and solved step by step with Newton's method, the
-    position constraints (with ``formulation='ggl'`` also the velocity constraints) holding at the
-    end of every step. A step that does not converge is retried with half the step size, up to
-    ``max_halvings`` times.
+    range). What the schemes and formulations discretise, and how a failing step is halved, is
+    told by :func:`vinculo.simulate`. Options kept as an object are passed on as keywords:
+    ``simulate(system, t_end, dt, **dataclasses.asdict(options))``.
 
     Arguments:
         scheme: 'trapezoidal' (the generalised trapezoidal rule with ``alpha``),
