@@ -30,6 +30,7 @@ from vinculo.errors import (
     VinculoError,
 )
 from vinculo.laws import constant, driven, piecewise_linear, polynomial, sine, tabulated
+from vinculo.run_options import RunOptions
 from vinculo.simulate import simulate
 from vinculo.solution import Solution
 from vinculo.stepping import Simulation, Snapshot
@@ -53,6 +54,7 @@ __all__ = [
     "NegativeTensionError",
     "ParticleId",
     "RedundantConstraintsError",
+    "RunOptions",
     "SchedulerError",
     "Simulation",
     "Snapshot",

@@ -7,6 +7,8 @@ from typing import Any, Callable, Sequence, Union
 import numpy as np
 import numpy.typing as npt
 
+from vinculo.errors import VinculoError
+
 class Law:
     """A prescribed scalar function of time with its first and second derivatives.
 
@@ -465,25 +467,95 @@ class RunSettings:
                  h_min: float = 1e-10, h_max: float | None = None,
                  t_eval: list[float] | None = None) -> None: ...
 
+class RunResult:
+    """A run as the compiled core returns it (``simulate``, ``Simulation.solution``): the stored
+    states and the statistics as typed read-only attributes (each array a fresh numpy copy), and
+    the error that stopped the run early as the exception that reports it. ``vinculo.Solution``
+    is built from it (``Solution.from_core``).
+
+    Row 0 is the initial state (0 iterations, step 0, multipliers from the consistent initial
+    accelerations); row k > 0 holds the multipliers of the step that ends at ``times[k]``, which
+    act at t_{k-1} + alpha dt for the trapezoidal schemes, where they evaluate the dynamics, and
+    at ``times[k]`` for generalized-alpha. With adaptive=True and t_eval: one row per requested
+    time, interpolated in its step, with that step's statistics.
+    """
+    @property
+    def times(self) -> npt.NDArray[np.float64]:
+        """Stored times, shape (s,), in s."""
+    @property
+    def positions(self) -> npt.NDArray[np.float64]:
+        """Positions, shape (s, n, 3), in m."""
+    @property
+    def velocities(self) -> npt.NDArray[np.float64]:
+        """Velocities, shape (s, n, 3), in m/s."""
+    @property
+    def multipliers(self) -> npt.NDArray[np.float64]:
+        """Lagrange multipliers, shape (s, m)."""
+    @property
+    def constraint_residual(self) -> npt.NDArray[np.float64]:
+        """max_k |s_k Phi_k| at each stored time, shape (s,), in m."""
+    @property
+    def velocity_violation(self) -> npt.NDArray[np.float64]:
+        """max_k |s_k (Phi_q v + Phi_t)| at each stored time, shape (s,), in m/s."""
+    @property
+    def newton_iterations(self) -> npt.NDArray[np.int64]:
+        """Newton iterations of each stored step, shape (s,)."""
+    @property
+    def step_sizes(self) -> npt.NDArray[np.float64]:
+        """Size of each stored step, shape (s,), in s."""
+    @property
+    def residual_norms(self) -> npt.NDArray[np.float64]:
+        """Final scaled residual norm of each stored step, shape (s,), in m."""
+    @property
+    def increment_norms(self) -> npt.NDArray[np.float64]:
+        """Last scaled Newton increment norm of each stored step, shape (s,), in m."""
+    @property
+    def accepted_step_sizes(self) -> npt.NDArray[np.float64]:
+        """Size of every accepted step, stored or not, in s."""
+    @property
+    def steps_taken(self) -> int:
+        """Steps attempted, including those rejected and retried."""
+    @property
+    def steps_rejected(self) -> int:
+        """Attempts rejected (Newton failed, or the error estimate exceeded the tolerance)."""
+    @property
+    def factorisations(self) -> int:
+        """Newton iteration matrices factorised over the run."""
+    @property
+    def linear_solver(self) -> str:
+        """The linear solver of the steps: 'dense LU', 'tree elimination' or 'sparse LU'."""
+    @property
+    def scheme(self) -> str:
+        """The time discretisation: 'trapezoidal', 'backward-euler' or 'generalized-alpha'."""
+    @property
+    def formulation(self) -> str:
+        """The equations discretised: 'index-3' or 'ggl'."""
+    @property
+    def error(self) -> VinculoError | None:
+        """None when the run reached its end; otherwise the exception of the error that stopped
+        it, of the ``vinculo.errors`` class the core's error selects, with the partial
+        ``vinculo.Solution`` as its ``solution`` attribute and, for a failed user function, the
+        user's exception as its ``__cause__``."""
+
 def simulate(system: System, settings: RunSettings,
-             progress: Callable[[float, float], None] | None = None) -> dict:
-    """Integrate; returns a dict of numpy arrays:
-    times (s,), positions (s, n, 3), velocities (s, n, 3), multipliers (s, m),
-    constraint_residual (s,) [max_k |s_k Phi_k| at each stored time, metres],
-    velocity_violation (s,) [max_k |s_k (Phi_q v + Phi_t)| at each stored time, m/s],
-    newton_iterations (s,) int, step_sizes (s,), residual_norms (s,), increment_norms (s,)
-    (row 0 is the initial state: 0 iterations, step 0, multipliers from the consistent
-    initial accelerations; row n > 0 holds the multipliers of the step that ends at times[n], which
-    act at t_{n-1} + alpha dt for the trapezoidal schemes, where they evaluate the dynamics, and
-    at times[n] for generalized-alpha),
-    (with adaptive=True and t_eval: one row per requested time, interpolated in its step,
-    with that step's statistics),
-    accepted_step_sizes (every accepted step, in s),
-    steps_taken, steps_rejected, factorisations (int), linear_solver, scheme, formulation (str), and
-    'error': None, or a dict {'kind', 'message', 'time', 'step_size', 'residual', 'iterations',
-    'equation'} when the run stopped early (the arrays then hold every step completed).
+             progress: Callable[[float, float], None] | None = None) -> RunResult:
+    """Integrate.
+
     progress(t, t_end) is called about twice a second of wall time.
-    Raises the vinculo.errors classes for bad input."""
+
+    Arguments:
+        system: the model.
+        settings: the run's settings.
+        progress: the progress callback, or None.
+
+    Returns:
+        The run; a run that stopped early returns the states computed before, with its
+        ``error``.
+
+    Raises:
+        VinculoError: the ``vinculo.errors`` class of an error found before the first step (bad
+            settings, an inconsistent initial state, ...).
+    """
 
 class Snapshot:
     """A copy of a running simulation's state (``Simulation.snapshot``), restored by
@@ -527,20 +599,17 @@ class Simulation:
         InconsistentInitialStateError: the initial state violates a constraint.
     """
     def __init__(self, system: System, settings: RunSettings) -> None: ...
-    def step_to(self, t: float) -> dict | None:
+    def step_to(self, t: float) -> None:
         """Advance to time t (at most t_end).
 
         Arguments:
             t: the time to reach, in s.
 
-        Returns:
-            None while the run goes on; the 'error' dict of ``simulate`` once it stopped.
-
         Raises:
             InvalidInputError: t is before the current time.
+            ConvergenceError: (or another ``vinculo.errors`` class, as ``RunResult.error``) the
+                run stopped, now or at an earlier call; its ``solution`` holds the states stored.
         """
-    def error(self) -> dict | None:
-        """The 'error' dict of ``simulate`` of a stopped run, None while it goes on."""
     @property
     def time(self) -> float:
         """Current time, in s."""
@@ -553,8 +622,8 @@ class Simulation:
     @property
     def multipliers(self) -> npt.NDArray[np.float64]:
         """Current multipliers, shape (m,)."""
-    def solution(self) -> dict:
-        """The states stored so far, as the dict ``simulate`` returns."""
+    def solution(self) -> RunResult:
+        """The states stored so far, as ``simulate`` returns them."""
     def snapshot(self) -> Snapshot:
         """A copy of the running state."""
     def restore(self, snapshot: Snapshot) -> None:

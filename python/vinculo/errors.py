@@ -7,7 +7,10 @@ user would expect (``ValueError`` for bad input, ``LookupError`` for an unknown 
 
 Every constructor has the signature ``(message, **details)``: the message is the text shown to the
 user, and each detail is stored as an attribute of the same name (and in the ``details`` dict).
-The compiled core raises these classes by name, as ``cls(message, name=..., value=...)``.
+The compiled core builds them as ``cls(message, name=..., value=...)``, in one place
+(``crates/vinculo-python/src/errors.rs``): the class is chosen by the variant of the core's error,
+for an error of a call and for the error that stopped a run alike; a stopped run's exception
+carries its partial :class:`vinculo.Solution` as ``solution``.
 """
 
 from __future__ import annotations

@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from vinculo import _core
 from vinculo._core import ConstraintId, ParticleId, System
 from vinculo.errors import InvalidInputError, UnknownHandleError
 
@@ -26,11 +27,24 @@ _ARRAY_FIELDS = (
 )
 
 
-def _frozen(array: Any, dtype: Any) -> np.ndarray:
-    """A read-only copy of ``array`` with the given dtype."""
-    result = np.array(array, dtype=dtype, copy=True)
+def _read_only(array: np.ndarray, dtype: Any) -> np.ndarray:
+    """``array`` (a fresh array, shared with nobody) with the given dtype, made read-only."""
+    result = np.asarray(array, dtype=dtype)
     result.flags.writeable = False
     return result
+
+
+def _description(error: BaseException | None) -> dict[str, Any] | None:
+    """The description of the error that stopped a run (:attr:`Solution.error`): the exception's
+    class name as 'kind', its message, and its details but the partial solution."""
+    if error is None:
+        return None
+    details = getattr(error, "details", {})
+    return {
+        "kind": type(error).__name__,
+        "message": getattr(error, "message", str(error)),
+        **{key: value for key, value in details.items() if key != "solution"},
+    }
 
 
 @dataclass(frozen=True, eq=False)
@@ -98,36 +112,40 @@ class Solution:
     scheme: str = ""
     steps_taken: int = 0
     steps_rejected: int = 0
-    accepted_step_sizes: np.ndarray = field(default_factory=lambda: _frozen([], np.float64))
+    accepted_step_sizes: np.ndarray = field(
+        default_factory=lambda: _read_only(np.empty(0), np.float64)
+    )
     formulation: str = ""
 
     @classmethod
-    def from_core(cls, data: dict[str, Any], system: System) -> Solution:
-        """Build a solution from the dict returned by ``vinculo._core.simulate``.
+    def from_core(cls, result: _core.RunResult, system: System) -> Solution:
+        """Build a solution from the run returned by ``vinculo._core.simulate``.
 
         Arguments:
-            data: the dict of arrays (and 'error') returned by the core.
+            result: the core's ``RunResult`` (its arrays are fresh copies, made read-only here).
             system: the system that was simulated.
 
         Returns:
-            The solution, with read-only copies of the arrays.
+            The solution; for a run that stopped early, :attr:`error` describes the exception of
+            ``result.error``.
         """
         arrays = {
-            name: _frozen(data[name], np.int64 if name == "newton_iterations" else np.float64)
+            name: _read_only(
+                getattr(result, name), np.int64 if name == "newton_iterations" else np.float64
+            )
             for name in _ARRAY_FIELDS
         }
-        error = data.get("error")
         return cls(
             **arrays,
-            error=dict(error) if error is not None else None,
+            error=_description(result.error),
             system=system,
-            linear_solver=str(data.get("linear_solver", "")),
-            factorisations=int(data.get("factorisations", 0)),
-            scheme=str(data.get("scheme", "")),
-            steps_taken=int(data.get("steps_taken", 0)),
-            steps_rejected=int(data.get("steps_rejected", 0)),
-            accepted_step_sizes=_frozen(data.get("accepted_step_sizes", []), np.float64),
-            formulation=str(data.get("formulation", "")),
+            linear_solver=result.linear_solver,
+            factorisations=result.factorisations,
+            scheme=result.scheme,
+            steps_taken=result.steps_taken,
+            steps_rejected=result.steps_rejected,
+            accepted_step_sizes=_read_only(result.accepted_step_sizes, np.float64),
+            formulation=result.formulation,
         )
 
     @property

@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
 from vinculo import _core
 from vinculo._core import Snapshot, System
-from vinculo.simulate import _convergence_error, _run_settings
+from vinculo.run_options import RunOptions
 from vinculo.solution import Solution
 
 __all__ = ["Simulation", "Snapshot"]
@@ -31,74 +31,20 @@ class Simulation:
         t_end: the latest time the run may reach, in s (the last fixed step lands on it).
         dt: step size, in s (the first step with ``adaptive=True``).
         alpha: parameter of the generalised trapezoidal rule (see :func:`vinculo.simulate`).
-        scheme: the time rule, as in :func:`vinculo.simulate`.
-        rho_inf: generalised-alpha's parameter, as in :func:`vinculo.simulate`.
-        formulation: 'index-3' or 'ggl', as in :func:`vinculo.simulate`.
-        t_start: initial time, in s.
-        tolerance: Newton tolerance, as in :func:`vinculo.simulate`.
-        max_iterations: Newton iterations allowed per attempt.
-        max_halvings: how many times a failing step may be halved.
-        initial_tolerance: largest initial violation accepted, as in :func:`vinculo.simulate`.
-        save_every: store every k-th step.
-        jacobian_reuse: modified Newton, as in :func:`vinculo.simulate`.
-        adaptive: error-controlled steps, as in :func:`vinculo.simulate`.
-        rtol: relative tolerance of adaptive steps.
-        atol: absolute tolerance of adaptive steps, in m.
-        h_min: smallest adaptive step, in s.
-        h_max: largest adaptive step, in s (default: no limit).
-        t_eval: times at which to store the state with ``adaptive=True``.
+        **options: the run's options, by name, as for :func:`vinculo.simulate` (each described
+            in :class:`vinculo.RunOptions`).
 
     Raises:
         InvalidInputError: a bad argument (as :func:`vinculo.simulate`).
+        TypeError: a keyword argument that is not one of the options.
         InconsistentInitialStateError: the initial state violates a constraint.
     """
 
     def __init__(
-        self,
-        system: System,
-        t_end: float,
-        dt: float,
-        alpha: float | None = None,
-        *,
-        scheme: str = "trapezoidal",
-        rho_inf: float | None = None,
-        formulation: str = "index-3",
-        t_start: float = 0.0,
-        tolerance: float = 1e-10,
-        max_iterations: int = 25,
-        max_halvings: int = 4,
-        initial_tolerance: float = 1e-8,
-        save_every: int = 1,
-        jacobian_reuse: bool = False,
-        adaptive: bool = False,
-        rtol: float = 1e-6,
-        atol: float = 1e-6,
-        h_min: float = 1e-10,
-        h_max: float | None = None,
-        t_eval: Sequence[float] | np.ndarray | None = None,
+        self, system: System, t_end: float, dt: float, alpha: float | None = None, **options: Any
     ) -> None:
         self._system = system.copy()
-        settings = _run_settings(
-            t_end,
-            dt,
-            alpha,
-            scheme=scheme,
-            rho_inf=rho_inf,
-            formulation=formulation,
-            t_start=t_start,
-            tolerance=tolerance,
-            max_iterations=max_iterations,
-            max_halvings=max_halvings,
-            initial_tolerance=initial_tolerance,
-            save_every=save_every,
-            jacobian_reuse=jacobian_reuse,
-            adaptive=adaptive,
-            rtol=rtol,
-            atol=atol,
-            h_min=h_min,
-            h_max=h_max,
-            t_eval=t_eval,
-        )
+        settings = RunOptions.of("Simulation", options).settings(t_end, dt, alpha)
         self._core = _core.Simulation(system, settings)
 
     def step_to(self, t: float) -> None:
@@ -113,10 +59,7 @@ class Simulation:
                 its ``solution`` holds every state stored before, and the simulation keeps them
                 (restore a snapshot to go on from an earlier state).
         """
-        error = self._core.step_to(float(t))
-        if error is not None:
-            cause = error.pop("cause", None)
-            raise _convergence_error(error, self.solution()) from cause
+        self._core.step_to(float(t))
 
     @property
     def time(self) -> float:
@@ -144,10 +87,7 @@ class Simulation:
         Returns:
             The :class:`Solution`, as :func:`vinculo.simulate` returns it for the same run.
         """
-        data = self._core.solution()
-        if data.get("error") is not None:
-            data["error"].pop("cause", None)
-        return Solution.from_core(data, self._system.copy())
+        return Solution.from_core(self._core.solution(), self._system.copy())
 
     def snapshot(self) -> Snapshot:
         """A copy of the running state, to return to with :meth:`restore`.

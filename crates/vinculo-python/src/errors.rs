@@ -1,5 +1,6 @@
 //! Maps core errors onto the exception classes of `vinculo.errors` (one root, `VinculoError`).
 
+use crate::user_physics::PendingError;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -20,7 +21,7 @@ pub fn raise(py: Python<'_>, class: &str, message: String, details: Bound<'_, Py
 }
 
 /// The details each variant carries, as keyword arguments.
-pub fn details<'py>(py: Python<'py>, e: &Error) -> PyResult<Bound<'py, PyDict>> {
+fn details<'py>(py: Python<'py>, e: &Error) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     match e {
         Error::InvalidParameter { name, value, .. } => {
@@ -116,12 +117,41 @@ pub fn details<'py>(py: Python<'py>, e: &Error) -> PyResult<Bound<'py, PyDict>> 
     Ok(d)
 }
 
-/// Converts a core error into the matching Python exception.
-pub fn to_py(e: Error) -> PyErr {
-    Python::attach(|py| match details(py, &e) {
+/// The one mapping from a core error to the Python exception that reports it, for every path (an
+/// error returned by a call, and the error that stopped a run): the class of `vinculo.errors` the
+/// variant selects ([`Error::kind`], a match on the variant), the core's message, the variant's
+/// details as keyword arguments, and, for a failed user function, the user's own exception (with
+/// its traceback) taken from `pending` as the cause. A run's partial solution is attached
+/// afterwards by [`with_solution`] (it is built from the run's result, which holds this exception).
+pub fn exception(py: Python<'_>, e: &Error, pending: Option<&PendingError>) -> PyErr {
+    let err = match details(py, e) {
         Ok(d) => raise(py, e.kind(), e.to_string(), d),
-        Err(err) => err,
-    })
+        Err(err) => return err,
+    };
+    // The pending exception is the one a user function raised in this run; it is the cause of
+    // this error only when the error is that function's failure.
+    let cause = pending.and_then(|p| p.lock().unwrap_or_else(|p| p.into_inner()).take());
+    if let (Error::UserFunction { .. }, Some(cause)) = (e, cause) {
+        err.set_cause(py, Some(cause));
+    }
+    err
+}
+
+/// Attaches the partial solution of a stopped run to its exception: the `solution` attribute and
+/// detail of the `vinculo.errors` classes.
+pub fn with_solution(py: Python<'_>, err: &PyErr, partial: &Bound<'_, PyAny>) -> PyResult<()> {
+    let exc = err.value(py);
+    exc.setattr("solution", partial)?;
+    if let Ok(details) = exc.getattr("details") {
+        details.set_item("solution", partial)?;
+    }
+    Ok(())
+}
+
+/// Converts a core error (of a call that has no user function to blame) into the matching Python
+/// exception ([`exception`]).
+pub fn to_py(e: Error) -> PyErr {
+    Python::attach(|py| exception(py, &e, None))
 }
 
 /// An input error with a name and value, raised as `InvalidInputError`.

@@ -4,6 +4,7 @@
 mod errors;
 mod laws;
 mod run;
+mod run_result;
 mod stepping;
 mod system;
 mod user_physics;
@@ -21,6 +22,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<stepping::PySimulation>()?;
     m.add_class::<stepping::PySnapshot>()?;
     m.add_class::<run::PyRunSettings>()?;
+    m.add_class::<run_result::PyRunResult>()?;
     m.add_function(wrap_pyfunction!(run::simulate, m)?)?;
     Ok(())
 }

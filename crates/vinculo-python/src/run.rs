@@ -1,11 +1,9 @@
 //! `simulate`: runs the core without the GIL, reports progress, returns numpy arrays.
 
-use crate::errors::{details, invalid, to_py};
+use crate::errors::{exception, invalid};
+use crate::run_result::PyRunResult;
 use crate::system::PySystem;
-use numpy::ndarray::{Array1, Array2, Array3};
-use numpy::IntoPyArray;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 use std::time::{Duration, Instant};
 use vinculo::integrators::{Formulation, NewtonOptions, Scheme};
 use vinculo::{simulate_with_observer, AdaptiveOptions, Observer, SimulationOptions, StepControl};
@@ -90,19 +88,21 @@ fn formulation_by_name(name: &str) -> PyResult<Formulation> {
     }
 }
 
-/// Integrates the system; see the type stubs (`_core.pyi`) for the returned dictionary.
+/// Integrates the system; returns the run (`RunResult`, see the type stubs `_core.pyi`), which
+/// carries the error that stopped it early, if any, as its exception.
 #[pyfunction]
 #[pyo3(signature = (system, settings, progress=None))]
 pub fn simulate<'py>(
     py: Python<'py>,
-    system: PyRef<'py, PySystem>,
+    system: Bound<'py, PySystem>,
     settings: PyRef<'py, PyRunSettings>,
     progress: Option<Py<PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<Bound<'py, PyRunResult>> {
     let options = &settings.options;
-    let model = &system.inner;
+    let this = system.borrow();
+    let model = &this.inner;
     // The exception of a user function of an earlier run is no longer of interest.
-    let pending = system.user_errors.clone();
+    let pending = this.user_errors.clone();
     pending.lock().unwrap_or_else(|p| p.into_inner()).take();
     let mut observer = Progress {
         callback: progress,
@@ -117,17 +117,11 @@ pub fn simulate<'py>(
     if let Some(e) = observer.error.take() {
         return Err(e);
     }
-    let sol = result.map_err(crate::errors::internal)?.map_err(|e| {
-        let user = matches!(e, vinculo::Error::UserFunction { .. });
-        let err = to_py(e);
-        let cause = pending.lock().unwrap_or_else(|p| p.into_inner()).take();
-        if let (true, Some(cause)) = (user, cause) {
-            err.set_cause(py, Some(cause));
-        }
-        err
-    })?;
-
-    solution_dict(py, &sol, &pending)
+    let sol = result
+        .map_err(crate::errors::internal)?
+        .map_err(|e| exception(py, &e, Some(&pending)))?;
+    drop(this);
+    PyRunResult::finished(py, sol, &pending, system.as_any())
 }
 
 /// The settings of a run (the keyword arguments of `vinculo.simulate`, less `progress`), converted
@@ -208,83 +202,4 @@ impl PyRunSettings {
     fn __repr__(&self) -> String {
         format!("RunSettings({:?})", self.options)
     }
-}
-
-/// The dictionary `Solution.from_core` reads (stubs, `_core.pyi`), with the user's exception of a
-/// failed user function as the error's `cause`.
-pub fn solution_dict<'py>(
-    py: Python<'py>,
-    sol: &vinculo::Solution,
-    pending: &crate::user_physics::PendingError,
-) -> PyResult<Bound<'py, PyDict>> {
-    let (s, n, m) = (sol.len(), sol.particles, sol.constraints);
-    let out = PyDict::new(py);
-    out.set_item("times", Array1::from(sol.times.clone()).into_pyarray(py))?;
-    out.set_item(
-        "positions",
-        Array3::from_shape_vec((s, n, 3), sol.positions.clone())
-            .expect("shape")
-            .into_pyarray(py),
-    )?;
-    out.set_item(
-        "velocities",
-        Array3::from_shape_vec((s, n, 3), sol.velocities.clone())
-            .expect("shape")
-            .into_pyarray(py),
-    )?;
-    out.set_item(
-        "multipliers",
-        Array2::from_shape_vec((s, m), sol.multipliers.clone())
-            .expect("shape")
-            .into_pyarray(py),
-    )?;
-    out.set_item(
-        "constraint_residual",
-        Array1::from(sol.constraint_residual.clone()).into_pyarray(py),
-    )?;
-    out.set_item(
-        "velocity_violation",
-        Array1::from(sol.velocity_violation.clone()).into_pyarray(py),
-    )?;
-    let stat = |f: &dyn Fn(&vinculo::StepStats) -> f64| Array1::from_iter(sol.stats.iter().map(f));
-    out.set_item(
-        "newton_iterations",
-        Array1::from_iter(sol.stats.iter().map(|x| x.newton_iterations as i64)).into_pyarray(py),
-    )?;
-    out.set_item("step_sizes", stat(&|x| x.step_size).into_pyarray(py))?;
-    out.set_item(
-        "residual_norms",
-        stat(&|x| x.residual_norm).into_pyarray(py),
-    )?;
-    out.set_item(
-        "increment_norms",
-        stat(&|x| x.increment_norm).into_pyarray(py),
-    )?;
-    out.set_item("steps_taken", sol.steps_taken)?;
-    out.set_item("steps_rejected", sol.steps_rejected)?;
-    out.set_item(
-        "accepted_step_sizes",
-        Array1::from(sol.accepted_step_sizes.clone()).into_pyarray(py),
-    )?;
-    out.set_item("factorisations", sol.factorisations)?;
-    out.set_item("linear_solver", sol.linear_solver)?;
-    out.set_item("scheme", sol.scheme.name())?;
-    out.set_item("formulation", sol.formulation.name())?;
-    match &sol.status {
-        Ok(()) => out.set_item("error", py.None())?,
-        Err(e) => {
-            let d = details(py, e)?;
-            d.set_item("kind", e.kind())?;
-            d.set_item("message", e.to_string())?;
-            // The user's own exception (with its traceback), to be raised as the cause.
-            if let vinculo::Error::UserFunction { .. } = e {
-                let cause = pending.lock().unwrap_or_else(|p| p.into_inner()).take();
-                if let Some(cause) = cause {
-                    d.set_item("cause", cause.into_value(py))?;
-                }
-            }
-            out.set_item("error", d)?;
-        }
-    }
-    Ok(out)
 }

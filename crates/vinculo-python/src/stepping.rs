@@ -1,13 +1,13 @@
 //! `Simulation`: the core's stepping object behind a Python class (glue only).
 
 use crate::errors::{invalid, to_py};
-use crate::run::{solution_dict, PyRunSettings};
+use crate::run::PyRunSettings;
+use crate::run_result::PyRunResult;
 use crate::system::PySystem;
 use crate::user_physics::PendingError;
 use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 use std::path::PathBuf;
 use std::sync::{Mutex, MutexGuard};
 use vinculo::model::System;
@@ -60,12 +60,22 @@ pub struct PySimulation {
     // Never moved out of nor mutated while `sim` lives (the box keeps its address).
     _system: Box<System>,
     user_errors: PendingError,
+    /// A copy of the Python system, for the `vinculo.Solution` of a stopped run's exception.
+    system: Py<PyAny>,
 }
 
 impl PySimulation {
     /// The running simulation.
     fn sim(&self) -> MutexGuard<'_, Simulation<'static>> {
         self.sim.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// The exception of the error that stopped the run, raised.
+    fn stopped(&self, py: Python<'_>) -> PyResult<()> {
+        match self.solution(py)?.get().raised(py) {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
     }
 
     /// Forgets the exception of a user function of an earlier call.
@@ -82,10 +92,12 @@ impl PySimulation {
     #[new]
     #[pyo3(signature = (system, settings))]
     fn new(
-        system: PyRef<'_, PySystem>,
+        system: Bound<'_, PySystem>,
         settings: PyRef<'_, PyRunSettings>,
     ) -> PyResult<PySimulation> {
         let options = &settings.options;
+        let copy = system.call_method0("copy")?.unbind();
+        let system = system.borrow();
         // The simulation's own copy: editing the Python system afterwards does not reach it
         // (driven laws and user groups are shared with the copy).
         let model = Box::new(system.inner.clone());
@@ -99,12 +111,13 @@ impl PySimulation {
             sim: Mutex::new(sim),
             _system: model,
             user_errors,
+            system: copy,
         })
     }
 
-    /// Advances to time t (at most t_end); returns None while the run goes on, else the error
-    /// dictionary of `_core.simulate` (the run stopped).
-    fn step_to<'py>(&mut self, py: Python<'py>, t: f64) -> PyResult<Option<Bound<'py, PyDict>>> {
+    /// Advances to time t (at most t_end); raises the exception of the error that stopped the run
+    /// (with the states stored so far as its partial solution).
+    fn step_to(&mut self, py: Python<'_>, t: f64) -> PyResult<()> {
         if t.is_nan() || t < self.sim().time() {
             return Err(invalid(
                 "t",
@@ -116,27 +129,17 @@ impl PySimulation {
             ));
         }
         if self.sim().status().is_err() {
-            return self.error(py);
+            return self.stopped(py);
         }
         self.clear_pending();
         let sim = self.sim.get_mut().unwrap_or_else(|p| p.into_inner());
         let result = py.detach(|| {
             std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| sim.step_to(t).is_ok()))
         });
-        let ok = result.map_err(crate::errors::internal)?;
-        if ok {
-            Ok(None)
+        if result.map_err(crate::errors::internal)? {
+            Ok(())
         } else {
-            self.error(py)
-        }
-    }
-
-    /// The error dictionary of a stopped run (None while it goes on).
-    fn error<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
-        let d = solution_dict(py, self.sim().solution(), &self.user_errors)?;
-        match d.get_item("error")? {
-            Some(e) if !e.is_none() => Ok(Some(e.cast_into::<PyDict>()?)),
-            _ => Ok(None),
+            self.stopped(py)
         }
     }
 
@@ -172,9 +175,10 @@ impl PySimulation {
         Array1::from(self.sim().multipliers().to_vec()).into_pyarray(py)
     }
 
-    /// The stored states so far, as the dictionary of `_core.simulate`.
-    fn solution<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        solution_dict(py, self.sim().solution(), &self.user_errors)
+    /// The stored states so far, as `_core.simulate` returns them.
+    fn solution<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyRunResult>> {
+        let solution = self.sim().solution().clone();
+        PyRunResult::finished(py, solution, &self.user_errors, self.system.bind(py))
     }
 
     /// A copy of the running state.

@@ -269,3 +269,146 @@ pub fn finite_vector(name: impl Into<String>, value: [f64; 3]) -> Result<[f64; 3
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Number of variants of [`Error`] (the arms of [`ordinal`]).
+    const VARIANTS: usize = 17;
+
+    /// The position of a variant. An exhaustive match: a new variant does not compile until it
+    /// has an arm here, and then [`one_of_each`] must give an example of it.
+    fn ordinal(e: &Error) -> usize {
+        match e {
+            Error::InvalidParameter { .. } => 0,
+            Error::InvalidVector { .. } => 1,
+            Error::SameParticle { .. } => 2,
+            Error::ConstraintOnFixedParticles { .. } => 3,
+            Error::UnknownParticle { .. } => 4,
+            Error::LawOutOfDomain { .. } => 5,
+            Error::InconsistentInitialState { .. } => 6,
+            Error::ProjectionFailed { .. } => 7,
+            Error::NewtonFailed { .. } => 8,
+            Error::SingularMatrix { .. } => 9,
+            Error::RedundantConstraints { .. } => 10,
+            Error::NegativeTension { .. } => 11,
+            Error::StepSizeTooSmall { .. } => 12,
+            Error::UserFunction { .. } => 13,
+            Error::UserFunctionOutput { .. } => 14,
+            Error::Snapshot { .. } => 15,
+            Error::Interrupted { .. } => 16,
+        }
+    }
+
+    /// One error of every variant.
+    fn one_of_each() -> Vec<Error> {
+        let s = |x: &str| x.to_string();
+        vec![
+            positive("mass", -1.0).unwrap_err(),
+            finite_vector("position", [f64::NAN, 0.0, 0.0]).unwrap_err(),
+            Error::SameParticle {
+                what: s("distance"),
+                particle: 3,
+            },
+            Error::ConstraintOnFixedParticles {
+                what: s("distance 0"),
+            },
+            Error::UnknownParticle { index: 7, count: 2 },
+            Error::LawOutOfDomain {
+                what: s("table"),
+                start: 0.0,
+                end: 1.0,
+                t_start: 0.0,
+                t_end: 2.0,
+            },
+            Error::InconsistentInitialState {
+                level: s("positions"),
+                quantity: s("Phi"),
+                constraint: s("distance 0"),
+                violation: 0.1,
+                scaled: 0.1,
+                tolerance: 1e-8,
+            },
+            Error::ProjectionFailed {
+                iterations: 50,
+                residual: 1e-3,
+                equation: s("distance 0"),
+            },
+            Error::NewtonFailed {
+                t: 0.5,
+                dt: 1e-3,
+                iterations: 25,
+                residual: 1.0,
+                equation: s("particle 1"),
+            },
+            Error::SingularMatrix {
+                t: 0.0,
+                equation: s("distance 1"),
+                detail: s("zero pivot"),
+            },
+            Error::RedundantConstraints {
+                constraint: s("distance 2"),
+                index: 2,
+                depends_on: vec![s("distance 0"), s("distance 1")],
+                depends_on_indices: vec![0, 1],
+            },
+            Error::NegativeTension {
+                t: 0.3,
+                constraint: s("string"),
+                index: 0,
+                tension: -1.0,
+            },
+            Error::StepSizeTooSmall {
+                t: 0.2,
+                h: 1e-12,
+                h_min: 1e-10,
+                error: 3.0,
+            },
+            Error::UserFunction {
+                group: s("g"),
+                call: s("force"),
+                t: 0.1,
+                message: s("boom"),
+            },
+            Error::UserFunctionOutput {
+                group: s("g"),
+                call: s("phi"),
+                t: 0.1,
+                problem: s("returned (2,)"),
+            },
+            Error::Snapshot {
+                what: s("run.snapshot"),
+                problem: s("truncated"),
+            },
+            Error::Interrupted { t: 0.4 },
+        ]
+    }
+
+    #[test]
+    fn every_variant_names_a_specific_exception_class_of_the_python_package() {
+        let examples = one_of_each();
+        let mut seen: Vec<usize> = examples.iter().map(ordinal).collect();
+        seen.sort_unstable();
+        assert_eq!(
+            seen,
+            (0..VARIANTS).collect::<Vec<_>>(),
+            "one example of every variant"
+        );
+        // The Python package's exception classes (the glue raises the class `kind` names): each
+        // variant must name one of them, and a specific one, not the root `VinculoError` nor
+        // `InternalError` (a bug, which no variant reports).
+        let classes = include_str!("../../../python/vinculo/errors.py");
+        for e in &examples {
+            let kind = e.kind();
+            assert!(
+                classes.contains(&format!("\nclass {kind}(")),
+                "{kind} (of {e:?}) is not a class of python/vinculo/errors.py"
+            );
+            assert!(
+                !["VinculoError", "InternalError"].contains(&kind),
+                "{e:?} maps to the generic {kind}"
+            );
+        }
+    }
+}

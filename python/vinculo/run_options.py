@@ -1,0 +1,168 @@
+"""The keyword options of a run, the same for :func:`vinculo.simulate` and `vinculo.Simulation`."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, fields
+from typing import Any
+
+import numpy as np
+
+from vinculo import _core, errors
+
+__all__ = ["RunOptions"]
+
+
+@dataclass(frozen=True, kw_only=True, eq=False)
+class RunOptions:
+    """How a run steps: the keyword options of :func:`vinculo.simulate` and
+    :class:`vinculo.Simulation` (both take them as keyword arguments, with these names and
+    defaults, and pass them to the compiled core as one ``RunSettings``, which checks every value's
+    range). What the schemes and formulations discretise, and how a failing step is halved, is
+    told by :func:`vinculo.simulate`. Options kept as an object are passed on as keywords:
+    ``simulate(system, t_end, dt, **dataclasses.asdict(options))``.
+
+    Arguments:
+        scheme: 'trapezoidal' (the generalised trapezoidal rule with ``alpha``),
+            'backward-euler' (the same rule with alpha = 1), or 'generalized-alpha' (the
+            generalised-alpha scheme of Arnold and Brüls for index-3 systems: second order, with
+            numerical damping of the high frequencies set by ``rho_inf``).
+        rho_inf: spectral radius at infinite frequency of 'generalized-alpha', in [0, 1]
+            (default 0.9): 1 adds no numerical damping, 0 removes the highest frequencies in one
+            step; the low frequencies are barely damped in every case.
+        formulation: 'index-3' (default: position constraints only, the velocities satisfy
+            ``Phi_q v + Phi_t = 0`` to the scheme's accuracy) or 'ggl' (the stabilised index-2
+            formulation of Gear, Gupta and Leimkuhler: the velocity constraints are added with a
+            second multiplier on the kinematics, ``q' = v + Phi_q^T mu``, so both levels hold at
+            every step to the Newton tolerance; same orders, same meaning of the multipliers,
+            about twice the unknowns and the general sparse LU instead of the tree elimination).
+        t_start: initial time, in s.
+        tolerance: Newton stops when the scaled residual and the last increment (both lengths, see
+            docs/theory/formulation.md) are below ``tolerance * system.length_scale()``.
+        max_iterations: Newton iterations allowed per attempt.
+        max_halvings: how many times a failing step may be halved before giving up.
+        initial_tolerance: largest initial violation accepted, relative to the model's scales:
+            ``|s_k Phi_k| <= initial_tolerance * length_scale`` for positions and
+            ``|s_k (Phi_q v + Phi_t)| <= initial_tolerance * speed`` for velocities, the speed being
+            the largest initial speed or ``sqrt(|g| length_scale)``.
+        save_every: store every k-th step (the last step is always stored); long runs of large
+            models need it to keep the output in memory.
+        jacobian_reuse: modified Newton: keep the factorised iteration matrix across iterations
+            and steps, refreshing it when the Newton increments shrink by less than half per
+            iteration, after 8 iterations with one matrix, and whenever the step size changes (a
+            step that fails with an old matrix is retried once with a fresh one). The converged
+            states are the same to the Newton tolerance; ``Solution.factorisations`` counts the
+            factorisations. Each step stops with an error near ``tolerance`` (full Newton stops
+            far below it), which enters the velocities divided by ``dt``: with small steps lower
+            the tolerance. False: full Newton (a new matrix every iteration).
+        adaptive: choose the step sizes by a local error estimate (on positions and velocities,
+            not multipliers) and a PI controller so that each step meets ``rtol`` and ``atol``;
+            ``dt`` is then the first step. False: fixed steps of ``dt`` (halved where Newton fails).
+            The estimate's weighted RMS norm over the free coordinates, with the weights
+            ``atol + rtol |q|`` for positions and ``atol U / L + rtol |v|`` for velocities
+            (``L = system.length_scale()``, ``U`` the speed scale of ``initial_tolerance``), times
+            ``T / h`` (error per unit step, ``T = L / U``) must be <= 1. A rejected step is retried
+            smaller (``Solution.steps_rejected`` counts them). The error of a run is then about
+            proportional to the tolerance (a few times it on a swinging pendulum). With
+            ``jacobian_reuse`` keep ``tolerance`` far below ``rtol``: modified Newton's error
+            near its tolerance looks like a step error at small steps.
+        rtol: relative tolerance of adaptive steps, in (0, 1).
+        atol: absolute tolerance of adaptive steps, in m (positions).
+        h_min: smallest adaptive step, in s: a run that would need a smaller one stops with
+            :class:`StepSizeTooSmallError`.
+        h_max: largest adaptive step, in s (default: no limit).
+        t_eval: times at which to return the state with ``adaptive=True`` (strictly increasing,
+            within ``[t_start, t_end]``), interpolated inside the step that contains each (cubic
+            Hermite positions, its derivative for velocities, linear multipliers) without forcing
+            the steps onto them. Default: the state after every accepted step (every
+            ``save_every``-th).
+    """
+
+    scheme: str = "trapezoidal"
+    rho_inf: float | None = None
+    formulation: str = "index-3"
+    t_start: float = 0.0
+    tolerance: float = 1e-10
+    max_iterations: int = 25
+    max_halvings: int = 4
+    initial_tolerance: float = 1e-8
+    save_every: int = 1
+    jacobian_reuse: bool = False
+    adaptive: bool = False
+    rtol: float = 1e-6
+    atol: float = 1e-6
+    h_min: float = 1e-10
+    h_max: float | None = None
+    t_eval: Sequence[float] | np.ndarray | None = None
+
+    @classmethod
+    def of(cls, caller: str, options: dict[str, Any]) -> RunOptions:
+        """The options a caller was given as keyword arguments.
+
+        Arguments:
+            caller: the function or class that took them, for the message of an unknown name.
+            options: the keyword arguments.
+
+        Returns:
+            The options, the defaults where a keyword was not given.
+
+        Raises:
+            TypeError: a keyword that is not an option (as for any unknown keyword argument); the
+                message lists the options.
+        """
+        known = [field.name for field in fields(cls)]
+        unknown = [name for name in options if name not in known]
+        if unknown:
+            raise TypeError(
+                f"{caller}() got an unexpected keyword argument {unknown[0]!r}; "
+                f"its run options are {', '.join(known)} (see vinculo.RunOptions)"
+            )
+        return cls(**options)
+
+    def settings(self, t_end: float, dt: float, alpha: float | None) -> _core.RunSettings:
+        """The settings of a run to ``t_end`` with steps ``dt`` and these options, as one object
+        of the compiled core (its ``SimulationOptions``, checked once).
+
+        The core checks every value's range; this checks first what Python must convert: the
+        names are strings and ``t_eval`` is one-dimensional.
+
+        Arguments:
+            t_end: final time, in s.
+            dt: step size, in s (the first step with ``adaptive=True``).
+            alpha: parameter of the generalised trapezoidal rule (None: its default, 1/2).
+
+        Returns:
+            The core's ``RunSettings``, taken by ``_core.simulate`` and ``_core.Simulation``.
+
+        Raises:
+            InvalidInputError: ``scheme`` or ``formulation`` is not a string, ``t_eval`` is not a
+                1-D sequence of times, or a value is out of its range (checked by the core).
+        """
+        if not isinstance(self.scheme, str):
+            raise errors.InvalidInputError(
+                f"scheme must be a name ('trapezoidal', 'backward-euler' or 'generalized-alpha'), "
+                f"got {self.scheme!r}",
+                name="scheme",
+                value=self.scheme,
+            )
+        if not isinstance(self.formulation, str):
+            raise errors.InvalidInputError(
+                f"formulation must be a name ('index-3' or 'ggl'), got {self.formulation!r}",
+                name="formulation",
+                value=self.formulation,
+            )
+        times = None
+        if self.t_eval is not None:
+            array = np.asarray(self.t_eval, dtype=np.float64)
+            if array.ndim != 1:
+                raise errors.InvalidInputError(
+                    f"t_eval must be a 1-D sequence of times, got an array of shape {array.shape}",
+                    name="t_eval",
+                    value=self.t_eval,
+                )
+            times = [float(x) for x in array]
+        options = {field.name: getattr(self, field.name) for field in fields(self)}
+        options.update(
+            jacobian_reuse=bool(self.jacobian_reuse), adaptive=bool(self.adaptive), t_eval=times
+        )
+        return _core.RunSettings(t_end, dt, alpha, **options)
