@@ -189,6 +189,37 @@ impl Layout {
 }
 
 impl Layout {
+    /// Adds constraint `c` (`con`)'s part of the iteration matrix `values` at the Jacobian's
+    /// evaluation points `at`: its Hessian-term blocks `hess`, the gradient at the evaluation
+    /// point in its multiplier's column and the gradient at the step's end in its row (one
+    /// evaluation when the two points are the same), as [`Layout::add_constraint_blocks`].
+    #[inline(always)]
+    pub fn add_constraint_terms<V: ?Sized>(
+        &self,
+        values: &mut V,
+        (c, con, hess): (
+            usize,
+            &crate::constraints::Constraint,
+            &crate::local::Blocks,
+        ),
+        at: &JacobianTerms<'_>,
+        add_block: impl Fn(&mut V, &Block, &crate::math::Mat3),
+        add: impl Fn(&mut V, Slot, f64),
+    ) {
+        let s = at.scales[c];
+        con.with_gradient(at.q_eval, at.t_eval, |grad_eval| {
+            if at.same_point() {
+                let grads = (grad_eval, grad_eval);
+                self.add_constraint_blocks(values, (c, hess), s, grads, &add_block, &add);
+            } else {
+                con.with_gradient(at.q_end, at.t_end, |grad_end| {
+                    let grads = (grad_eval, grad_end);
+                    self.add_constraint_blocks(values, (c, hess), s, grads, &add_block, &add);
+                });
+            }
+        });
+    }
+
     /// Adds constraint `c`'s part of the iteration matrix `values`: its Hessian-term blocks
     /// `hess` between its touched particles (through `add_block`, which adds a 3x3 matrix into
     /// a block), `-s grad_column` into its multiplier's column (the -Phi_q^T block) and

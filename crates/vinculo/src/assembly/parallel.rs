@@ -429,7 +429,6 @@ impl ParallelAssembly {
             });
         }
         let constraints = system.constraints();
-        let same_point = at.same_point();
         for g in 0..self.constraint_colour_start.len() - 1 {
             let group = &self.constraint_colours
                 [self.constraint_colour_start[g]..self.constraint_colour_start[g + 1]];
@@ -447,34 +446,8 @@ impl ParallelAssembly {
                         v.add_block(b, 1.0, m)
                     };
                     let add = |v: &mut &SharedValues, slot, x| unsafe { v.add(slot, x) };
-                    let s = at.scales[c];
                     let mut target = shared;
-                    con.with_gradient(at.q_eval, at.t_eval, |grad_eval| {
-                        let blocks = (c, &hess);
-                        if same_point {
-                            let grads = (grad_eval, grad_eval);
-                            layout.add_constraint_blocks(
-                                &mut target,
-                                blocks,
-                                s,
-                                grads,
-                                add_block,
-                                add,
-                            );
-                        } else {
-                            con.with_gradient(at.q_end, at.t_end, |grad_end| {
-                                let grads = (grad_eval, grad_end);
-                                layout.add_constraint_blocks(
-                                    &mut target,
-                                    blocks,
-                                    s,
-                                    grads,
-                                    add_block,
-                                    add,
-                                );
-                            });
-                        }
-                    });
+                    layout.add_constraint_terms(&mut target, (c, con, &hess), at, add_block, add);
                 }
             });
         }

@@ -84,31 +84,12 @@ impl Layout {
                 |b, s, m| super::add_block(values, b, s, m),
             );
         }
-        let same_point = at.same_point();
         let mut hess = Hessian::zeros(0);
         for (c, con) in system.constraints().iter().enumerate() {
             hess.reset(con.particles().len());
             con.add_hessian(at.q_eval, at.t_eval, at.hessian * at.lambda[c], &mut hess);
             let add_block = |v: &mut [f64], b: &Block, m: &Mat3| super::add_block(v, b, 1.0, m);
-            let s = at.scales[c];
-            con.with_gradient(at.q_eval, at.t_eval, |grad_eval| {
-                if same_point {
-                    let grads = (grad_eval, grad_eval);
-                    self.add_constraint_blocks(values, (c, &hess), s, grads, add_block, super::add);
-                } else {
-                    con.with_gradient(at.q_end, at.t_end, |grad_end| {
-                        let grads = (grad_eval, grad_end);
-                        self.add_constraint_blocks(
-                            values,
-                            (c, &hess),
-                            s,
-                            grads,
-                            add_block,
-                            super::add,
-                        );
-                    });
-                }
-            });
+            self.add_constraint_terms(values, (c, con, &hess), at, add_block, super::add);
         }
     }
 
