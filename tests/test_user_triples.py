@@ -1,4 +1,5 @@
-"""User groups whose elements touch three particles (System.add_force_group and
+"""Elements over three particles: the built-in bending force (System.add_bending) and user groups
+whose elements touch three particles (System.add_force_group and
 add_constraint_group with a (k, 3) array of particles): the core places elements of any size.
 
 References: the closed-form frequency of a bent cantilever (bending energy EI (1 - cos theta) / l,
@@ -32,7 +33,9 @@ def bending(stiffness, analytic):
     return {"force": force, "jacobian": jacobian if analytic else None}
 
 
-@pytest.mark.parametrize("analytic", [True, False], ids=["user Jacobian", "finite differences"])
+@pytest.mark.parametrize(
+    "analytic", [True, False, "built-in"], ids=["user Jacobian", "finite differences", "built-in"]
+)
 def test_bending_on_a_triple_swings_at_the_closed_form_frequency(analytic):
     # A cantilever of two segments: a and b fixed (the clamp), the tip c held at distance l from b
     # by a rigid link and bent by the force on the triple. For a small angle theta of the free
@@ -45,8 +48,11 @@ def test_bending_on_a_triple_swings_at_the_closed_form_frequency(analytic):
     tip = (length * np.cos(theta0), length * np.sin(theta0), 0.0)
     c = system.add_particle(mass, tip)
     system.add_distance(b, c)
-    triples = np.array([[a.index, b.index, c.index]])
-    system.add_force_group(triples, **bending(ei / length**3, analytic), name="bending")
+    if analytic == "built-in":
+        system.add_bending(a, b, c, ei, spacing=length)
+    else:
+        triples = np.array([[a.index, b.index, c.index]])
+        system.add_force_group(triples, **bending(ei / length**3, analytic), name="bending")
 
     omega = np.sqrt(ei / (mass * length**3))
     period = 2 * np.pi / omega * (1 + theta0**2 / 16)

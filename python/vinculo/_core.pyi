@@ -234,6 +234,31 @@ class System:
             InvalidInputError: a negative or non-finite coefficient, or a == b.
             UnknownHandleError: a handle of another system.
         """
+    def add_bending(self, a: ParticleId, b: ParticleId, c: ParticleId, ei: float,
+                    spacing: float | None = None) -> ForceId:
+        """Bending stiffness of a line at its particle ``b``, between its neighbours ``a`` and
+        ``c``: a force on the three particles from the energy
+        ``EI / (2 l^3) |q_a - 2 q_b + q_c|^2``, which is ``EI theta^2 / (2 l)`` for segments of
+        length ``l`` meeting at a small angle ``theta`` (a beam element of curvature
+        ``theta / l``), zero on a straight evenly spaced line and unchanged by rigid motions.
+        Put one at every interior node of a chain of distances to give it bending stiffness.
+
+        Arguments:
+            a: the previous node.
+            b: the node (the middle particle).
+            c: the next node.
+            ei: bending stiffness EI (N m^2, >= 0).
+            spacing: node spacing l (m, > 0); None: the mean of the current distances a-b and
+                b-c.
+
+        Returns:
+            The force's handle.
+
+        Raises:
+            InvalidInputError: a negative or non-finite EI, a spacing that is not positive, or a
+                particle given twice.
+            UnknownHandleError: a handle of another system.
+        """
     def add_force(self, particle: ParticleId, force: Vector) -> ForceId:
         """A prescribed force on one particle, each component a number or a Law of time (N).
 

@@ -284,6 +284,25 @@ impl PySystem {
         Ok(PyForceId { index: id.0 })
     }
 
+    /// Bending stiffness ei (N m^2) at the middle particle b of three consecutive particles of a
+    /// line, with node spacing `spacing` (m; None: the mean current distance a-b, b-c).
+    #[pyo3(signature = (a, b, c, ei, spacing=None))]
+    fn add_bending(
+        &mut self,
+        a: &Bound<'_, PyAny>,
+        b: &Bound<'_, PyAny>,
+        c: &Bound<'_, PyAny>,
+        ei: f64,
+        spacing: Option<f64>,
+    ) -> PyResult<PyForceId> {
+        let (a, b, c) = (self.particle(a)?, self.particle(b)?, self.particle(c)?);
+        let id = self
+            .inner
+            .add_bending(a, b, c, ei, spacing)
+            .map_err(to_py)?;
+        Ok(PyForceId { index: id.0 })
+    }
+
     /// A prescribed force (3 numbers or Laws, N) on a particle.
     fn add_force(
         &mut self,
