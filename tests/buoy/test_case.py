@@ -20,8 +20,8 @@ from vinculo.errors import InvalidInputError
 
 
 def test_derived_quantities_match_the_study_table():
-    # Reference: the parameter table of the study (docs/buoy.md), which quotes m_s = 0.1920 kg,
-    # m_f = 0.5236 kg and m_a = 0.2723 kg to four digits for D = 0.1 m.
+    # Reference: the parameter table of the study (docs/guide/buoy-study.md), which quotes
+    # m_s = 0.1920 kg, m_f = 0.5236 kg and m_a = 0.2723 kg to four digits for D = 0.1 m.
     case = BuoyCase()
     assert case.radius == 0.05
     assert case.sphere_mass == pytest.approx(0.1920, abs=5e-5)
@@ -41,10 +41,11 @@ def test_pendulum_length_follows_the_attachment():
 
 
 def test_assumptions_name_existing_fields_with_reasons():
-    # Reference: the study does not give X0, the attachment point or a ramp (docs/buoy.md), nor
-    # a heavy string or a viscous force; everything else is the paper's table (docs/buoy.md,
-    # "Parameters (from the paper)"), so each field is one or the other, except the tank: its
-    # size is the paper's, its being closed (no sloshing) an assumption.
+    # Reference: the study does not give X0, the attachment point or a ramp
+    # (docs/guide/buoy-study.md), nor a heavy string or a viscous force; everything else is the
+    # paper's table (docs/guide/buoy-study.md, its parameter table), so each field is one or the
+    # other, except the tank: its size is the paper's, its being closed (no sloshing) an
+    # assumption.
     assert {"amplitude", "attachment", "ramp_periods"} <= set(ASSUMPTIONS)
     names = {field.name for field in dataclasses.fields(BuoyCase)}
     assert set(ASSUMPTIONS) | set(PAPER_VALUES) == names

@@ -81,8 +81,8 @@ def test_tank_motion_rejects_a_bad_frequency():
 
 
 def test_point_mass_frequencies_match_the_study():
-    # Reference: docs/buoy.md, omega_n^2 = (m_f - m_s) g / ((m_s + m_a) L) for a point mass:
-    # 1.053 Hz for L = 0.16 m and 0.919 Hz for L = 0.21 m.
+    # Reference: docs/theory/hydrodynamics.md, omega_n^2 = (m_f - m_s) g / ((m_s + m_a) L) for a
+    # point mass: 1.053 Hz for L = 0.16 m and 0.919 Hz for L = 0.21 m.
     centre = OneDofModel(BuoyCase(attachment="centre"))
     assert not centre.include_inertia  # the point mass is the default for a centre attachment
     assert centre.natural_frequency() == pytest.approx(1.053, abs=5e-4)
@@ -268,7 +268,8 @@ def test_one_dof_tension_satisfies_newton_along_the_rod():
 
 
 def test_high_frequency_ratio_of_the_default_case():
-    # Reference: docs/buoy.md, (m_f - m_s) / (m_s + m_a) = 0.714 for the default case.
+    # Reference: docs/theory/hydrodynamics.md, (m_f - m_s) / (m_s + m_a) = 0.714 for the default
+    # case.
     assert high_frequency_ratio(CASE) == pytest.approx(0.714, abs=5e-4)
     # With I_c, a rigid pendulum must also spin the sphere: mu L^2 / (m L^2 + I_c), by hand.
     length = 0.21
@@ -296,7 +297,7 @@ def test_one_dof_relative_amplitude_approaches_the_high_frequency_limit(include_
 
 
 def test_absolute_motion_nearly_vanishes_at_the_antiresonance():
-    # Reference: docs/buoy.md, the absolute displacement vanishes at
+    # Reference: docs/theory/hydrodynamics.md, the absolute displacement vanishes at
     # omega^2 = (m_f - m_s) g / ((m_f + m_a) L) for the undamped point mass (0.70 Hz here); drag
     # leaves a small quadrature residue. Tolerance: 3 % of the tank amplitude, against ratios of
     # 0.47 at 0.6 Hz and 1.23 at 0.8 Hz on either side (linear closed form). There the relative
