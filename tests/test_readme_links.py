@@ -28,3 +28,27 @@ def test_readme_links_point_at_files():
     missing = [t for t in relative_targets((ROOT / "README.md").read_text())
                if not (ROOT / t).exists()]
     assert not missing, f"README links to missing files: {missing}"
+
+
+CITED = re.compile(r"\bdocs/[A-Za-z0-9_./-]+\.md\b")
+
+
+def test_every_document_the_code_cites_is_in_the_repository():
+    # Derivations cited from code, tests and examples (e.g. "docs/theory/formulation.md") must
+    # be pages of this repository, which a reader of the project can open.
+    sources = [
+        path
+        for folder in ("crates", "python", "tests", "examples", "tools")
+        for path in (ROOT / folder).rglob("*")
+        if path.suffix in {".rs", ".py", ".pyi"} and path.resolve() != Path(__file__).resolve()
+    ]
+    assert len(sources) > 50
+    missing = sorted(
+        {
+            f"{path.relative_to(ROOT)}: {cited}"
+            for path in sources
+            for cited in CITED.findall(path.read_text(encoding="utf-8", errors="replace"))
+            if not (ROOT / cited).exists()
+        }
+    )
+    assert not missing, f"cited documents missing from the repository: {missing}"
