@@ -40,7 +40,8 @@ use crate::initial::{
     consistent_accelerations, scaled_velocity_violation, scaled_violation, singular_error,
 };
 use crate::integrators::{
-    Formulation, NewtonFailure, NewtonOptions, RuleState, StabilizedWorkspace, StepWorkspace,
+    Formulation, NewtonFailure, NewtonOptions, RuleState, StabilizedWorkspace, StepStart,
+    StepWorkspace,
 };
 use crate::math::Vec3;
 use crate::model::System;
@@ -671,17 +672,9 @@ impl Simulation<'_> {
             if may_reject {
                 self.scratch.rule_saved.copy_from(&c.rule);
             }
-            let attempt = scheme.step(
-                system,
-                ws,
-                self.stabilized.as_mut(),
-                c.t,
-                &c.q,
-                &c.v,
-                &mut c.rule,
-                h_try,
-                &self.newton,
-            );
+            let start = StepStart::new(c.t, &c.q, &c.v, h_try);
+            let stabilized = self.stabilized.as_mut();
+            let attempt = scheme.step(system, ws, stabilized, start, &mut c.rule, &self.newton);
             self.sol.factorisations = ws.matrix.factorisations;
             // A failed user function stops the run at once (NaN terms would only fail again).
             if let Some(e) = system.user_failure() {
@@ -727,7 +720,8 @@ impl Simulation<'_> {
         let c = &mut self.carried;
         let s = &mut self.scratch;
         let ws = &mut self.ws;
-        scheme.end_acceleration(&c.rule, h, &c.v, &ws.state.v, &mut s.acc_new);
+        let start = StepStart::new(c.t, &c.q, &c.v, h);
+        scheme.end_acceleration(&c.rule, start, &ws.state.v, &mut s.acc_new);
         let t_new = match &mut c.controller {
             Controller::Fixed(fixed) => fixed.accepted(end),
             Controller::Adaptive(control) => {
