@@ -565,6 +565,9 @@ impl<'a> Simulation<'a> {
         );
         assert_eq!(snapshot.carried.lambda.len(), self.carried.lambda.len());
         self.carried.clone_from(&snapshot.carried);
+        if let Controller::Adaptive(control) = &mut self.carried.controller {
+            control.fit(self.system, self.ws.layout.unknowns());
+        }
         self.sol.truncate(snapshot.rows);
         self.sol.accepted_step_sizes.truncate(snapshot.accepted);
         self.sol.steps_taken = snapshot.steps_taken;

@@ -119,10 +119,10 @@ pub fn sample_offset(scheme: &Scheme, h: f64) -> f64 {
 #[derive(Debug, Clone)]
 pub struct AccelerationHistory {
     /// The last accepted raw sample: time, values and weight (its step; 0 for the start).
-    raw: (f64, Vec<Vec3>, f64),
+    pub(crate) raw: (f64, Vec<Vec3>, f64),
     /// The last two smoothed samples (time, values), newest first.
-    newest: (f64, Vec<Vec3>),
-    older: Option<(f64, Vec<Vec3>)>,
+    pub(crate) newest: (f64, Vec<Vec3>),
+    pub(crate) older: Option<(f64, Vec<Vec3>)>,
 }
 
 impl AccelerationHistory {
