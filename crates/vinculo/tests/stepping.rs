@@ -52,6 +52,23 @@ fn assert_same_run(a: &Solution, b: &Solution, what: &str) {
     assert_eq!(a.status, b.status, "{what}: status");
 }
 
+/// The options of a run to t = 0.25 with steps of 0.01 (the first step with error control, at
+/// the default tolerances).
+fn run_to_025(scheme: Scheme, formulation: Formulation, adaptive: bool) -> SimulationOptions {
+    SimulationOptions {
+        t_end: 0.25,
+        dt: 1e-2,
+        scheme,
+        formulation,
+        step_control: if adaptive {
+            StepControl::Adaptive(AdaptiveOptions::default())
+        } else {
+            StepControl::Fixed
+        },
+        ..Default::default()
+    }
+}
+
 /// Stepping to t1 = 0.1, taking a snapshot, on to t2 = 0.25, restoring and stepping to t2 again
 /// gives the stored states of one `simulate` to t2 (and of the stepped run before the restore),
 /// bit for bit, with each time rule on both formulations, with fixed and error-controlled steps
@@ -71,18 +88,7 @@ fn restored_run_is_the_uninterrupted_run_bit_for_bit() {
                 if adaptive && scheme == (Scheme::GeneralizedTrapezoidal { alpha: 1.0 }) {
                     continue; // gives up on this chain (StepSizeTooSmall at t = 0.159)
                 }
-                let options = SimulationOptions {
-                    t_end: 0.25,
-                    dt: 1e-2,
-                    scheme,
-                    formulation,
-                    step_control: if adaptive {
-                        StepControl::Adaptive(AdaptiveOptions::default())
-                    } else {
-                        StepControl::Fixed
-                    },
-                    ..Default::default()
-                };
+                let options = run_to_025(scheme, formulation, adaptive);
                 let what = format!("{scheme:?} {formulation:?} adaptive {adaptive}");
                 let mut run = Simulation::new(&system, &options).unwrap();
                 run.step_to(0.1).clone().unwrap();
@@ -169,50 +175,60 @@ fn rows_from(s: &Solution, t: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
     )
 }
 
-/// A snapshot saved to a file at t1 = 0.1, loaded and restored into a new simulation of the
-/// same model and stepped to t2 = 0.25 gives the states of one `simulate` to t2 from t1 on, bit
-/// for bit (the reference: `simulate` itself), with each time rule on both formulations; the
-/// loaded snapshot is the saved one bit for bit (saved again, the same bytes).
+/// A snapshot saved to a file at t1 (0.1 with fixed steps; with error control, the end of the
+/// step that passes 0.1, the file then holding the error control's state), loaded and restored
+/// into a new simulation of the same model and stepped to t2 = 0.25 gives the states
+/// (positions, velocities, multipliers) and accepted step sizes of one `simulate` to t2 from t1
+/// on, bit for bit (the reference: `simulate` itself), with each time rule on both formulations,
+/// with fixed and error-controlled steps; the loaded snapshot is the saved one bit for bit
+/// (saved again, the same bytes).
 #[test]
 fn snapshot_file_continues_the_run_bit_for_bit() {
     let system = chain();
-    let dir = std::env::temp_dir().join(format!("vinculo-snapshot-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = unique_dir("snapshot");
     let schemes = [
         Scheme::GeneralizedTrapezoidal { alpha: 0.5 },
         Scheme::GeneralizedAlpha { rho_inf: 0.8 },
     ];
     for scheme in schemes {
         for formulation in [Formulation::Index3, Formulation::Ggl] {
-            let options = SimulationOptions {
-                t_end: 0.25,
-                dt: 1e-2,
-                scheme,
-                formulation,
-                ..Default::default()
-            };
-            let what = format!("{scheme:?} {formulation:?}");
-            let path = dir.join(format!("{scheme:?}-{formulation:?}.snap"));
-            let mut run = Simulation::new(&system, &options).unwrap();
-            run.step_to(0.1).clone().unwrap();
-            run.snapshot().save(&path).unwrap();
-            let loaded = vinculo::Snapshot::load(&path).unwrap();
-            let again = dir.join("again.snap");
-            loaded.save(&again).unwrap();
-            assert_eq!(
-                std::fs::read(&path).unwrap(),
-                std::fs::read(&again).unwrap()
-            );
-            let mut fresh = Simulation::new(&system, &options).unwrap();
-            fresh.try_restore(&loaded).unwrap();
-            assert_eq!(fresh.time().to_bits(), run.time().to_bits(), "{what}");
-            fresh.step_to(0.25).clone().unwrap();
-            let one_call = simulate(&system, &options).unwrap();
-            assert_eq!(
-                rows_from(fresh.solution(), run.time()),
-                rows_from(&one_call, run.time()),
-                "{what}: continued from the file"
-            );
+            for adaptive in [false, true] {
+                let options = run_to_025(scheme, formulation, adaptive);
+                let what = format!("{scheme:?} {formulation:?} adaptive {adaptive}");
+                let path = dir.join(format!("{scheme:?}-{formulation:?}-{adaptive}.snap"));
+                let mut run = Simulation::new(&system, &options).unwrap();
+                run.step_to(0.1).clone().unwrap();
+                let before = run.solution().accepted_step_sizes.clone();
+                assert!(before.len() > 3, "{what}: {} steps to t1", before.len());
+                run.snapshot().save(&path).unwrap();
+                let loaded = vinculo::Snapshot::load(&path).unwrap();
+                let again = dir.join("again.snap");
+                loaded.save(&again).unwrap();
+                assert_eq!(
+                    std::fs::read(&path).unwrap(),
+                    std::fs::read(&again).unwrap(),
+                    "{what}: saved again"
+                );
+                let mut fresh = Simulation::new(&system, &options).unwrap();
+                fresh.try_restore(&loaded).unwrap();
+                assert_eq!(fresh.time().to_bits(), run.time().to_bits(), "{what}");
+                fresh.step_to(0.25).clone().unwrap();
+                let one_call = simulate(&system, &options).unwrap();
+                let continued = rows_from(fresh.solution(), run.time());
+                assert!(continued.0.len() > 3, "{what}: {} rows", continued.0.len());
+                assert_eq!(
+                    continued,
+                    rows_from(&one_call, run.time()),
+                    "{what}: continued from the file"
+                );
+                let steps = [before, fresh.solution().accepted_step_sizes.clone()].concat();
+                let bits = |x: &[f64]| x.iter().map(|h| h.to_bits()).collect::<Vec<u64>>();
+                assert_eq!(
+                    bits(&steps),
+                    bits(&one_call.accepted_step_sizes),
+                    "{what}: accepted step sizes"
+                );
+            }
         }
     }
     // A corrupt file (one byte flipped), a file of another kind and a snapshot of another
@@ -236,6 +252,18 @@ fn snapshot_file_continues_the_run_bit_for_bit() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// A new directory under the system's temporary directory, named after `what`, this process
+/// and the time (tests running at once do not share it).
+fn unique_dir(what: &str) -> std::path::PathBuf {
+    let now = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .as_nanos();
+    let dir = std::env::temp_dir().join(format!("vinculo-{what}-{}-{now}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
 /// 64-bit FNV-1a (the snapshot file's checksum, as published by Fowler, Noll and Vo), to write
 /// files that pass the checksum but not the decoder.
 fn fnv1a(bytes: &[u8]) -> u64 {
@@ -251,80 +279,6 @@ fn with_checksum(mut body: Vec<u8>) -> Vec<u8> {
     body
 }
 
-/// A snapshot of an error-controlled run saved to a file at t1 (the end of the step that
-/// passes 0.1), loaded and restored into a new simulation of the same model and stepped to
-/// t2 = 0.25 gives the states (positions, velocities, multipliers) and accepted step sizes of
-/// one uninterrupted `simulate` to t2, bit for bit (the reference: `simulate` itself), with
-/// each time rule on both formulations; the loaded snapshot is the saved one bit for bit (saved
-/// again, the same bytes).
-#[test]
-fn adaptive_snapshot_file_continues_the_run_bit_for_bit() {
-    let system = chain();
-    let dir = std::env::temp_dir().join(format!(
-        "vinculo-adaptive-snapshot-{}-{:?}",
-        std::process::id(),
-        std::time::SystemTime::now()
-    ));
-    std::fs::create_dir_all(&dir).unwrap();
-    let schemes = [
-        Scheme::GeneralizedTrapezoidal { alpha: 0.5 },
-        Scheme::GeneralizedAlpha { rho_inf: 0.8 },
-    ];
-    for scheme in schemes {
-        for formulation in [Formulation::Index3, Formulation::Ggl] {
-            let options = SimulationOptions {
-                t_end: 0.25,
-                dt: 1e-2,
-                scheme,
-                formulation,
-                step_control: StepControl::Adaptive(AdaptiveOptions {
-                    rtol: 1e-5,
-                    atol: 1e-6,
-                    ..Default::default()
-                }),
-                ..Default::default()
-            };
-            let what = format!("{scheme:?} {formulation:?} adaptive");
-            let path = dir.join(format!("{scheme:?}-{formulation:?}.snap"));
-            let mut run = Simulation::new(&system, &options).unwrap();
-            run.step_to(0.1).clone().unwrap();
-            let t1 = run.time();
-            let before = run.solution().accepted_step_sizes.clone();
-            assert!(before.len() > 3, "{what}: {} steps to t1", before.len());
-            run.snapshot().save(&path).unwrap();
-            let loaded = vinculo::Snapshot::load(&path).unwrap();
-            let again = dir.join("again.snap");
-            loaded.save(&again).unwrap();
-            assert_eq!(
-                std::fs::read(&path).unwrap(),
-                std::fs::read(&again).unwrap(),
-                "{what}: saved again"
-            );
-            let mut fresh = Simulation::new(&system, &options).unwrap();
-            fresh.try_restore(&loaded).unwrap();
-            assert_eq!(fresh.time().to_bits(), t1.to_bits(), "{what}");
-            fresh.step_to(0.25).clone().unwrap();
-            let one_call = simulate(&system, &options).unwrap();
-            let continued = rows_from(fresh.solution(), t1);
-            let reference = rows_from(&one_call, t1);
-            assert!(continued.0.len() > 3, "{what}: {} rows", continued.0.len());
-            assert_eq!(continued, reference, "{what}: continued from the file");
-            let steps: Vec<f64> = before
-                .iter()
-                .chain(&fresh.solution().accepted_step_sizes)
-                .copied()
-                .collect();
-            let bits = |x: &[f64]| x.iter().map(|h| h.to_bits()).collect::<Vec<u64>>();
-            assert_eq!(
-                bits(&steps),
-                bits(&one_call.accepted_step_sizes),
-                "{what}: accepted step sizes"
-            );
-        }
-    }
-    std::fs::remove_dir_all(&dir).ok();
-}
-
 /// A version 2 file of an error-controlled run that is truncated, or whose error-control part
 /// is cut short or carries an unknown time rule under a valid checksum, or that claims to be of
 /// version 1 (which has fixed steps only), is refused with the snapshot error; a fixed-step
@@ -333,12 +287,7 @@ fn adaptive_snapshot_file_continues_the_run_bit_for_bit() {
 #[test]
 fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     let system = chain();
-    let dir = std::env::temp_dir().join(format!(
-        "vinculo-damaged-snapshot-{}-{:?}",
-        std::process::id(),
-        std::time::SystemTime::now()
-    ));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = unique_dir("damaged-snapshot");
     let adaptive = SimulationOptions {
         t_end: 0.25,
         dt: 1e-2,
