@@ -241,3 +241,5 @@ def test_corrupt_and_foreign_snapshot_files_are_refused(tmp_path):
     truncated.write_bytes(adaptive_path.read_bytes()[:-30])
     with pytest.raises(vinculo.InvalidInputError, match=r"corrupt|truncated"):
         adaptive.load_snapshot(truncated)
+    with pytest.raises(vinculo.InvalidInputError, match="step control"):
+        sim.load_snapshot(adaptive_path)

@@ -18,7 +18,9 @@
 //! A snapshot ([`Simulation::snapshot`]) is a copy of the carried state and of the number of
 //! stored rows; restoring it and stepping on repeats the steps bit for bit (the workspaces
 //! hold nothing a step reads before writing it, except the factorisation that modified Newton
-//! reuses, which a restore discards).
+//! reuses, which a restore discards). A snapshot of either kind of run saves to a file
+//! (`snapshot_file.rs`) with the step controller's state; the error control's scratch arrays are
+//! not part of it and are sized for the system again on restore.
 //!
 //! Error-controlled steps are never bent to an intermediate stop: [`Simulation::step_to`] ends
 //! with the step that reaches or passes it (its state is the current state), so a run stepped to
@@ -505,13 +507,15 @@ impl<'a> Simulation<'a> {
     }
 
     /// [`Simulation::restore`] after checking that `snapshot` belongs to this model (its
-    /// particle and constraint counts and fingerprint). A snapshot of another run of the model
-    /// (another simulation's, or one loaded from a file) carries the state but not the history
-    /// before it: the stored states restart with the snapshot's (stored as a row of its own
-    /// unless the run has requested output times, with the statistics of no step).
+    /// particle and constraint counts and fingerprint) and to a run of the same kind (fixed or
+    /// error-controlled steps, a time rule with the same state). A snapshot of another run of
+    /// the model (another simulation's, or one loaded from a file) carries the state but not the
+    /// history before it: the stored states restart with the snapshot's (stored as a row of its
+    /// own unless the run has requested output times, with the statistics of no step).
     ///
     /// # Errors
-    /// [`Error::Snapshot`] for a snapshot of another model.
+    /// [`Error::Snapshot`] for a snapshot of another model, or of a run with the other step
+    /// control or another time rule.
     pub fn try_restore(&mut self, snapshot: &Snapshot) -> Result<()> {
         let (n, m) = (self.carried.q.len(), self.carried.lambda.len());
         if (snapshot.particles(), snapshot.constraints()) != (n, m)
@@ -528,6 +532,12 @@ impl<'a> Simulation<'a> {
                     snapshot.fingerprint,
                     self.fingerprint
                 ),
+            });
+        }
+        if let Some(problem) = self.other_run_kind(snapshot) {
+            return Err(Error::Snapshot {
+                what: "snapshot".into(),
+                problem,
             });
         }
         if snapshot.run == self.run {
@@ -548,6 +558,51 @@ impl<'a> Simulation<'a> {
             );
         }
         Ok(())
+    }
+
+    /// What makes `snapshot` (of this model) a snapshot of another kind of run than this one:
+    /// the other step control, or a time rule with another state.
+    fn other_run_kind(&self, snapshot: &Snapshot) -> Option<String> {
+        let scheme = self.options.scheme;
+        match (&snapshot.carried.controller, &self.carried.controller) {
+            (Controller::Fixed(_), Controller::Fixed(_)) => {}
+            (Controller::Adaptive(theirs), Controller::Adaptive(_)) if theirs.scheme != scheme => {
+                return Some(format!(
+                    "a snapshot of a run with the scheme {:?} restored into one with {scheme:?}: \
+                     create the simulation with the snapshot's scheme",
+                    theirs.scheme
+                ))
+            }
+            (Controller::Adaptive(_), Controller::Adaptive(_)) => {}
+            (theirs, _) => {
+                let adaptive = matches!(theirs, Controller::Adaptive(_));
+                return Some(format!(
+                    "a snapshot of a run with {} steps restored into one with {} steps: create \
+                     the simulation with the snapshot's step control (adaptive = {adaptive})",
+                    if adaptive {
+                        "error-controlled"
+                    } else {
+                        "fixed"
+                    },
+                    if adaptive {
+                        "fixed"
+                    } else {
+                        "error-controlled"
+                    },
+                ));
+            }
+        }
+        let (theirs, ours) = (&snapshot.carried.rule, &self.carried.rule);
+        if theirs.acceleration.len() != ours.acceleration.len() {
+            return Some(format!(
+                "a snapshot of a run whose time rule carries {} accelerations restored into one \
+                 whose rule ({}) carries {}: create the simulation with the snapshot's scheme",
+                theirs.acceleration.len(),
+                scheme.name(),
+                ours.acceleration.len()
+            ));
+        }
+        None
     }
 
     /// Returns to the state of `snapshot` (taken from this simulation): later stored states

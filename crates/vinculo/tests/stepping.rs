@@ -281,7 +281,8 @@ fn with_checksum(mut body: Vec<u8>) -> Vec<u8> {
 
 /// A version 2 file of an error-controlled run that is truncated, or whose error-control part
 /// is cut short or carries an unknown time rule under a valid checksum, or that claims to be of
-/// version 1 (which has fixed steps only), is refused with the snapshot error; a fixed-step
+/// version 1 (which has fixed steps only), is refused with the snapshot error, and so is the
+/// snapshot restored into a fixed-step run or a run of another time rule; a fixed-step
 /// file written as version 1 (the two versions agree there) is still read, to the same
 /// snapshot (saved again, the version 2 file).
 #[test]
@@ -332,6 +333,26 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     let mut as_v1 = body.to_vec();
     as_v1[8..12].copy_from_slice(&1u32.to_le_bytes());
     refused(&with_checksum(as_v1), "unknown step controller 1");
+
+    // A snapshot restored into a run of another kind: fixed steps, or another time rule.
+    let loaded = vinculo::Snapshot::load(&path).unwrap();
+    let mut fixed_run = Simulation::new(&system, &SimulationOptions::default()).unwrap();
+    let err = fixed_run.try_restore(&loaded).unwrap_err();
+    assert!(err.to_string().contains("error-controlled steps"), "{err}");
+    let other_rule = SimulationOptions {
+        scheme: Scheme::GeneralizedAlpha { rho_inf: 0.8 },
+        ..adaptive.clone()
+    };
+    let mut alpha_run = Simulation::new(&system, &other_rule).unwrap();
+    let err = alpha_run.try_restore(&loaded).unwrap_err();
+    assert!(err.to_string().contains("snapshot's scheme"), "{err}");
+    let fixed_alpha = SimulationOptions {
+        scheme: Scheme::GeneralizedAlpha { rho_inf: 0.8 },
+        ..Default::default()
+    };
+    let mut alpha_run = Simulation::new(&system, &fixed_alpha).unwrap();
+    let err = alpha_run.try_restore(&fixed_run.snapshot()).unwrap_err();
+    assert!(err.to_string().contains("carries 0 accelerations"), "{err}");
 
     // A fixed-step file written as version 1 is read.
     let mut fixed = Simulation::new(&system, &SimulationOptions::default()).unwrap();
