@@ -176,14 +176,20 @@ def test_a_failed_step_raises_and_keeps_what_was_computed():
     assert np.array_equal(sim.solution().times, raised.value.solution.times)
 
 
+@pytest.mark.parametrize("adaptive", [False, True], ids=["fixed", "adaptive"])
 @pytest.mark.parametrize("options", CASES, ids=lambda o: "-".join(str(v) for v in o.values()))
-def test_snapshot_file_continues_as_one_simulate_call(tmp_path, options):
+def test_snapshot_file_continues_as_one_simulate_call(tmp_path, options, adaptive):
     # Reference: one vinculo.simulate() to t2; a new simulation loads the state saved at t1 and
-    # stores, from t1 on, the same rows bit for bit (the file holds the floats' exact bits).
+    # stores, from t1 on, the same rows and accepted step sizes bit for bit (the file holds the
+    # floats' exact bits; with error control also the controller's state, and t1 is the end of
+    # the step that reaches 0.25).
     t1, t2, dt = 0.25, 0.6, 0.01
+    if adaptive:
+        options = {**options, "adaptive": True, "rtol": 1e-5, "atol": 1e-6}
     reference = vinculo.simulate(double_pendulum(), t_end=t2, dt=dt, **options)
     sim = vinculo.Simulation(double_pendulum(), t_end=t2, dt=dt, **options)
     sim.step_to(t1)
+    before = sim.solution().accepted_step_sizes
     path = tmp_path / "state.snap"
     sim.save_snapshot(path)
     other = vinculo.Simulation(double_pendulum(), t_end=t2, dt=dt, **options)
@@ -193,12 +199,15 @@ def test_snapshot_file_continues_as_one_simulate_call(tmp_path, options):
     other.step_to(t2)
     continued = other.solution()
     later = reference.times >= sim.time
+    assert later.sum() > 3
     assert np.array_equal(continued.times, reference.times[later])
     for name in FIELDS[1:]:
         assert np.array_equal(getattr(continued, name), getattr(reference, name)[later]), name
+    steps = np.concatenate([before, continued.accepted_step_sizes])
+    assert np.array_equal(steps, reference.accepted_step_sizes)
 
 
-def test_corrupt_foreign_and_adaptive_snapshot_files_are_refused(tmp_path):
+def test_corrupt_and_foreign_snapshot_files_are_refused(tmp_path):
     sim = vinculo.Simulation(double_pendulum(), t_end=0.1, dt=0.01)
     sim.step_to(0.05)
     path = tmp_path / "state.snap"
@@ -226,5 +235,11 @@ def test_corrupt_foreign_and_adaptive_snapshot_files_are_refused(tmp_path):
     with pytest.raises(vinculo.InvalidInputError, match="another system"):
         vinculo.Simulation(other, t_end=0.1, dt=0.01).load_snapshot(path)
     adaptive = vinculo.Simulation(double_pendulum(), t_end=0.1, dt=0.01, adaptive=True)
-    with pytest.raises(vinculo.InvalidInputError, match="adaptive"):
-        adaptive.save_snapshot(tmp_path / "adaptive.snap")
+    adaptive.step_to(0.05)
+    adaptive_path = tmp_path / "adaptive.snap"
+    adaptive.save_snapshot(adaptive_path)
+    truncated.write_bytes(adaptive_path.read_bytes()[:-30])
+    with pytest.raises(vinculo.InvalidInputError, match=r"corrupt|truncated"):
+        adaptive.load_snapshot(truncated)
+    with pytest.raises(vinculo.InvalidInputError, match="step control"):
+        sim.load_snapshot(adaptive_path)

@@ -117,12 +117,15 @@ class Simulation:
     def save_snapshot(self, path: str | os.PathLike[str]) -> None:
         """Save a snapshot of the current state to a file (a small binary format, floats bit-exact).
 
+        With ``adaptive=True`` the file also holds the error control's state (the next step size,
+        the step-size controller's memory, the acceleration history of the error estimate), so a
+        run loaded from it takes the same steps as the saved run would.
+
         Arguments:
             path: the file to write.
 
         Raises:
-            InvalidInputError: the run uses error-controlled steps (``adaptive=True``: keep
-                in-memory snapshots instead), the run has stopped, or the file cannot be written.
+            InvalidInputError: the run has stopped, or the file cannot be written.
         """
         self._core.snapshot().save(os.fspath(path))
 

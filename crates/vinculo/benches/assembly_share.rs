@@ -15,7 +15,7 @@
 use std::process::Command;
 use std::time::Instant;
 
-use vinculo::integrators::{GeneralizedTrapezoidal, NewtonOptions, StepWorkspace};
+use vinculo::integrators::{GeneralizedTrapezoidal, NewtonOptions, StepStart, StepWorkspace};
 use vinculo::linear::{LinearSolver, Singular};
 use vinculo::model::System;
 use vinculo::{simulate_with_observer, Observer, SimulationOptions};
@@ -83,7 +83,12 @@ fn assembly_times(system: &System, parallel_from: usize) -> (f64, f64) {
             ..NewtonOptions::default()
         };
         let start = Instant::now();
-        let _ = scheme.step(system, &mut ws, 0.0, &q_n, &v_n, DT, &options);
+        let _ = scheme.step(
+            system,
+            &mut ws,
+            StepStart::new(0.0, &q_n, &v_n, DT),
+            &options,
+        );
         start.elapsed().as_secs_f64()
     };
     let repeats = (2_000_000 / q_n.len()).clamp(7, 101);

@@ -25,7 +25,7 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, SamplingMode};
-use vinculo::integrators::{GeneralizedTrapezoidal, NewtonOptions, StepWorkspace};
+use vinculo::integrators::{GeneralizedTrapezoidal, NewtonOptions, StepStart, StepWorkspace};
 use vinculo::linear::{LinearSolver, Singular};
 use vinculo::math::Vec3;
 use vinculo::model::System;
@@ -123,6 +123,11 @@ impl Start {
         }
     }
 
+    /// The step of size DT from (t_n, q_n, v_n).
+    fn step(&self, t_n: f64) -> StepStart<'_> {
+        StepStart::new(t_n, &self.q_n, &self.v_n, DT)
+    }
+
     fn predict(&self, ws: &mut StepWorkspace, lambda: Option<&[f64]>) {
         for ((q, q_n), v_n) in ws.state.q.iter_mut().zip(&self.q_n).zip(&self.v_n) {
             for k in 0..3 {
@@ -143,7 +148,7 @@ impl Start {
             max_iterations: iterations,
             ..NewtonOptions::default()
         };
-        let _ = SCHEME.step(system, ws, 0.0, &self.q_n, &self.v_n, DT, &options);
+        let _ = SCHEME.step(system, ws, self.step(0.0), &options);
     }
 }
 
@@ -226,15 +231,7 @@ fn whole_step(c: &mut Criterion) {
         initial.predict(&mut ws, None);
         let options = NewtonOptions::default();
         SCHEME
-            .step(
-                &system,
-                &mut ws,
-                0.0,
-                &initial.q_n,
-                &initial.v_n,
-                DT,
-                &options,
-            )
+            .step(&system, &mut ws, initial.step(0.0), &options)
             .unwrap();
         let start = Start {
             q_n: ws.state.q.clone(),
@@ -243,7 +240,7 @@ fn whole_step(c: &mut Criterion) {
         let lambda = ws.state.lambda.clone();
         start.predict(&mut ws, Some(&lambda));
         let report = SCHEME
-            .step(&system, &mut ws, DT, &start.q_n, &start.v_n, DT, &options)
+            .step(&system, &mut ws, start.step(DT), &options)
             .unwrap();
         let label = format!(
             "{name} ({}, {} Newton it.)",
@@ -254,15 +251,7 @@ fn whole_step(c: &mut Criterion) {
             b.iter(|| {
                 start.predict(&mut ws, Some(&lambda));
                 SCHEME
-                    .step(
-                        black_box(&system),
-                        &mut ws,
-                        DT,
-                        &start.q_n,
-                        &start.v_n,
-                        DT,
-                        &options,
-                    )
+                    .step(black_box(&system), &mut ws, start.step(DT), &options)
                     .unwrap()
             })
         });

@@ -31,28 +31,30 @@ use crate::math::Vec3;
 use crate::model::System;
 use crate::step_control::{AdaptiveOptions, ErrorWeights, PiController};
 
-/// The error control's state (carried from step to step, copied by a snapshot) and its scratch
-/// arrays.
+/// The error control's state (carried from step to step, copied by a snapshot and saved in a
+/// snapshot file) and its scratch arrays (written before they are read: not saved; sized for the
+/// system by [`ErrorControl::fit`]).
 #[derive(Debug, Clone)]
 pub(crate) struct ErrorControl {
-    scheme: Scheme,
-    control: AdaptiveOptions,
-    weights: ErrorWeights,
-    pi: PiController,
+    pub(crate) scheme: Scheme,
+    pub(crate) control: AdaptiveOptions,
+    pub(crate) weights: ErrorWeights,
+    /// The PI controller's memory (last error norm, last attempt rejected).
+    pub(crate) pi: PiController,
     /// The next step size.
-    h: f64,
-    constants: ErrorConstants,
+    pub(crate) h: f64,
+    pub(crate) constants: ErrorConstants,
     /// Built at the first attempt, once a factorisation can project the initial accelerations.
-    history: AccelerationHistory,
+    pub(crate) history: AccelerationHistory,
     /// Error norm of the step being judged.
-    err: f64,
-    free: Vec<bool>,
-    projection: Vec<f64>,
-    initial: Vec<Vec3>,
-    a_sample: Vec<Vec3>,
-    e_q: Vec<Vec3>,
-    e_v: Vec<Vec3>,
-    q_end: Vec<Vec3>,
+    pub(crate) err: f64,
+    pub(crate) free: Vec<bool>,
+    pub(crate) projection: Vec<f64>,
+    pub(crate) initial: Vec<Vec3>,
+    pub(crate) a_sample: Vec<Vec3>,
+    pub(crate) e_q: Vec<Vec3>,
+    pub(crate) e_v: Vec<Vec3>,
+    pub(crate) q_end: Vec<Vec3>,
 }
 
 impl ErrorControl {
@@ -85,6 +87,25 @@ impl ErrorControl {
             e_q: acc.to_vec(),
             e_v: acc.to_vec(),
             q_end: vec![[0.0; 3]; acc.len()],
+        }
+    }
+
+    /// Sizes the scratch arrays for `system` with `unknowns` index-3 unknowns (a control loaded
+    /// from a snapshot file carries none); nothing changes when they already fit.
+    pub(crate) fn fit(&mut self, system: &System, unknowns: usize) {
+        let n = system.particles().len();
+        if self.free.len() != n {
+            self.free = system.particles().iter().map(|p| !p.fixed).collect();
+        }
+        self.projection.resize(unknowns, 0.0);
+        for a in [
+            &mut self.initial,
+            &mut self.a_sample,
+            &mut self.e_q,
+            &mut self.e_v,
+            &mut self.q_end,
+        ] {
+            a.resize(n, [0.0; 3]);
         }
     }
 

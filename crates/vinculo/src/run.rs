@@ -18,7 +18,9 @@
 //! A snapshot ([`Simulation::snapshot`]) is a copy of the carried state and of the number of
 //! stored rows; restoring it and stepping on repeats the steps bit for bit (the workspaces
 //! hold nothing a step reads before writing it, except the factorisation that modified Newton
-//! reuses, which a restore discards).
+//! reuses, which a restore discards). A snapshot of either kind of run saves to a file
+//! (`snapshot_file.rs`) with the step controller's state; the error control's scratch arrays are
+//! not part of it and are sized for the system again on restore.
 //!
 //! Error-controlled steps are never bent to an intermediate stop: [`Simulation::step_to`] ends
 //! with the step that reaches or passes it (its state is the current state), so a run stepped to
@@ -40,7 +42,8 @@ use crate::initial::{
     consistent_accelerations, scaled_velocity_violation, scaled_violation, singular_error,
 };
 use crate::integrators::{
-    Formulation, NewtonFailure, NewtonOptions, RuleState, StabilizedWorkspace, StepWorkspace,
+    Formulation, NewtonFailure, NewtonOptions, RuleState, StabilizedWorkspace, StepStart,
+    StepWorkspace,
 };
 use crate::math::Vec3;
 use crate::model::System;
@@ -504,13 +507,15 @@ impl<'a> Simulation<'a> {
     }
 
     /// [`Simulation::restore`] after checking that `snapshot` belongs to this model (its
-    /// particle and constraint counts and fingerprint). A snapshot of another run of the model
-    /// (another simulation's, or one loaded from a file) carries the state but not the history
-    /// before it: the stored states restart with the snapshot's (stored as a row of its own
-    /// unless the run has requested output times, with the statistics of no step).
+    /// particle and constraint counts and fingerprint) and to a run of the same kind (fixed or
+    /// error-controlled steps, a time rule with the same state). A snapshot of another run of
+    /// the model (another simulation's, or one loaded from a file) carries the state but not the
+    /// history before it: the stored states restart with the snapshot's (stored as a row of its
+    /// own unless the run has requested output times, with the statistics of no step).
     ///
     /// # Errors
-    /// [`Error::Snapshot`] for a snapshot of another model.
+    /// [`Error::Snapshot`] for a snapshot of another model, or of a run with the other step
+    /// control or another time rule.
     pub fn try_restore(&mut self, snapshot: &Snapshot) -> Result<()> {
         let (n, m) = (self.carried.q.len(), self.carried.lambda.len());
         if (snapshot.particles(), snapshot.constraints()) != (n, m)
@@ -527,6 +532,12 @@ impl<'a> Simulation<'a> {
                     snapshot.fingerprint,
                     self.fingerprint
                 ),
+            });
+        }
+        if let Some(problem) = self.other_run_kind(snapshot) {
+            return Err(Error::Snapshot {
+                what: "snapshot".into(),
+                problem,
             });
         }
         if snapshot.run == self.run {
@@ -549,6 +560,51 @@ impl<'a> Simulation<'a> {
         Ok(())
     }
 
+    /// What makes `snapshot` (of this model) a snapshot of another kind of run than this one:
+    /// the other step control, or a time rule with another state.
+    fn other_run_kind(&self, snapshot: &Snapshot) -> Option<String> {
+        let scheme = self.options.scheme;
+        match (&snapshot.carried.controller, &self.carried.controller) {
+            (Controller::Fixed(_), Controller::Fixed(_)) => {}
+            (Controller::Adaptive(theirs), Controller::Adaptive(_)) if theirs.scheme != scheme => {
+                return Some(format!(
+                    "a snapshot of a run with the scheme {:?} restored into one with {scheme:?}: \
+                     create the simulation with the snapshot's scheme",
+                    theirs.scheme
+                ))
+            }
+            (Controller::Adaptive(_), Controller::Adaptive(_)) => {}
+            (theirs, _) => {
+                let adaptive = matches!(theirs, Controller::Adaptive(_));
+                return Some(format!(
+                    "a snapshot of a run with {} steps restored into one with {} steps: create \
+                     the simulation with the snapshot's step control (adaptive = {adaptive})",
+                    if adaptive {
+                        "error-controlled"
+                    } else {
+                        "fixed"
+                    },
+                    if adaptive {
+                        "fixed"
+                    } else {
+                        "error-controlled"
+                    },
+                ));
+            }
+        }
+        let (theirs, ours) = (&snapshot.carried.rule, &self.carried.rule);
+        if theirs.acceleration.len() != ours.acceleration.len() {
+            return Some(format!(
+                "a snapshot of a run whose time rule carries {} accelerations restored into one \
+                 whose rule ({}) carries {}: create the simulation with the snapshot's scheme",
+                theirs.acceleration.len(),
+                scheme.name(),
+                ours.acceleration.len()
+            ));
+        }
+        None
+    }
+
     /// Returns to the state of `snapshot` (taken from this simulation): later stored states
     /// are dropped, and stepping on repeats the steps that followed the snapshot bit for bit
     /// (with modified Newton, the first step after a restore factorises a fresh matrix).
@@ -564,6 +620,9 @@ impl<'a> Simulation<'a> {
         );
         assert_eq!(snapshot.carried.lambda.len(), self.carried.lambda.len());
         self.carried.clone_from(&snapshot.carried);
+        if let Controller::Adaptive(control) = &mut self.carried.controller {
+            control.fit(self.system, self.ws.layout.unknowns());
+        }
         self.sol.truncate(snapshot.rows);
         self.sol.accepted_step_sizes.truncate(snapshot.accepted);
         self.sol.steps_taken = snapshot.steps_taken;
@@ -671,17 +730,9 @@ impl Simulation<'_> {
             if may_reject {
                 self.scratch.rule_saved.copy_from(&c.rule);
             }
-            let attempt = scheme.step(
-                system,
-                ws,
-                self.stabilized.as_mut(),
-                c.t,
-                &c.q,
-                &c.v,
-                &mut c.rule,
-                h_try,
-                &self.newton,
-            );
+            let start = StepStart::new(c.t, &c.q, &c.v, h_try);
+            let stabilized = self.stabilized.as_mut();
+            let attempt = scheme.step(system, ws, stabilized, start, &mut c.rule, &self.newton);
             self.sol.factorisations = ws.matrix.factorisations;
             // A failed user function stops the run at once (NaN terms would only fail again).
             if let Some(e) = system.user_failure() {
@@ -727,7 +778,8 @@ impl Simulation<'_> {
         let c = &mut self.carried;
         let s = &mut self.scratch;
         let ws = &mut self.ws;
-        scheme.end_acceleration(&c.rule, h, &c.v, &ws.state.v, &mut s.acc_new);
+        let start = StepStart::new(c.t, &c.q, &c.v, h);
+        scheme.end_acceleration(&c.rule, start, &ws.state.v, &mut s.acc_new);
         let t_new = match &mut c.controller {
             Controller::Fixed(fixed) => fixed.accepted(end),
             Controller::Adaptive(control) => {

@@ -1,6 +1,6 @@
 //! Snapshot files: a [`Snapshot`] saved to and loaded from a small binary file.
 //!
-//! # Format (version 1)
+//! # Format (version 2)
 //!
 //! Little-endian throughout; every float is stored as its IEEE-754 bits, so a loaded snapshot
 //! is bit for bit the saved one.
@@ -8,28 +8,48 @@
 //! | field | type |
 //! |---|---|
 //! | magic `VNCLSNAP` | 8 bytes |
-//! | version (1) | u32 |
+//! | version (2) | u32 |
 //! | model fingerprint ([`crate::run::fingerprint`]), particles n, constraint equations m | 3 x u64 |
 //! | time | f64 |
 //! | positions, velocities, accelerations | 3 x (n x 3 f64) |
 //! | multipliers | m f64 |
 //! | the time rule's state: 4 arrays of 3-vectors, each a u64 length then length x 3 f64 | |
-//! | step controller tag (0: fixed steps), then top u32, unit f64, units u64, level u32, t_grid f64 | |
+//! | step controller tag: 0 (fixed steps) or 1 (error control), then its state (below) | u8 |
 //! | accepted steps, next output, stored rows, steps taken, steps rejected, accepted step sizes, factorisations | 7 x u64 |
 //! | checksum: FNV-1a 64 of every byte before it | u64 |
 //!
-//! Only snapshots of fixed-step runs that have not stopped are saved (the state of the error
-//! control is not part of the format).
+//! Fixed steps (tag 0): top u32, unit f64, units u64, level u32, t_grid f64.
+//!
+//! Error control (tag 1, `adaptive.rs`; its scratch arrays are not saved):
+//!
+//! | field | type |
+//! |---|---|
+//! | scheme: tag (0: generalised trapezoidal, 1: generalised-alpha) and its parameter (alpha, rho_inf) | u8, f64 |
+//! | options: rtol, atol, h_min, h_max, hold | 5 x f64 |
+//! | error weights: time scale, atol_q, atol_v, rtol | 4 x f64 |
+//! | PI controller: order k, last error norm, last attempt rejected (0 or 1), hold | f64, f64, u8, f64 |
+//! | next step size h, error norm of the last judged step | 2 x f64 |
+//! | error-estimate constants q2, q3, v2, v3 | 4 x f64 |
+//! | acceleration history: raw sample (time f64, accelerations, weight f64), newest smoothed sample (time f64, accelerations), older sample present (0 or 1) and, if so, the same | |
+//!
+//! where each accelerations array is a u64 length then length x 3 f64.
+//!
+//! Version 1 is version 2 with fixed steps only (tag 0); files of version 1 are still read.
+//! Snapshots of runs that stopped are not saved.
 
 use std::path::Path;
 
+use crate::adaptive::ErrorControl;
 use crate::error::{Error, Result};
-use crate::integrators::RuleState;
+use crate::integrators::{AccelerationHistory, ErrorConstants, RuleState, Scheme};
 use crate::math::Vec3;
 use crate::run::{Carried, Controller, FixedSteps, Fnv, Snapshot};
+use crate::step_control::{AdaptiveOptions, ErrorWeights, PiController};
 
 const MAGIC: &[u8; 8] = b"VNCLSNAP";
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
+/// The oldest format version still read.
+const OLDEST: u32 = 1;
 
 fn file_error(path: &Path, problem: impl Into<String>) -> Error {
     Error::Snapshot {
@@ -59,6 +79,44 @@ impl Writer {
     fn sized_vecs(&mut self, xs: &[Vec3]) {
         self.u64(xs.len() as u64);
         self.vecs(xs);
+    }
+    fn f64s(&mut self, xs: &[f64]) {
+        for &x in xs {
+            self.f64(x);
+        }
+    }
+    fn sample(&mut self, (t, a): (f64, &[Vec3])) {
+        self.f64(t);
+        self.sized_vecs(a);
+    }
+
+    /// The state of the error control (module documentation).
+    fn error_control(&mut self, e: &ErrorControl) {
+        let (tag, parameter) = match e.scheme {
+            Scheme::GeneralizedTrapezoidal { alpha } => (0, alpha),
+            Scheme::GeneralizedAlpha { rho_inf } => (1, rho_inf),
+        };
+        self.0.push(tag);
+        self.f64(parameter);
+        let (c, w) = (&e.control, &e.weights);
+        self.f64s(&[c.rtol, c.atol, c.h_min, c.h_max, c.hold]);
+        self.f64s(&[w.time_scale, w.atol_q, w.atol_v, w.rtol]);
+        self.f64s(&[e.pi.k, e.pi.previous]);
+        self.0.push(e.pi.rejected as u8);
+        self.f64s(&[e.pi.hold, e.h, e.err]);
+        let k = &e.constants;
+        self.f64s(&[k.q2, k.q3, k.v2, k.v3]);
+        let history = &e.history;
+        self.sample((history.raw.0, &history.raw.1));
+        self.f64(history.raw.2);
+        self.sample((history.newest.0, &history.newest.1));
+        match &history.older {
+            Some((t, a)) => {
+                self.0.push(1);
+                self.sample((*t, a));
+            }
+            None => self.0.push(0),
+        }
     }
 }
 
@@ -115,23 +173,96 @@ impl Reader<'_> {
         let n = self.usize()?;
         self.vecs(n)
     }
+    fn f64s<const N: usize>(&mut self) -> Result<[f64; N]> {
+        let mut out = [0.0; N];
+        for x in &mut out {
+            *x = self.f64()?;
+        }
+        Ok(out)
+    }
+    fn flag(&mut self, what: &str) -> Result<bool> {
+        match self.take(1)?[0] {
+            0 => Ok(false),
+            1 => Ok(true),
+            x => Err(file_error(
+                self.path,
+                format!("{what} {x} is corrupt (0 or 1)"),
+            )),
+        }
+    }
+    fn sample(&mut self) -> Result<(f64, Vec<Vec3>)> {
+        Ok((self.f64()?, self.sized_vecs()?))
+    }
+
+    /// The state of the error control (module documentation), its scratch arrays empty.
+    fn error_control(&mut self) -> Result<ErrorControl> {
+        let tag = self.take(1)?[0];
+        let parameter = self.f64()?;
+        let scheme = match tag {
+            0 => Scheme::GeneralizedTrapezoidal { alpha: parameter },
+            1 => Scheme::GeneralizedAlpha { rho_inf: parameter },
+            _ => return Err(file_error(self.path, format!("unknown time rule {tag}"))),
+        };
+        let [rtol, atol, h_min, h_max, hold] = self.f64s()?;
+        let control = AdaptiveOptions {
+            rtol,
+            atol,
+            h_min,
+            h_max,
+            hold,
+        };
+        let [time_scale, atol_q, atol_v, rtol] = self.f64s()?;
+        let weights = ErrorWeights {
+            time_scale,
+            atol_q,
+            atol_v,
+            rtol,
+        };
+        let [k, previous] = self.f64s()?;
+        let rejected = self.flag("the PI controller's rejected flag")?;
+        let [hold, h, err] = self.f64s()?;
+        let pi = PiController {
+            k,
+            previous,
+            rejected,
+            hold,
+        };
+        let [q2, q3, v2, v3] = self.f64s()?;
+        let raw = self.sample()?;
+        let raw = (raw.0, raw.1, self.f64()?);
+        let newest = self.sample()?;
+        let older = match self.flag("the older-sample flag")? {
+            true => Some(self.sample()?),
+            false => None,
+        };
+        Ok(ErrorControl {
+            scheme,
+            control,
+            weights,
+            pi,
+            h,
+            constants: ErrorConstants { q2, q3, v2, v3 },
+            history: AccelerationHistory { raw, newest, older },
+            err,
+            free: Vec::new(),
+            projection: Vec::new(),
+            initial: Vec::new(),
+            a_sample: Vec::new(),
+            e_q: Vec::new(),
+            e_v: Vec::new(),
+            q_end: Vec::new(),
+        })
+    }
 }
 
 impl Snapshot {
     /// Saves the snapshot to a file at `path` (format in the module documentation).
     ///
     /// # Errors
-    /// [`Error::Snapshot`] when the snapshot is of an error-controlled run or of a run that
-    /// stopped, or when the file cannot be written.
+    /// [`Error::Snapshot`] when the snapshot is of a run that stopped, or when the file cannot
+    /// be written.
     pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
         let path = path.as_ref();
-        let Controller::Fixed(fixed) = &self.carried.controller else {
-            return Err(file_error(
-                path,
-                "snapshots of error-controlled (adaptive) runs cannot be saved to a file; keep \
-                 them in memory or use fixed steps",
-            ));
-        };
         if let Err(e) = &self.status {
             return Err(file_error(
                 path,
@@ -156,12 +287,20 @@ impl Snapshot {
         w.sized_vecs(&c.rule.algorithmic);
         w.sized_vecs(&c.rule.predicted_q);
         w.sized_vecs(&c.rule.predicted_v);
-        w.0.push(0);
-        w.u32(fixed.top);
-        w.f64(fixed.unit);
-        w.u64(fixed.units);
-        w.u32(fixed.level);
-        w.f64(fixed.t_grid);
+        match &c.controller {
+            Controller::Fixed(fixed) => {
+                w.0.push(0);
+                w.u32(fixed.top);
+                w.f64(fixed.unit);
+                w.u64(fixed.units);
+                w.u32(fixed.level);
+                w.f64(fixed.t_grid);
+            }
+            Controller::Adaptive(control) => {
+                w.0.push(1);
+                w.error_control(control);
+            }
+        }
         for x in [
             c.step,
             c.next_output,
@@ -183,8 +322,9 @@ impl Snapshot {
     /// [`crate::Simulation::try_restore`] into a simulation of the same model.
     ///
     /// # Errors
-    /// [`Error::Snapshot`] when the file cannot be read, is not a snapshot file, is of another
-    /// format version, or is truncated or corrupt (its checksum does not match).
+    /// [`Error::Snapshot`] when the file cannot be read, is not a snapshot file, is of a format
+    /// version this vinculo does not read (1 and 2 are), or is truncated or corrupt (its
+    /// checksum does not match).
     pub fn load(path: impl AsRef<Path>) -> Result<Snapshot> {
         let path = path.as_ref();
         let bytes =
@@ -200,10 +340,13 @@ impl Snapshot {
         let mut h = Fnv::new();
         h.write(body);
         let version = u32::from_le_bytes(body[8..12].try_into().expect("4 bytes"));
-        if version != VERSION {
+        if !(OLDEST..=VERSION).contains(&version) {
             return Err(file_error(
                 path,
-                format!("format version {version}; this vinculo reads version {VERSION}"),
+                format!(
+                    "format version {version}; this vinculo reads versions {OLDEST} to \
+                     {VERSION}: save the snapshot again with this vinculo"
+                ),
             ));
         }
         if h.finish() != u64::from_le_bytes(sum.try_into().expect("8 bytes")) {
@@ -235,16 +378,22 @@ impl Snapshot {
             predicted_v: r.sized_vecs()?,
         };
         let tag = r.take(1)?[0];
-        if tag != 0 {
-            return Err(file_error(path, format!("unknown step controller {tag}")));
-        }
-        let controller = Controller::Fixed(FixedSteps {
-            top: r.u32()?,
-            unit: r.f64()?,
-            units: r.u64()?,
-            level: r.u32()?,
-            t_grid: r.f64()?,
-        });
+        let controller = match tag {
+            0 => Controller::Fixed(FixedSteps {
+                top: r.u32()?,
+                unit: r.f64()?,
+                units: r.u64()?,
+                level: r.u32()?,
+                t_grid: r.f64()?,
+            }),
+            1 if version >= 2 => Controller::Adaptive(Box::new(r.error_control()?)),
+            _ => {
+                return Err(file_error(
+                    path,
+                    format!("unknown step controller {tag} in a version {version} file"),
+                ))
+            }
+        };
         let mut counts = [0usize; 7];
         for x in &mut counts {
             *x = r.usize()?;

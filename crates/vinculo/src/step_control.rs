@@ -200,12 +200,13 @@ impl ErrorWeights {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PiController {
     /// Power of h in the scaled error (the scheme order, module documentation).
-    k: f64,
+    pub(crate) k: f64,
     /// Error norm of the last accepted step (1 before the first).
-    previous: f64,
+    pub(crate) previous: f64,
     /// True when the last attempt was rejected (the next accepted step may not grow).
-    rejected: bool,
-    hold: f64,
+    pub(crate) rejected: bool,
+    /// Error norms below this hold the step (module documentation).
+    pub(crate) hold: f64,
 }
 
 /// Error norms below this count as this (a step with no error grows by the most allowed).

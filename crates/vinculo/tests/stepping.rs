@@ -52,6 +52,23 @@ fn assert_same_run(a: &Solution, b: &Solution, what: &str) {
     assert_eq!(a.status, b.status, "{what}: status");
 }
 
+/// The options of a run to t = 0.25 with steps of 0.01 (the first step with error control, at
+/// the default tolerances).
+fn run_to_025(scheme: Scheme, formulation: Formulation, adaptive: bool) -> SimulationOptions {
+    SimulationOptions {
+        t_end: 0.25,
+        dt: 1e-2,
+        scheme,
+        formulation,
+        step_control: if adaptive {
+            StepControl::Adaptive(AdaptiveOptions::default())
+        } else {
+            StepControl::Fixed
+        },
+        ..Default::default()
+    }
+}
+
 /// Stepping to t1 = 0.1, taking a snapshot, on to t2 = 0.25, restoring and stepping to t2 again
 /// gives the stored states of one `simulate` to t2 (and of the stepped run before the restore),
 /// bit for bit, with each time rule on both formulations, with fixed and error-controlled steps
@@ -71,18 +88,7 @@ fn restored_run_is_the_uninterrupted_run_bit_for_bit() {
                 if adaptive && scheme == (Scheme::GeneralizedTrapezoidal { alpha: 1.0 }) {
                     continue; // gives up on this chain (StepSizeTooSmall at t = 0.159)
                 }
-                let options = SimulationOptions {
-                    t_end: 0.25,
-                    dt: 1e-2,
-                    scheme,
-                    formulation,
-                    step_control: if adaptive {
-                        StepControl::Adaptive(AdaptiveOptions::default())
-                    } else {
-                        StepControl::Fixed
-                    },
-                    ..Default::default()
-                };
+                let options = run_to_025(scheme, formulation, adaptive);
                 let what = format!("{scheme:?} {formulation:?} adaptive {adaptive}");
                 let mut run = Simulation::new(&system, &options).unwrap();
                 run.step_to(0.1).clone().unwrap();
@@ -169,50 +175,60 @@ fn rows_from(s: &Solution, t: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
     )
 }
 
-/// A snapshot saved to a file at t1 = 0.1, loaded and restored into a new simulation of the
-/// same model and stepped to t2 = 0.25 gives the states of one `simulate` to t2 from t1 on, bit
-/// for bit (the reference: `simulate` itself), with each time rule on both formulations; the
-/// loaded snapshot is the saved one bit for bit (saved again, the same bytes).
+/// A snapshot saved to a file at t1 (0.1 with fixed steps; with error control, the end of the
+/// step that passes 0.1, the file then holding the error control's state), loaded and restored
+/// into a new simulation of the same model and stepped to t2 = 0.25 gives the states
+/// (positions, velocities, multipliers) and accepted step sizes of one `simulate` to t2 from t1
+/// on, bit for bit (the reference: `simulate` itself), with each time rule on both formulations,
+/// with fixed and error-controlled steps; the loaded snapshot is the saved one bit for bit
+/// (saved again, the same bytes).
 #[test]
 fn snapshot_file_continues_the_run_bit_for_bit() {
     let system = chain();
-    let dir = std::env::temp_dir().join(format!("vinculo-snapshot-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = unique_dir("snapshot");
     let schemes = [
         Scheme::GeneralizedTrapezoidal { alpha: 0.5 },
         Scheme::GeneralizedAlpha { rho_inf: 0.8 },
     ];
     for scheme in schemes {
         for formulation in [Formulation::Index3, Formulation::Ggl] {
-            let options = SimulationOptions {
-                t_end: 0.25,
-                dt: 1e-2,
-                scheme,
-                formulation,
-                ..Default::default()
-            };
-            let what = format!("{scheme:?} {formulation:?}");
-            let path = dir.join(format!("{scheme:?}-{formulation:?}.snap"));
-            let mut run = Simulation::new(&system, &options).unwrap();
-            run.step_to(0.1).clone().unwrap();
-            run.snapshot().save(&path).unwrap();
-            let loaded = vinculo::Snapshot::load(&path).unwrap();
-            let again = dir.join("again.snap");
-            loaded.save(&again).unwrap();
-            assert_eq!(
-                std::fs::read(&path).unwrap(),
-                std::fs::read(&again).unwrap()
-            );
-            let mut fresh = Simulation::new(&system, &options).unwrap();
-            fresh.try_restore(&loaded).unwrap();
-            assert_eq!(fresh.time().to_bits(), run.time().to_bits(), "{what}");
-            fresh.step_to(0.25).clone().unwrap();
-            let one_call = simulate(&system, &options).unwrap();
-            assert_eq!(
-                rows_from(fresh.solution(), run.time()),
-                rows_from(&one_call, run.time()),
-                "{what}: continued from the file"
-            );
+            for adaptive in [false, true] {
+                let options = run_to_025(scheme, formulation, adaptive);
+                let what = format!("{scheme:?} {formulation:?} adaptive {adaptive}");
+                let path = dir.join(format!("{scheme:?}-{formulation:?}-{adaptive}.snap"));
+                let mut run = Simulation::new(&system, &options).unwrap();
+                run.step_to(0.1).clone().unwrap();
+                let before = run.solution().accepted_step_sizes.clone();
+                assert!(before.len() > 3, "{what}: {} steps to t1", before.len());
+                run.snapshot().save(&path).unwrap();
+                let loaded = vinculo::Snapshot::load(&path).unwrap();
+                let again = dir.join("again.snap");
+                loaded.save(&again).unwrap();
+                assert_eq!(
+                    std::fs::read(&path).unwrap(),
+                    std::fs::read(&again).unwrap(),
+                    "{what}: saved again"
+                );
+                let mut fresh = Simulation::new(&system, &options).unwrap();
+                fresh.try_restore(&loaded).unwrap();
+                assert_eq!(fresh.time().to_bits(), run.time().to_bits(), "{what}");
+                fresh.step_to(0.25).clone().unwrap();
+                let one_call = simulate(&system, &options).unwrap();
+                let continued = rows_from(fresh.solution(), run.time());
+                assert!(continued.0.len() > 3, "{what}: {} rows", continued.0.len());
+                assert_eq!(
+                    continued,
+                    rows_from(&one_call, run.time()),
+                    "{what}: continued from the file"
+                );
+                let steps = [before, fresh.solution().accepted_step_sizes.clone()].concat();
+                let bits = |x: &[f64]| x.iter().map(|h| h.to_bits()).collect::<Vec<u64>>();
+                assert_eq!(
+                    bits(&steps),
+                    bits(&one_call.accepted_step_sizes),
+                    "{what}: accepted step sizes"
+                );
+            }
         }
     }
     // A corrupt file (one byte flipped), a file of another kind and a snapshot of another
@@ -233,6 +249,125 @@ fn snapshot_file_continues_the_run_bit_for_bit() {
     let mut foreign = Simulation::new(&other, &SimulationOptions::default()).unwrap();
     let err = foreign.try_restore(&run.snapshot()).unwrap_err();
     assert!(err.to_string().contains("another system"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A new directory under the system's temporary directory, named after `what`, this process
+/// and the time (tests running at once do not share it).
+fn unique_dir(what: &str) -> std::path::PathBuf {
+    let now = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .as_nanos();
+    let dir = std::env::temp_dir().join(format!("vinculo-{what}-{}-{now}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// 64-bit FNV-1a (the snapshot file's checksum, as published by Fowler, Noll and Vo), to write
+/// files that pass the checksum but not the decoder.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+/// `body` (a snapshot file without its checksum) with its checksum appended.
+fn with_checksum(mut body: Vec<u8>) -> Vec<u8> {
+    let sum = fnv1a(&body);
+    body.extend_from_slice(&sum.to_le_bytes());
+    body
+}
+
+/// A version 2 file of an error-controlled run that is truncated, or whose error-control part
+/// is cut short or carries an unknown time rule under a valid checksum, or that claims to be of
+/// version 1 (which has fixed steps only), is refused with the snapshot error, and so is the
+/// snapshot restored into a fixed-step run or a run of another time rule; a fixed-step
+/// file written as version 1 (the two versions agree there) is still read, to the same
+/// snapshot (saved again, the version 2 file).
+#[test]
+fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
+    let system = chain();
+    let dir = unique_dir("damaged-snapshot");
+    let adaptive = SimulationOptions {
+        t_end: 0.25,
+        dt: 1e-2,
+        step_control: StepControl::Adaptive(AdaptiveOptions::default()),
+        ..Default::default()
+    };
+    let path = dir.join("adaptive.snap");
+    let mut run = Simulation::new(&system, &adaptive).unwrap();
+    run.step_to(0.05).clone().unwrap();
+    run.snapshot().save(&path).unwrap();
+    let good = std::fs::read(&path).unwrap();
+    assert_eq!(&good[8..12], &2u32.to_le_bytes());
+    let refused = |bytes: &[u8], expected: &str| {
+        let damaged = dir.join("damaged.snap");
+        std::fs::write(&damaged, bytes).unwrap();
+        match vinculo::Snapshot::load(&damaged) {
+            Err(e @ vinculo::Error::Snapshot { .. }) => {
+                assert!(e.to_string().contains(expected), "{e}")
+            }
+            other => panic!("expected the snapshot error, got {other:?}"),
+        }
+    };
+    // Truncated: the checksum no longer matches.
+    refused(&good[..good.len() - 20], "checksum");
+    // Cut short inside the acceleration history, with a checksum of what is left.
+    let body = &good[..good.len() - 8];
+    refused(
+        &with_checksum(body[..body.len() - 60].to_vec()),
+        "truncated",
+    );
+    // The time rule's tag (right after the step controller's tag 1) made unknown.
+    let n = system.particles().len();
+    let m = run.snapshot().constraints();
+    // Header, counts, time, q, v, acc, lambda, then the rule's four sized arrays (empty for the
+    // default trapezoidal rule: their lengths alone).
+    let tag_at = 8 + 4 + 24 + 8 + 3 * 24 * n + 8 * m + 4 * 8;
+    assert_eq!(body[tag_at], 1, "the step controller's tag");
+    let mut unknown = body.to_vec();
+    unknown[tag_at + 1] = 7;
+    refused(&with_checksum(unknown), "unknown time rule 7");
+    // Version 1 has no error control.
+    let mut as_v1 = body.to_vec();
+    as_v1[8..12].copy_from_slice(&1u32.to_le_bytes());
+    refused(&with_checksum(as_v1), "unknown step controller 1");
+
+    // A snapshot restored into a run of another kind: fixed steps, or another time rule.
+    let loaded = vinculo::Snapshot::load(&path).unwrap();
+    let mut fixed_run = Simulation::new(&system, &SimulationOptions::default()).unwrap();
+    let err = fixed_run.try_restore(&loaded).unwrap_err();
+    assert!(err.to_string().contains("error-controlled steps"), "{err}");
+    let other_rule = SimulationOptions {
+        scheme: Scheme::GeneralizedAlpha { rho_inf: 0.8 },
+        ..adaptive.clone()
+    };
+    let mut alpha_run = Simulation::new(&system, &other_rule).unwrap();
+    let err = alpha_run.try_restore(&loaded).unwrap_err();
+    assert!(err.to_string().contains("snapshot's scheme"), "{err}");
+    let fixed_alpha = SimulationOptions {
+        scheme: Scheme::GeneralizedAlpha { rho_inf: 0.8 },
+        ..Default::default()
+    };
+    let mut alpha_run = Simulation::new(&system, &fixed_alpha).unwrap();
+    let err = alpha_run.try_restore(&fixed_run.snapshot()).unwrap_err();
+    assert!(err.to_string().contains("carries 0 accelerations"), "{err}");
+
+    // A fixed-step file written as version 1 is read.
+    let mut fixed = Simulation::new(&system, &SimulationOptions::default()).unwrap();
+    fixed.step_to(0.05).clone().unwrap();
+    let v2 = dir.join("fixed.snap");
+    fixed.snapshot().save(&v2).unwrap();
+    let v2_bytes = std::fs::read(&v2).unwrap();
+    let mut v1_body = v2_bytes[..v2_bytes.len() - 8].to_vec();
+    v1_body[8..12].copy_from_slice(&1u32.to_le_bytes());
+    let v1 = dir.join("fixed-v1.snap");
+    std::fs::write(&v1, with_checksum(v1_body)).unwrap();
+    let loaded = vinculo::Snapshot::load(&v1).unwrap();
+    let again = dir.join("fixed-again.snap");
+    loaded.save(&again).unwrap();
+    assert_eq!(std::fs::read(&again).unwrap(), v2_bytes);
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -119,10 +119,10 @@ pub fn sample_offset(scheme: &Scheme, h: f64) -> f64 {
 #[derive(Debug, Clone)]
 pub struct AccelerationHistory {
     /// The last accepted raw sample: time, values and weight (its step; 0 for the start).
-    raw: (f64, Vec<Vec3>, f64),
+    pub(crate) raw: (f64, Vec<Vec3>, f64),
     /// The last two smoothed samples (time, values), newest first.
-    newest: (f64, Vec<Vec3>),
-    older: Option<(f64, Vec<Vec3>)>,
+    pub(crate) newest: (f64, Vec<Vec3>),
+    pub(crate) older: Option<(f64, Vec<Vec3>)>,
 }
 
 impl AccelerationHistory {
@@ -206,7 +206,7 @@ impl AccelerationHistory {
 mod tests {
     use super::*;
     use crate::integrators::{
-        index3_step, GeneralizedAlpha, GeneralizedTrapezoidal, NewtonOptions, RuleState,
+        index3_step, GeneralizedAlpha, GeneralizedTrapezoidal, NewtonOptions, RuleState, StepStart,
         StepWorkspace,
     };
     use crate::laws::VectorLaw;
@@ -273,10 +273,11 @@ mod tests {
             let tau = tau_1 - j as f64 * h;
             history.push(tau, &state(exact(tau)[2]), h);
         }
+        let start = StepStart::new(t_n, &q_n, &v_n, h);
         let a_new = match scheme {
             Scheme::GeneralizedTrapezoidal { alpha } => {
                 GeneralizedTrapezoidal { alpha }
-                    .step(&system, &mut ws, t_n, &q_n, &v_n, h, &newton)
+                    .step(&system, &mut ws, start, &newton)
                     .unwrap();
                 state((ws.state.v[1][0] - v_n[1][0]) / h)
             }
@@ -289,19 +290,7 @@ mod tests {
                 let a = e[2] + delta * h * e[3] + kappa * h * h * e[4];
                 let mut alpha_state = RuleState::new(&state(a));
                 alpha_state.acceleration = state(e[2]);
-                let (q, v) = (&q_n, &v_n);
-                index3_step(
-                    ga,
-                    &system,
-                    &mut ws,
-                    t_n,
-                    q,
-                    v,
-                    &mut alpha_state,
-                    h,
-                    &newton,
-                )
-                .unwrap();
+                index3_step(ga, &system, &mut ws, start, &mut alpha_state, &newton).unwrap();
                 alpha_state.acceleration.clone()
             }
         };

@@ -67,7 +67,9 @@
 //! w = 1 (everything at t_{n+1}).
 
 use super::error_estimate::ErrorConstants;
-use super::rule::{GglCoefficients, Index3Rule, RuleState, StepPoint, TimeRule};
+use super::rule::{
+    GglBase, GglCoefficients, Index3Rule, RuleState, StepPoint, StepStart, TimeRule,
+};
 use crate::math::Vec3;
 
 /// The scheme, given by its spectral radius at infinite frequency rho_inf in [0, 1].
@@ -91,8 +93,9 @@ pub struct AlphaCoefficients {
 }
 
 impl RuleState {
-    /// Computes the predictors p and w of a step of size `h` from (q_n, v_n) and a_n.
-    fn predict(&mut self, k: &AlphaCoefficients, h: f64, q_n: &[Vec3], v_n: &[Vec3]) {
+    /// Computes the predictors p and w of a step from `start` and a_n.
+    fn predict(&mut self, k: &AlphaCoefficients, start: &StepStart) {
+        let (h, q_n, v_n) = (start.h, start.q_n, start.v_n);
         let (hh, half) = (h * h, 0.5 - k.beta);
         for i in 0..q_n.len() {
             let a_n = self.algorithmic[i];
@@ -156,50 +159,38 @@ pub struct AlphaStep<'a> {
     c: f64,
     /// d(v_{n+1})/dq = gamma/(beta h).
     dv_dq: f64,
-    point: StepPoint,
 }
 
 impl Index3Rule for AlphaStep<'_> {
+    /// Everything at t_{n+1}.
     const AT_END: bool = true;
 
-    fn point(&self) -> StepPoint {
-        self.point
-    }
-
+    /// v_{n+1} = w + h gamma a_{n+1}, and the evaluation point is the step's end.
     #[inline(always)]
     fn kinematics(&self, i: usize, q: &Vec3) -> (Vec3, Vec3, Vec3) {
         let v = self.known.kinematics(q, &self.p[i], &self.w[i]).1;
         (v, *q, v)
     }
 
+    /// M qdd_{n+1} - m g, qdd_{n+1} from a_{n+1} (module documentation).
     #[inline(always)]
-    fn inertia_row(
-        &self,
-        i: usize,
-        q: &Vec3,
-        _v: &Vec3,
-        inertia: f64,
-        mass: f64,
-        g: &Vec3,
-    ) -> Vec3 {
+    fn inertia_row(&self, i: usize, q: &Vec3, _: &Vec3, inertia: f64, mass: f64, g: &Vec3) -> Vec3 {
         let known = &self.known;
         let (p, a_n, qdd_n) = (&self.p[i], &self.a_n[i], &self.qdd_n[i]);
-        let sigma = self.point.sigma;
         std::array::from_fn(|k| {
             let a = (q[k] - p[k]) * known.inv_beta_h2;
             let inertial = known.c_a * a + known.c_m * a_n[k] - known.c_f * qdd_n[k];
-            sigma * (inertia * inertial - mass * g[k])
+            inertia * inertial - mass * g[k]
         })
     }
 
     /// sigma c M = M/m_ref: the scaled mass block.
     #[inline(always)]
-    fn mass_diagonal(&self, inertia: f64) -> f64 {
-        self.point.sigma * self.c * inertia
+    fn mass_diagonal(&self, sigma: f64, inertia: f64) -> f64 {
+        sigma * self.c * inertia
     }
 
-    fn weights(&self) -> (f64, f64, f64) {
-        let sigma = self.point.sigma;
+    fn weights(&self, sigma: f64) -> (f64, f64, f64) {
         (-sigma, -sigma * self.dv_dq, -sigma)
     }
 }
@@ -250,18 +241,16 @@ impl TimeRule for GeneralizedAlpha {
         h
     }
 
-    fn index3<'a>(
-        &self,
-        state: &'a mut RuleState,
-        t_n: f64,
-        q_n: &'a [Vec3],
-        v_n: &'a [Vec3],
-        h: f64,
-        mass_ref: f64,
-    ) -> AlphaStep<'a> {
-        let k = self.coefficients();
+    /// At t_{n+1}, rows scaled by 1/(c m_ref) (module documentation).
+    fn point(&self, start: &StepStart, mass_ref: f64) -> StepPoint {
+        let (k, h) = (self.coefficients(), start.h);
         let c = (1.0 - k.alpha_m) / ((1.0 - k.alpha_f) * k.beta * h * h);
-        state.predict(&k, h, q_n, v_n);
+        StepPoint::new(start, 1.0, 1.0 / (c * mass_ref))
+    }
+
+    fn index3<'a>(&self, state: &'a mut RuleState, start: StepStart<'a>) -> AlphaStep<'a> {
+        let (k, h) = (self.coefficients(), start.h);
+        state.predict(&k, &start);
         let state = &*state;
         AlphaStep {
             p: &state.predicted_q,
@@ -269,13 +258,8 @@ impl TimeRule for GeneralizedAlpha {
             a_n: &state.algorithmic,
             qdd_n: &state.acceleration,
             known: Predictors::new(&k, h),
-            c,
+            c: (1.0 - k.alpha_m) / ((1.0 - k.alpha_f) * k.beta * h * h),
             dv_dq: k.gamma / (k.beta * h),
-            point: StepPoint {
-                t_eval: t_n + h,
-                t_end: t_n + h,
-                sigma: 1.0 / (c * mass_ref),
-            },
         }
     }
 
@@ -292,24 +276,15 @@ impl TimeRule for GeneralizedAlpha {
         }
     }
 
-    fn ggl(
-        &self,
-        state: &RuleState,
-        h: f64,
-        q_n: &[Vec3],
-        v_n: &[Vec3],
-        base_q: &mut [Vec3],
-        base_a: &mut [Vec3],
-    ) -> GglCoefficients {
-        let k = self.coefficients();
+    fn ggl(&self, state: &RuleState, start: StepStart, base: GglBase) -> GglCoefficients {
+        let (k, h) = (self.coefficients(), start.h);
         let kappa = k.beta * h / k.gamma;
-        for i in 0..q_n.len() {
+        for (i, (q_n, v_n)) in start.q_n.iter().zip(start.v_n).enumerate() {
             for x in 0..3 {
                 let (a_n, qdd_n) = (state.algorithmic[i][x], state.acceleration[i][x]);
-                let old = v_n[i][x] + h * (1.0 - k.gamma) * a_n;
-                base_q[i][x] =
-                    q_n[i][x] + h * v_n[i][x] + h * h * (0.5 - k.beta) * a_n - kappa * old;
-                base_a[i][x] =
+                let old = v_n[x] + h * (1.0 - k.gamma) * a_n;
+                base.b[i][x] = q_n[x] + h * v_n[x] + h * h * (0.5 - k.beta) * a_n - kappa * old;
+                base.c[i][x] =
                     (k.alpha_m * a_n - k.alpha_f * qdd_n - (1.0 - k.alpha_m) * old / (k.gamma * h))
                         / (1.0 - k.alpha_f);
             }
@@ -337,14 +312,7 @@ impl TimeRule for GeneralizedAlpha {
     }
 
     /// The true acceleration qdd_{n+1}.
-    fn end_acceleration(
-        &self,
-        state: &RuleState,
-        _h: f64,
-        _v_n: &[Vec3],
-        _v: &[Vec3],
-        out: &mut [Vec3],
-    ) {
+    fn end_acceleration(&self, state: &RuleState, _: StepStart, _: &[Vec3], out: &mut [Vec3]) {
         out.copy_from_slice(&state.acceleration);
     }
 }

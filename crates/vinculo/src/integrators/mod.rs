@@ -26,7 +26,7 @@ pub use generalized_alpha::{AlphaCoefficients, AlphaStep, GeneralizedAlpha};
 pub use newton::{
     IterationMatrix, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport,
 };
-pub use rule::{GglCoefficients, Index3Rule, RuleState, StepPoint, TimeRule};
+pub use rule::{GglBase, GglCoefficients, Index3Rule, RuleState, StepPoint, StepStart, TimeRule};
 pub use stabilized::{phi_qt, Formulation, StabilizedWorkspace};
 pub use stabilized_layout::StabilizedLayout;
 pub use step_problem::{index3_step, StepProblem};
@@ -114,57 +114,48 @@ impl Scheme {
         with_rule!(*self, rule => rule.initial_state(acc))
     }
 
-    /// Takes one step of size `h` from (t_n, q_n, v_n, `state`): on the GGL formulation when
+    /// Takes one step from `start` and `state` (the rule's state): on the GGL formulation when
     /// `stabilized` is given, on the index-3 DAE otherwise ([`index3_step`],
     /// [`StabilizedWorkspace::step`] say what the buffers hold before and after).
-    #[allow(clippy::too_many_arguments)]
     pub fn step(
         &self,
         system: &System,
         ws: &mut StepWorkspace,
         stabilized: Option<&mut StabilizedWorkspace>,
-        t_n: f64,
-        q_n: &[Vec3],
-        v_n: &[Vec3],
+        start: StepStart,
         state: &mut RuleState,
-        h: f64,
         options: &NewtonOptions,
     ) -> Result<NewtonReport, NewtonFailure> {
         with_rule!(*self, rule => match stabilized {
-            Some(ggl) => ggl.step(system, ws, rule, t_n, q_n, v_n, state, h, options),
-            None => index3_step(rule, system, ws, t_n, q_n, v_n, state, h, options),
+            Some(ggl) => ggl.step(system, ws, rule, start, state, options),
+            None => index3_step(rule, system, ws, start, state, options),
         })
     }
 
-    /// The acceleration of a converged step of size `h` from v_n to v_{n+1} = `v` (the rule's
-    /// `state` already advanced), into `out`: the run loop's predictor and error sample.
+    /// The acceleration of a converged step from `start` to v_{n+1} = `v` (the rule's `state`
+    /// already advanced), into `out`: the run loop's predictor and error sample.
     pub fn end_acceleration(
         &self,
         state: &RuleState,
-        h: f64,
-        v_n: &[Vec3],
+        start: StepStart,
         v: &[Vec3],
         out: &mut [Vec3],
     ) {
-        with_rule!(*self, rule => rule.end_acceleration(state, h, v_n, v, out))
+        with_rule!(*self, rule => rule.end_acceleration(state, start, v, out))
     }
 }
 
 impl GeneralizedTrapezoidal {
-    /// Takes one index-3 step of size `h` from (t_n, q_n, v_n) ([`index3_step`]; the rule
-    /// carries no state of its own).
-    #[allow(clippy::too_many_arguments)]
+    /// Takes one index-3 step from `start` ([`index3_step`]; the rule carries no state of its
+    /// own).
     pub fn step(
         &self,
         system: &System,
         ws: &mut StepWorkspace,
-        t_n: f64,
-        q_n: &[Vec3],
-        v_n: &[Vec3],
-        h: f64,
+        start: StepStart,
         options: &NewtonOptions,
     ) -> Result<NewtonReport, NewtonFailure> {
         let mut none = RuleState::new(&[]);
-        index3_step(*self, system, ws, t_n, q_n, v_n, &mut none, h, options)
+        index3_step(*self, system, ws, start, &mut none, options)
     }
 }

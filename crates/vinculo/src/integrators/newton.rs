@@ -167,6 +167,23 @@ pub struct LinearWork<'a> {
     pub matrix: &'a mut IterationMatrix,
 }
 
+impl<'a> LinearWork<'a> {
+    /// A workspace's `solver` and its arrays `values` and `r`, with the run's `matrix` state.
+    pub fn new(
+        solver: &'a mut Box<dyn LinearSolver>,
+        values: &'a mut [f64],
+        r: &'a mut [f64],
+        matrix: &'a mut IterationMatrix,
+    ) -> LinearWork<'a> {
+        LinearWork {
+            solver: solver.as_mut(),
+            values,
+            r,
+            matrix,
+        }
+    }
+}
+
 /// Solves `problem` by Newton's method with the given linear solver and work arrays. `key`
 /// identifies the iteration matrix (step size and scheme coefficients): modified Newton reuses
 /// a factorisation only when it was made for the same key.

@@ -8,10 +8,14 @@
 //! rule is one file implementing [`TimeRule`], registered once as a variant of
 //! [`super::Scheme`] (whose `with_rule!` dispatch is the only `match` on the scheme):
 //!
-//! - [`TimeRule::index3`] folds what is known before a step (q_n, v_n, the rule's own state)
-//!   into a per-step object implementing [`Index3Rule`]; the one index-3 step problem
-//!   ([`super::StepProblem`], see `step_problem.rs`) is generic over it and monomorphised per
-//!   rule, so the per-particle kinematics inline into the assembly loops;
+//! - every step is given by its [`StepStart`] (t_n, q_n, v_n and the size h), and evaluated at
+//!   a [`StepPoint`] (t_e = t_n + w h, the end t_n + h, the scale of the dynamics rows) that
+//!   [`StepPoint::new`] builds for the index-3 and the GGL step problems alike;
+//! - [`TimeRule::point`] gives an index-3 step's point and scale, and [`TimeRule::index3`]
+//!   folds what is known before a step (q_n, v_n, the rule's own state) into a per-step object
+//!   implementing [`Index3Rule`]; the one index-3 step problem ([`super::StepProblem`], see
+//!   `step_problem.rs`) is generic over it and monomorphised per rule, so the per-particle
+//!   kinematics inline into the assembly loops;
 //! - [`TimeRule::ggl`] gives the coefficients of the common linear form of the stabilised step
 //!   (`stabilized.rs`), the one GGL step problem;
 //! - [`TimeRule::advance`] and [`TimeRule::advance_ggl`] update the rule's state after a
@@ -60,12 +64,33 @@ impl RuleState {
     }
 }
 
+/// Where a step starts and how long it is: (t_n, q_n, v_n) and h, what every step of a rule
+/// and of the step problems starts from.
+#[derive(Debug, Clone, Copy)]
+pub struct StepStart<'a> {
+    /// t_n.
+    pub t_n: f64,
+    /// Positions q_n.
+    pub q_n: &'a [Vec3],
+    /// Velocities v_n.
+    pub v_n: &'a [Vec3],
+    /// The step size h.
+    pub h: f64,
+}
+
+impl<'a> StepStart<'a> {
+    /// The step of size `h` from (`t_n`, `q_n`, `v_n`).
+    pub fn new(t_n: f64, q_n: &'a [Vec3], v_n: &'a [Vec3], h: f64) -> StepStart<'a> {
+        StepStart { t_n, q_n, v_n, h }
+    }
+}
+
 /// One step of a rule as the index-3 step problem sees it: the kinematics of the unknown q =
 /// q_{n+1} and the weights of the scaled residual and Jacobian (`docs/theory/time-rules.md`,
-/// scaling in `docs/theory/formulation.md`).
+/// scaling in `docs/theory/formulation.md`), for the step's scale sigma ([`StepPoint`]).
 ///
 /// The residual of the step is, per free particle and coordinate,
-/// `inertia_row(..) - sigma f(q_e, v_e, t_e) - sigma Phi_q(q_e, t_e)^T lambda`, and
+/// `sigma (inertia_row(..) - f(q_e, v_e, t_e) - Phi_q(q_e, t_e)^T lambda)`, and
 /// `s_k Phi_k(q, t_end)` per constraint; its Jacobian is `mass_diagonal` on the diagonal of the
 /// mass block plus `force_dq df/dq + force_dv df/dv + hessian sum_k lambda_k Phi_k,qq` at the
 /// evaluation point, `-s G(q_e)^T` and `s G(q, t_end)`.
@@ -74,18 +99,16 @@ pub trait Index3Rule: Sync {
     /// v_e = v_{n+1}, t_e = t_{n+1}); false: at a point of their own (stored by the step problem
     /// in its evaluation buffers).
     const AT_END: bool;
-    /// The step's evaluation and end times and the scale of its dynamics rows.
-    fn point(&self) -> StepPoint;
     /// (v_{n+1}, q_e, v_e) of particle `i` at the iterate `q` (q_e and v_e unused when
     /// [`Index3Rule::AT_END`]).
     fn kinematics(&self, i: usize, q: &Vec3) -> (Vec3, Vec3, Vec3);
-    /// The scaled inertia and gravity terms sigma (M qdd_{n+1} - m g) of particle `i`, from its
-    /// iterate `q` and new velocity `v`.
+    /// The inertia and gravity terms M qdd_{n+1} - m g of particle `i`, from its iterate `q` and
+    /// new velocity `v` (unscaled: the step problem multiplies them by sigma).
     fn inertia_row(&self, i: usize, q: &Vec3, v: &Vec3, inertia: f64, mass: f64, g: &Vec3) -> Vec3;
     /// The scaled mass term sigma (d qdd / dq) M of a particle of inertia `inertia`.
-    fn mass_diagonal(&self, inertia: f64) -> f64;
-    /// The weights (of df/dq, of df/dv, of lambda_k Phi_k,qq) in the scaled Jacobian.
-    fn weights(&self) -> (f64, f64, f64);
+    fn mass_diagonal(&self, sigma: f64, inertia: f64) -> f64;
+    /// The weights (of df/dq, of df/dv, of lambda_k Phi_k,qq) in the Jacobian scaled by sigma.
+    fn weights(&self, sigma: f64) -> (f64, f64, f64);
 }
 
 /// Where an index-3 step is evaluated and how its dynamics rows are scaled.
@@ -99,6 +122,18 @@ pub struct StepPoint {
     pub sigma: f64,
 }
 
+impl StepPoint {
+    /// The point of a step from `start` at the weight `w` of the new state (t_e = t_n + w h,
+    /// w = 1: the step's end), its dynamics rows scaled by `sigma`.
+    pub fn new(start: &StepStart, w: f64, sigma: f64) -> StepPoint {
+        StepPoint {
+            t_eval: start.t_n + w * start.h,
+            t_end: start.t_n + start.h,
+            sigma,
+        }
+    }
+}
+
 /// The coefficients of a stabilised (GGL) step in its common linear form
 /// (`docs/theory/ggl.md`): q = b + kappa v + G^T mu, qdd = c + c_v v, evaluation point
 /// (1 - w) x_n + w x_{n+1}.
@@ -110,6 +145,15 @@ pub struct GglCoefficients {
     pub c_v: f64,
     /// Weight of the new state in the evaluation point.
     pub w: f64,
+}
+
+/// Where a rule writes the parts of a GGL step known before it, per particle: b of
+/// q = b + kappa v + G^T mu and c of qdd = c + c_v v ([`GglCoefficients`]).
+pub struct GglBase<'a> {
+    /// b.
+    pub b: &'a mut [Vec3],
+    /// c.
+    pub c: &'a mut [Vec3],
 }
 
 /// A time rule: its coefficients and its state update (module documentation).
@@ -135,46 +179,27 @@ pub trait TimeRule: Copy + Send + Sync {
         RuleState::new(acc)
     }
 
-    /// The index-3 step of size `h` from (t_n, q_n, v_n, `state`), computing its predictors into
-    /// `state` first; `mass_ref` sets the scaling.
-    fn index3<'a>(
-        &self,
-        state: &'a mut RuleState,
-        t_n: f64,
-        q_n: &'a [Vec3],
-        v_n: &'a [Vec3],
-        h: f64,
-        mass_ref: f64,
-    ) -> Self::Step<'a>;
+    /// Where the index-3 step from `start` is evaluated, and the scale of its dynamics rows for
+    /// the reference mass `mass_ref`.
+    fn point(&self, start: &StepStart, mass_ref: f64) -> StepPoint;
+
+    /// The kinematics of the index-3 step from `start` and `state` (computing its predictors
+    /// into `state` first).
+    fn index3<'a>(&self, state: &'a mut RuleState, start: StepStart<'a>) -> Self::Step<'a>;
 
     /// After a converged index-3 step of size `h` to q_{n+1} = `q` (from the predictors that
     /// [`TimeRule::index3`] left in `state`): the rule's new state.
     fn advance(&self, state: &mut RuleState, h: f64, q: &[Vec3]);
 
-    /// The GGL step of size `h` from (q_n, v_n, `state`): its coefficients, with b and c
-    /// written into `base_q` and `base_a`.
-    fn ggl(
-        &self,
-        state: &RuleState,
-        h: f64,
-        q_n: &[Vec3],
-        v_n: &[Vec3],
-        base_q: &mut [Vec3],
-        base_a: &mut [Vec3],
-    ) -> GglCoefficients;
+    /// The GGL step from `start` and `state`: its coefficients, with b and c written into
+    /// `base`.
+    fn ggl(&self, state: &RuleState, start: StepStart, base: GglBase) -> GglCoefficients;
 
     /// After a converged GGL step of size `h` from v_n to v_{n+1} = `v`: the rule's new state.
     fn advance_ggl(&self, state: &mut RuleState, h: f64, v_n: &[Vec3], v: &[Vec3]);
 
-    /// The acceleration of a converged step of size `h` from v_n to v_{n+1} = `v` (with the
-    /// state already advanced), into `out`: what the run loop's predictor extrapolates with and
-    /// its error estimate samples.
-    fn end_acceleration(
-        &self,
-        state: &RuleState,
-        h: f64,
-        v_n: &[Vec3],
-        v: &[Vec3],
-        out: &mut [Vec3],
-    );
+    /// The acceleration of a converged step from `start` to v_{n+1} = `v` (with the state
+    /// already advanced), into `out`: what the run loop's predictor extrapolates with and its
+    /// error estimate samples.
+    fn end_acceleration(&self, state: &RuleState, start: StepStart, v: &[Vec3], out: &mut [Vec3]);
 }

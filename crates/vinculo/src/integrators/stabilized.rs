@@ -33,7 +33,9 @@
 //!
 //! The rule gives kappa, c_v, w, b and c ([`TimeRule::ggl`]; the formulas of each rule are in its
 //! own file, `trapezoidal.rs` and `generalized_alpha.rs`), and updates its state from v_{n+1}
-//! after the step ([`TimeRule::advance_ggl`]). This file is the one GGL step problem,
+//! after the step ([`TimeRule::advance_ggl`]). The step starts from a [`StepStart`] and is
+//! evaluated at the [`StepPoint`] of weight w (built by [`StepPoint::new`], as the index-3
+//! step's is). This file is the one GGL step problem,
 //! written once for every rule: with mu = 0 and the trapezoidal rule, v_e = (q - q_n)/h and the
 //! step is the index-3 one of `step_problem.rs`.
 //!
@@ -97,7 +99,7 @@
 //! the dense LU, others the general sparse LU, analysed once per run.
 
 use super::newton::{self, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport};
-use super::rule::{RuleState, TimeRule};
+use super::rule::{GglBase, RuleState, StepPoint, StepStart, TimeRule};
 use super::stabilized_layout::StabilizedLayout;
 use super::workspace::{StepBuffers, StepWorkspace};
 
@@ -138,12 +140,8 @@ struct StepRule {
     c_v: f64,
     /// Weight of the new state in the evaluation point.
     w: f64,
-    /// Time of the evaluation point.
-    t_eval: f64,
-    /// t_{n+1}.
-    t_end: f64,
-    /// Scale of the dynamic rows, kappa/(c_v m_ref).
-    sigma: f64,
+    /// Evaluation point, end, and the scale of the dynamic rows sigma = kappa/(c_v m_ref).
+    point: StepPoint,
 }
 
 /// The layout, solver and buffers of the GGL steps of a run (allocated once).
@@ -183,51 +181,78 @@ impl StabilizedWorkspace {
         }
     }
 
-    /// The coefficients of a step of `rule` of size `h` from (t_n, q_n, v_n, `state`), with
-    /// b and c in `base_q` and `base_a`.
-    #[allow(clippy::too_many_arguments)]
+    /// The coefficients of a step of `rule` from `start` and `state`, with b and c in
+    /// `base_q` and `base_a`; `mass_ref` sets the scaling.
     fn prepare<T: TimeRule>(
         &mut self,
         rule: T,
         mass_ref: f64,
-        t_n: f64,
-        q_n: &[Vec3],
-        v_n: &[Vec3],
+        start: StepStart,
         state: &RuleState,
-        h: f64,
     ) -> StepRule {
-        let k = rule.ggl(state, h, q_n, v_n, &mut self.base_q, &mut self.base_a);
+        let base = GglBase {
+            b: &mut self.base_q,
+            c: &mut self.base_a,
+        };
+        let k = rule.ggl(state, start, base);
         StepRule {
             kappa: k.kappa,
             c_v: k.c_v,
             w: k.w,
-            t_eval: t_n + k.w * h,
-            t_end: t_n + h,
-            sigma: k.kappa / (k.c_v * mass_ref),
+            point: StepPoint::new(&start, k.w, k.kappa / (k.c_v * mass_ref)),
         }
     }
 
-    /// Takes one GGL step of `rule` of size `h` from (t_n, q_n, v_n, `state`). The caller sets
-    /// the predictor in `ws.state.q` and `ws.state.lambda`; the velocities start from the
+    /// The problem of the step `rule` from `start` on these buffers and `ws.state` (the
+    /// iterate), and the linear solver's share of the workspace.
+    fn problem<'a>(
+        &'a mut self,
+        system: &'a System,
+        ws: &'a mut StepWorkspace,
+        start: StepStart<'a>,
+        rule: StepRule,
+    ) -> (StabilizedProblem<'a>, LinearWork<'a>) {
+        let problem = StabilizedProblem {
+            system,
+            layout: &self.layout,
+            state: &mut ws.state,
+            mu: &mut self.mu,
+            scales: &ws.scales,
+            inertia: &ws.inertia,
+            start,
+            base_q: &self.base_q,
+            base_a: &self.base_a,
+            q_eval: &mut self.q_eval,
+            v_eval: &mut self.v_eval,
+            probe: &mut self.probe,
+            rule,
+        };
+        let work = LinearWork::new(
+            &mut self.solver,
+            &mut self.values,
+            &mut self.r,
+            &mut ws.matrix,
+        );
+        (problem, work)
+    }
+
+    /// Takes one GGL step of `time_rule` from `start` and `state` (the rule's state). The caller
+    /// sets the predictor in `ws.state.q` and `ws.state.lambda`; the velocities start from the
     /// kinematics with mu = 0. On success `ws.state` holds q_{n+1}, v_{n+1} and lambda_{n+1},
     /// `self.mu` the velocity multipliers and `state` the rule's new state; on failure `state`
     /// is unchanged. `ws.matrix` tracks this
     /// solver's factorisation for modified Newton; failures name equations in the index-3
     /// numbering of `ws.layout` ([`StabilizedLayout::index3_equation`]).
-    #[allow(clippy::too_many_arguments)]
     pub fn step<T: TimeRule>(
         &mut self,
         system: &System,
         ws: &mut StepWorkspace,
         time_rule: T,
-        t_n: f64,
-        q_n: &[Vec3],
-        v_n: &[Vec3],
+        start: StepStart,
         state: &mut RuleState,
-        h: f64,
         options: &NewtonOptions,
     ) -> Result<NewtonReport, NewtonFailure> {
-        let rule = self.prepare(time_rule, ws.mass_ref, t_n, q_n, v_n, state, h);
+        let rule = self.prepare(time_rule, ws.mass_ref, start, state);
         for (v, (q, b)) in ws
             .state
             .v
@@ -239,31 +264,9 @@ impl StabilizedWorkspace {
             }
         }
         self.mu.fill(0.0);
-        let mut problem = StabilizedProblem {
-            system,
-            layout: &self.layout,
-            state: &mut ws.state,
-            mu: &mut self.mu,
-            scales: &ws.scales,
-            inertia: &ws.inertia,
-            q_n,
-            v_n,
-            base_q: &self.base_q,
-            base_a: &self.base_a,
-            q_eval: &mut self.q_eval,
-            v_eval: &mut self.v_eval,
-            probe: &mut self.probe,
-            rule,
-        };
-        let work = LinearWork {
-            solver: self.solver.as_mut(),
-            values: &mut self.values,
-            r: &mut self.r,
-            matrix: &mut ws.matrix,
-        };
-        let layout = &self.layout;
-        let report = newton::solve(&mut problem, work, time_rule.matrix_key(h), options).map_err(
-            |failure| match failure {
+        let (mut problem, work) = self.problem(system, ws, start, rule);
+        let report = newton::solve(&mut problem, work, time_rule.matrix_key(start.h), options)
+            .map_err(|failure| match failure {
                 NewtonFailure::NotConverged {
                     iterations,
                     residual,
@@ -271,15 +274,14 @@ impl StabilizedWorkspace {
                 } => NewtonFailure::NotConverged {
                     iterations,
                     residual,
-                    worst: layout.index3_equation(worst),
+                    worst: self.layout.index3_equation(worst),
                 },
                 NewtonFailure::Singular(mut s) => {
-                    s.column = s.column.map(|c| layout.index3_equation(c));
+                    s.column = s.column.map(|c| self.layout.index3_equation(c));
                     NewtonFailure::Singular(s)
                 }
-            },
-        )?;
-        time_rule.advance_ggl(state, h, v_n, &ws.state.v);
+            })?;
+        time_rule.advance_ggl(state, start.h, start.v_n, &ws.state.v);
         Ok(report)
     }
 }
@@ -310,8 +312,7 @@ pub struct StabilizedProblem<'a> {
     mu: &'a mut [f64],
     scales: &'a [f64],
     inertia: &'a [f64],
-    q_n: &'a [Vec3],
-    v_n: &'a [Vec3],
+    start: StepStart<'a>,
     base_q: &'a [Vec3],
     base_a: &'a [Vec3],
     q_eval: &'a mut [Vec3],
@@ -323,12 +324,13 @@ pub struct StabilizedProblem<'a> {
 impl NewtonProblem for StabilizedProblem<'_> {
     fn residual(&mut self, r: &mut [f64]) {
         let (system, layout, rule) = (self.system, self.layout, self.rule);
+        let point = rule.point;
         let (n3, m) = (3 * layout.free, layout.constraints);
         let b = &*self.state;
         for i in 0..b.q.len() {
             for x in 0..3 {
-                self.q_eval[i][x] = (1.0 - rule.w) * self.q_n[i][x] + rule.w * b.q[i][x];
-                self.v_eval[i][x] = (1.0 - rule.w) * self.v_n[i][x] + rule.w * b.v[i][x];
+                self.q_eval[i][x] = (1.0 - rule.w) * self.start.q_n[i][x] + rule.w * b.q[i][x];
+                self.v_eval[i][x] = (1.0 - rule.w) * self.start.v_n[i][x] + rule.w * b.v[i][x];
             }
         }
         let g = system.gravity();
@@ -338,31 +340,31 @@ impl NewtonProblem for StabilizedProblem<'_> {
                 for x in 0..3 {
                     r[d + x] = b.q[i][x] - self.base_q[i][x] - rule.kappa * b.v[i][x];
                     let qdd = self.base_a[i][x] + rule.c_v * b.v[i][x];
-                    r[n3 + d + x] = rule.sigma * (self.inertia[i] * qdd - p.mass * g[x]);
+                    r[n3 + d + x] = point.sigma * (self.inertia[i] * qdd - p.mass * g[x]);
                 }
             }
         }
         for f in system.forces() {
-            let fl = f.force(self.q_eval, self.v_eval, rule.t_eval);
+            let fl = f.force(self.q_eval, self.v_eval, point.t_eval);
             for (x, &p) in f.particles().iter().enumerate() {
                 let d = layout.dof[p];
                 if d != NONE {
                     for y in 0..3 {
-                        r[n3 + d + y] -= rule.sigma * fl[x][y];
+                        r[n3 + d + y] -= point.sigma * fl[x][y];
                     }
                 }
             }
         }
         for (c, con) in system.constraints().iter().enumerate() {
-            let grad_e = con.gradient(self.q_eval, rule.t_eval);
-            let grad_1 = con.gradient(&b.q, rule.t_end);
+            let grad_e = con.gradient(self.q_eval, point.t_eval);
+            let grad_1 = con.gradient(&b.q, point.t_end);
             let mut gv = 0.0;
             for (x, &p) in con.particles().iter().enumerate() {
                 let d = layout.dof[p];
                 if d != NONE {
                     for y in 0..3 {
                         r[d + y] -= grad_1[x][y] * self.mu[c];
-                        r[n3 + d + y] -= rule.sigma * grad_e[x][y] * b.lambda[c];
+                        r[n3 + d + y] -= point.sigma * grad_e[x][y] * b.lambda[c];
                     }
                 }
                 for y in 0..3 {
@@ -370,15 +372,16 @@ impl NewtonProblem for StabilizedProblem<'_> {
                 }
             }
             let s = self.scales[c];
-            r[2 * n3 + c] = s * con.residual(&b.q, rule.t_end);
-            r[2 * n3 + m + c] = s * rule.kappa * (gv + con.phi_t(&b.q, rule.t_end));
+            r[2 * n3 + c] = s * con.residual(&b.q, point.t_end);
+            r[2 * n3 + m + c] = s * rule.kappa * (gv + con.phi_t(&b.q, point.t_end));
         }
     }
 
     fn jacobian(&mut self, values: &mut [f64]) {
         let (system, layout, rule) = (self.system, self.layout, self.rule);
+        let point = rule.point;
         let b = &*self.state;
-        let mass_ref = rule.kappa / (rule.c_v * rule.sigma);
+        let mass_ref = rule.kappa / (rule.c_v * point.sigma);
         for i in 0..system.particles().len() {
             if layout.dof[i] == NONE {
                 continue;
@@ -397,8 +400,8 @@ impl NewtonProblem for StabilizedProblem<'_> {
             let n = f.particles().len();
             let mut dq = Jacobian::zeros(n);
             let mut dv = Jacobian::zeros(n);
-            f.add_jacobian(self.q_eval, self.v_eval, rule.t_eval, &mut dq, &mut dv);
-            let (wq, wv) = (-rule.sigma * rule.w, -rule.sigma * rule.w / rule.kappa);
+            f.add_jacobian(self.q_eval, self.v_eval, point.t_eval, &mut dq, &mut dv);
+            let (wq, wv) = (-point.sigma * rule.w, -point.sigma * rule.w / rule.kappa);
             let pairs = layout.force_offsets.pairs(fi);
             let (blocks_q, blocks_v) = (&layout.force_q[pairs.clone()], &layout.force_v[pairs]);
             add_force_blocks(blocks_q, blocks_v, (wq, &dq), (wv, &dv), |b, s, m| {
@@ -410,13 +413,13 @@ impl NewtonProblem for StabilizedProblem<'_> {
             let n = parts.len();
             let s = self.scales[c];
             let mut dyn_hess = Hessian::zeros(n);
-            let w_lambda = -rule.sigma * rule.w * b.lambda[c];
-            con.add_hessian(self.q_eval, rule.t_eval, w_lambda, &mut dyn_hess);
+            let w_lambda = -point.sigma * rule.w * b.lambda[c];
+            con.add_hessian(self.q_eval, point.t_eval, w_lambda, &mut dyn_hess);
             let mut hess = Hessian::zeros(n);
-            con.add_hessian(&b.q, rule.t_end, 1.0, &mut hess);
-            let grad_e = con.gradient(self.q_eval, rule.t_eval);
-            let grad_1 = con.gradient(&b.q, rule.t_end);
-            let qt = phi_qt(con, &b.q, rule.t_end, self.probe);
+            con.add_hessian(&b.q, point.t_end, 1.0, &mut hess);
+            let grad_e = con.gradient(self.q_eval, point.t_eval);
+            let grad_1 = con.gradient(&b.q, point.t_end);
+            let qt = phi_qt(con, &b.q, point.t_end, self.probe);
             let pairs = layout.constraint_offsets.pairs(c);
             let (dynamic_hessian, kinematic_hessian) = (
                 &layout.dynamic_hessian[pairs.clone()],
@@ -470,7 +473,7 @@ impl NewtonProblem for StabilizedProblem<'_> {
         }
         for c in 0..m {
             let s = self.scales[c];
-            b.lambda[c] -= dx[2 * n3 + c] * s / self.rule.sigma;
+            b.lambda[c] -= dx[2 * n3 + c] * s / self.rule.point.sigma;
             self.mu[c] -= dx[2 * n3 + m + c] * s;
         }
     }
@@ -508,8 +511,9 @@ mod tests {
                 alpha.acceleration = q_n.iter().map(|x| [x[1], -x[0], 0.3]).collect();
                 let h = 0.01;
                 let mass_ref = ws.mass_ref;
+                let start = StepStart::new(0.3, &q_n, &v_n, h);
                 let rule = crate::integrators::with_rule!(scheme, r => {
-                    ggl.prepare(r, mass_ref, 0.3, &q_n, &v_n, &alpha, h)
+                    ggl.prepare(r, mass_ref, start, &alpha)
                 });
                 perturbed_iterate(&mut ws, &q_n);
                 for (i, v) in ws.state.v.iter_mut().enumerate() {
@@ -518,23 +522,9 @@ mod tests {
                 for (k, mu) in ggl.mu.iter_mut().enumerate() {
                     *mu = 1e-3 * (k as f64 - 1.5);
                 }
-                let mut problem = StabilizedProblem {
-                    system: &s,
-                    layout: &ggl.layout,
-                    state: &mut ws.state,
-                    mu: &mut ggl.mu,
-                    scales: &ws.scales,
-                    inertia: &ws.inertia,
-                    q_n: &q_n,
-                    v_n: &v_n,
-                    base_q: &ggl.base_q,
-                    base_a: &ggl.base_a,
-                    q_eval: &mut ggl.q_eval,
-                    v_eval: &mut ggl.v_eval,
-                    probe: &mut ggl.probe,
-                    rule,
-                };
-                assert_pattern_jacobian_matches(&mut problem, &ggl.layout.pattern);
+                let pattern = ggl.layout.pattern.clone();
+                let (mut problem, _) = ggl.problem(&s, &mut ws, start, rule);
+                assert_pattern_jacobian_matches(&mut problem, &pattern);
             }
         }
     }

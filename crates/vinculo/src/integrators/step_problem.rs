@@ -4,10 +4,13 @@
 //! # Design
 //!
 //! The residual, the Jacobian, their parallel variants and the update are written once here and
-//! parametrised by the rule's per-step object ([`Index3Rule`], see `rule.rs`): the rule says how
-//! the iterate q becomes v_{n+1} and the evaluation point (q_e, v_e, t_e), what the inertia row
-//! and the mass block are, and with which weights df/dq, df/dv and the constraint Hessians enter.
-//! [`StepProblem`] is generic over it, so each rule gets its own monomorphised loops (no
+//! parametrised by the rule's per-step object ([`Index3Rule`], see `rule.rs`) and the step's
+//! [`StepPoint`] ([`TimeRule::point`]: t_e, t_{n+1} and the scale sigma of the dynamics rows,
+//! built by [`StepPoint::new`] as for the GGL step): the rule says how the iterate q becomes
+//! v_{n+1} and the evaluation point (q_e, v_e), what the inertia row and the mass block are, and
+//! with which weights df/dq, df/dv and the constraint Hessians enter; the step problem applies
+//! sigma. Every step starts from a [`StepStart`] (t_n, q_n, v_n, h), the one argument the step
+//! functions of both step problems and of the run loop pass on. [`StepProblem`] is generic over it, so each rule gets its own monomorphised loops (no
 //! dynamic dispatch per particle). Placing the elements' local values and derivatives is the
 //! assembler's job (`assembly/`): the serial loops ([`Layout::residual`], [`Layout::jacobian`])
 //! and the parallel ones ([`ParallelAssembly`]) read the same [`ResidualTerms`] and
@@ -20,7 +23,7 @@
 use rayon::prelude::*;
 
 use super::newton::{self, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport};
-use super::rule::{Index3Rule, RuleState, TimeRule};
+use super::rule::{Index3Rule, RuleState, StepPoint, StepStart, TimeRule};
 use super::workspace::{StepBuffers, StepWorkspace};
 use crate::assembly::{
     InertiaRows, JacobianTerms, Layout, ParallelAssembly, ResidualTerms, MIN_TASK,
@@ -37,13 +40,20 @@ pub struct StepProblem<'a, R: Index3Rule> {
     scales: &'a [f64],
     inertia: &'a [f64],
     parallel: Option<&'a mut ParallelAssembly>,
+    point: StepPoint,
     rule: R,
 }
 
 impl<'a, R: Index3Rule> StepProblem<'a, R> {
-    /// The problem of the rule step `rule` on the workspace's buffers (the iterate and
-    /// multipliers in `ws.state`), and the linear solver's share of the workspace.
-    pub fn new(system: &'a System, ws: &'a mut StepWorkspace, rule: R) -> (Self, LinearWork<'a>) {
+    /// The problem of the rule step `rule` ([`TimeRule::index3`]) at `point`
+    /// ([`TimeRule::point`]) on the workspace's buffers (the iterate and multipliers in
+    /// `ws.state`), and the linear solver's share of the workspace.
+    pub fn new(
+        system: &'a System,
+        ws: &'a mut StepWorkspace,
+        point: StepPoint,
+        rule: R,
+    ) -> (Self, LinearWork<'a>) {
         let problem = StepProblem {
             system,
             layout: &ws.layout,
@@ -51,14 +61,10 @@ impl<'a, R: Index3Rule> StepProblem<'a, R> {
             scales: &ws.scales,
             inertia: &ws.inertia,
             parallel: ws.parallel.as_mut(),
+            point,
             rule,
         };
-        let work = LinearWork {
-            solver: ws.solver.as_mut(),
-            values: &mut ws.values,
-            r: &mut ws.r,
-            matrix: &mut ws.matrix,
-        };
+        let work = LinearWork::new(&mut ws.solver, &mut ws.values, &mut ws.r, &mut ws.matrix);
         (problem, work)
     }
 
@@ -115,8 +121,7 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
         }
         let b = &*self.buffers;
         let (q_eval, v_eval) = Self::eval_point(b);
-        let rule = &self.rule;
-        let point = rule.point();
+        let (rule, point) = (&self.rule, self.point);
         let terms = ResidualTerms {
             q_eval,
             v_eval,
@@ -131,6 +136,7 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
         let (particles, g) = (system.particles(), system.gravity());
         let row = Rows {
             rule,
+            sigma: point.sigma,
             q: &b.q,
             v: &b.v,
             inertia,
@@ -147,8 +153,8 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
         let b = &*self.buffers;
         let (q_eval, v_eval) = Self::eval_point(b);
         let rule = &self.rule;
-        let (force_dq, force_dv, hessian) = rule.weights();
-        let point = rule.point();
+        let point = self.point;
+        let (force_dq, force_dv, hessian) = rule.weights(point.sigma);
         let terms = JacobianTerms {
             q_eval,
             v_eval,
@@ -162,7 +168,7 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
             scales: self.scales,
         };
         let inertia = self.inertia;
-        let mass = |i: usize| rule.mass_diagonal(inertia[i]);
+        let mass = |i: usize| rule.mass_diagonal(point.sigma, inertia[i]);
         match self.parallel.as_deref() {
             Some(parallel) => parallel.jacobian(self.system, self.layout, &terms, values, mass),
             None => self.layout.jacobian(self.system, &terms, values, mass),
@@ -171,19 +177,15 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
 
     fn update(&mut self, dx: &[f64]) {
         let b = &mut *self.buffers;
-        self.layout.apply_increment(
-            &mut b.q,
-            &mut b.lambda,
-            dx,
-            self.scales,
-            self.rule.point().sigma,
-        );
+        self.layout
+            .apply_increment(&mut b.q, &mut b.lambda, dx, self.scales, self.point.sigma);
     }
 }
 
-/// The inertia and gravity rows of a step of the rule step `R` at the current iterate.
+/// The scaled inertia and gravity rows of a step of the rule step `R` at the current iterate.
 struct Rows<'b, R> {
     rule: &'b R,
+    sigma: f64,
     q: &'b [Vec3],
     v: &'b [Vec3],
     inertia: &'b [f64],
@@ -196,30 +198,30 @@ impl<R: Index3Rule> InertiaRows for Rows<'_, R> {
     fn rows(&self, i: usize) -> Vec3 {
         let mass = self.particles[i].mass;
         let (q, v) = (&self.q[i], &self.v[i]);
-        self.rule
-            .inertia_row(i, q, v, self.inertia[i], mass, &self.g)
+        let row = self
+            .rule
+            .inertia_row(i, q, v, self.inertia[i], mass, &self.g);
+        row.map(|x| self.sigma * x)
     }
 }
 
-/// Takes one index-3 step of `rule` of size `h` from (t_n, q_n, v_n, `state`). The caller sets
-/// the predictor in `ws.state.q` and `ws.state.lambda`; on success they hold q_{n+1} and
+/// Takes one index-3 step of `rule` from `start` and `state` (the rule's state). The caller
+/// sets the predictor in `ws.state.q` and `ws.state.lambda`; on success they hold q_{n+1} and
 /// lambda_{n+1}, `ws.state.v` holds v_{n+1} and `state` the rule's new state. On failure the
 /// rule's carried state (its accelerations) is unchanged.
-#[allow(clippy::too_many_arguments)]
 pub fn index3_step<T: TimeRule>(
     rule: T,
     system: &System,
     ws: &mut StepWorkspace,
-    t_n: f64,
-    q_n: &[Vec3],
-    v_n: &[Vec3],
+    start: StepStart,
     state: &mut RuleState,
-    h: f64,
     options: &NewtonOptions,
 ) -> Result<NewtonReport, NewtonFailure> {
+    let h = start.h;
     let report = {
-        let step = rule.index3(state, t_n, q_n, v_n, h, ws.mass_ref);
-        let (mut problem, work) = StepProblem::new(system, ws, step);
+        let point = rule.point(&start, ws.mass_ref);
+        let step = rule.index3(state, start);
+        let (mut problem, work) = StepProblem::new(system, ws, point, step);
         let report = newton::solve(&mut problem, work, rule.matrix_key(h), options)?;
         problem.kinematics();
         report
@@ -248,13 +250,29 @@ mod tests {
     ) -> (Vec<f64>, Vec<f64>) {
         let (q_n, v_n) = (s.initial_positions(), s.initial_velocities());
         let (unknowns, nnz) = (ws.layout.unknowns(), ws.layout.pattern.nnz());
-        let step = rule.index3(state, 0.3, &q_n, &v_n, 0.01, ws.mass_ref);
-        let (mut problem, _) = StepProblem::new(s, ws, step);
+        let (mut problem, _) = problem_at(rule, s, ws, state, start(&q_n, &v_n));
         let mut r = vec![0.0; unknowns];
         let mut values = vec![0.0; nnz];
         problem.residual(&mut r);
         problem.jacobian(&mut values);
         (r, values)
+    }
+
+    /// The problem of the step of `rule` from `start` and `state`.
+    fn problem_at<'a, T: TimeRule>(
+        rule: T,
+        s: &'a System,
+        ws: &'a mut StepWorkspace,
+        state: &'a mut RuleState,
+        start: StepStart<'a>,
+    ) -> (StepProblem<'a, T::Step<'a>>, LinearWork<'a>) {
+        let point = rule.point(&start, ws.mass_ref);
+        StepProblem::new(s, ws, point, rule.index3(state, start))
+    }
+
+    /// The step of size h = 0.01 from (t_n = 0.3, q_n, v_n).
+    fn start<'a>(q_n: &'a [Vec3], v_n: &'a [Vec3]) -> StepStart<'a> {
+        StepStart::new(0.3, q_n, v_n, 0.01)
     }
 
     /// Generalised-alpha's state with non-zero old accelerations.
@@ -324,8 +342,7 @@ mod tests {
                 let layout = ws.layout.clone();
                 let mut state = RuleState::new(&q_n);
                 let rule = GeneralizedTrapezoidal { alpha };
-                let step = rule.index3(&mut state, 0.3, &q_n, &v_n, 0.01, ws.mass_ref);
-                let (mut problem, _) = StepProblem::new(&s, &mut ws, step);
+                let (mut problem, _) = problem_at(rule, &s, &mut ws, &mut state, start(&q_n, &v_n));
                 assert_jacobian_matches(&mut problem, &layout);
             }
             for rho_inf in [0.0, 0.6, 1.0] {
@@ -339,8 +356,7 @@ mod tests {
                     .map(|i| [-0.1, 0.4 * i as f64, 0.7])
                     .collect();
                 let rule = GeneralizedAlpha { rho_inf };
-                let step = rule.index3(&mut state, 0.3, &q_n, &v_n, 0.01, ws.mass_ref);
-                let (mut problem, _) = StepProblem::new(&s, &mut ws, step);
+                let (mut problem, _) = problem_at(rule, &s, &mut ws, &mut state, start(&q_n, &v_n));
                 assert_jacobian_matches(&mut problem, &layout);
             }
         }

@@ -29,7 +29,9 @@
 //! c_v = 1/h, c = -v_n/h, w = alpha.
 
 use super::error_estimate::ErrorConstants;
-use super::rule::{GglCoefficients, Index3Rule, RuleState, StepPoint, TimeRule};
+use super::rule::{
+    GglBase, GglCoefficients, Index3Rule, RuleState, StepPoint, StepStart, TimeRule,
+};
 use crate::math::Vec3;
 
 /// The rule and its parameter alpha in [1/2, 1] (1/2: trapezoidal, 1: backward Euler).
@@ -43,56 +45,10 @@ pub struct GeneralizedTrapezoidal {
 /// v_a = (q - q_n)/h, v_{n+1} = (v_a - (1 - alpha) v_n)/alpha, q_a = (1 - alpha) q_n + alpha q.
 #[derive(Debug, Clone, Copy)]
 pub struct TrapezoidalStep<'a> {
-    q_n: &'a [Vec3],
-    v_n: &'a [Vec3],
-    h: f64,
+    start: StepStart<'a>,
     alpha: f64,
     inv_h: f64,
     inv_alpha: f64,
-    point: StepPoint,
-}
-
-impl Index3Rule for TrapezoidalStep<'_> {
-    const AT_END: bool = false;
-
-    fn point(&self) -> StepPoint {
-        self.point
-    }
-
-    #[inline(always)]
-    fn kinematics(&self, i: usize, q: &Vec3) -> (Vec3, Vec3, Vec3) {
-        let (q_n, v_n) = (&self.q_n[i], &self.v_n[i]);
-        let a = self.alpha;
-        let va: Vec3 = std::array::from_fn(|k| (q[k] - q_n[k]) * self.inv_h);
-        let v = std::array::from_fn(|k| (va[k] - (1.0 - a) * v_n[k]) * self.inv_alpha);
-        let qa = std::array::from_fn(|k| (1.0 - a) * q_n[k] + a * q[k]);
-        (v, qa, va)
-    }
-
-    #[inline(always)]
-    fn inertia_row(
-        &self,
-        i: usize,
-        _q: &Vec3,
-        v: &Vec3,
-        inertia: f64,
-        mass: f64,
-        g: &Vec3,
-    ) -> Vec3 {
-        let v_n = &self.v_n[i];
-        let sigma = self.point.sigma;
-        std::array::from_fn(|k| sigma * (inertia * ((v[k] - v_n[k]) * self.inv_h) - mass * g[k]))
-    }
-
-    #[inline(always)]
-    fn mass_diagonal(&self, inertia: f64) -> f64 {
-        self.point.sigma * inertia / (self.alpha * self.h * self.h)
-    }
-
-    fn weights(&self) -> (f64, f64, f64) {
-        let sigma = self.point.sigma;
-        (-sigma * self.alpha, -sigma / self.h, -sigma * self.alpha)
-    }
 }
 
 impl TimeRule for GeneralizedTrapezoidal {
@@ -126,27 +82,18 @@ impl TimeRule for GeneralizedTrapezoidal {
         self.alpha * h
     }
 
-    fn index3<'a>(
-        &self,
-        _state: &'a mut RuleState,
-        t_n: f64,
-        q_n: &'a [Vec3],
-        v_n: &'a [Vec3],
-        h: f64,
-        mass_ref: f64,
-    ) -> TrapezoidalStep<'a> {
+    /// At t_n + alpha h, rows scaled by alpha h^2 / m_ref.
+    fn point(&self, start: &StepStart, mass_ref: f64) -> StepPoint {
+        let (alpha, h) = (self.alpha, start.h);
+        StepPoint::new(start, alpha, alpha * h * h / mass_ref)
+    }
+
+    fn index3<'a>(&self, _: &'a mut RuleState, start: StepStart<'a>) -> TrapezoidalStep<'a> {
         TrapezoidalStep {
-            q_n,
-            v_n,
-            h,
+            start,
             alpha: self.alpha,
-            inv_h: 1.0 / h,
+            inv_h: 1.0 / start.h,
             inv_alpha: 1.0 / self.alpha,
-            point: StepPoint {
-                t_eval: t_n + self.alpha * h,
-                t_end: t_n + h,
-                sigma: self.alpha * h * h / mass_ref,
-            },
         }
     }
 
@@ -157,20 +104,12 @@ impl TimeRule for GeneralizedTrapezoidal {
 
     fn advance(&self, _state: &mut RuleState, _h: f64, _q: &[Vec3]) {}
 
-    fn ggl(
-        &self,
-        _state: &RuleState,
-        h: f64,
-        q_n: &[Vec3],
-        v_n: &[Vec3],
-        base_q: &mut [Vec3],
-        base_a: &mut [Vec3],
-    ) -> GglCoefficients {
-        let a = self.alpha;
-        for i in 0..q_n.len() {
+    fn ggl(&self, _: &RuleState, start: StepStart, base: GglBase) -> GglCoefficients {
+        let (a, h) = (self.alpha, start.h);
+        for (i, (q_n, v_n)) in start.q_n.iter().zip(start.v_n).enumerate() {
             for x in 0..3 {
-                base_q[i][x] = q_n[i][x] + (1.0 - a) * h * v_n[i][x];
-                base_a[i][x] = -v_n[i][x] / h;
+                base.b[i][x] = q_n[x] + (1.0 - a) * h * v_n[x];
+                base.c[i][x] = -v_n[x] / h;
             }
         }
         GglCoefficients {
@@ -183,18 +122,47 @@ impl TimeRule for GeneralizedTrapezoidal {
     fn advance_ggl(&self, _state: &mut RuleState, _h: f64, _v_n: &[Vec3], _v: &[Vec3]) {}
 
     /// The step's mean acceleration (v_{n+1} - v_n)/h.
-    fn end_acceleration(
-        &self,
-        _state: &RuleState,
-        h: f64,
-        v_n: &[Vec3],
-        v: &[Vec3],
-        out: &mut [Vec3],
-    ) {
-        for i in 0..out.len() {
+    fn end_acceleration(&self, _: &RuleState, start: StepStart, v: &[Vec3], out: &mut [Vec3]) {
+        for (i, v_n) in start.v_n.iter().enumerate() {
             for k in 0..3 {
-                out[i][k] = (v[i][k] - v_n[i][k]) / h;
+                out[i][k] = (v[i][k] - v_n[k]) / start.h;
             }
         }
+    }
+}
+
+impl Index3Rule for TrapezoidalStep<'_> {
+    /// Forces and constraint gradients at (q_a, v_a, t_a).
+    const AT_END: bool = false;
+
+    #[inline(always)]
+    fn kinematics(&self, i: usize, q: &Vec3) -> (Vec3, Vec3, Vec3) {
+        let (q_n, v_n) = (&self.start.q_n[i], &self.start.v_n[i]);
+        let a = self.alpha;
+        let va: Vec3 = std::array::from_fn(|k| (q[k] - q_n[k]) * self.inv_h);
+        let v = std::array::from_fn(|k| (va[k] - (1.0 - a) * v_n[k]) * self.inv_alpha);
+        let qa = std::array::from_fn(|k| (1.0 - a) * q_n[k] + a * q[k]);
+        (v, qa, va)
+    }
+
+    /// M (v_{n+1} - v_n)/h - m g.
+    #[inline(always)]
+    fn inertia_row(&self, i: usize, _: &Vec3, v: &Vec3, inertia: f64, mass: f64, g: &Vec3) -> Vec3 {
+        let v_n = &self.start.v_n[i];
+        std::array::from_fn(|k| inertia * ((v[k] - v_n[k]) * self.inv_h) - mass * g[k])
+    }
+
+    #[inline(always)]
+    fn mass_diagonal(&self, sigma: f64, inertia: f64) -> f64 {
+        let h = self.start.h;
+        sigma * inertia / (self.alpha * h * h)
+    }
+
+    fn weights(&self, sigma: f64) -> (f64, f64, f64) {
+        (
+            -sigma * self.alpha,
+            -sigma / self.start.h,
+            -sigma * self.alpha,
+        )
     }
 }
