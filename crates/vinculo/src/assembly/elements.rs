@@ -8,21 +8,36 @@
 use super::{Block, Pattern, Slot, NONE, NO_SLOT};
 use std::ops::Range;
 
-/// Where each element's entries start in the flat per-particle and per-pair tables.
+/// Where each element's entries start in the flat per-particle and per-pair tables. When every
+/// element touches the same number of particles (a chain of distances, a line of bending nodes)
+/// the starts are multiples of it and nothing is stored; otherwise two arrays of starts.
 #[derive(Debug, Clone, Default)]
 pub struct ElementOffsets {
-    /// Element e's per-particle entries are `start[e]..start[e + 1]` (k + 1 values).
+    /// Number of elements k.
+    count: usize,
+    /// The particle count shared by every element, if it is shared.
+    uniform: Option<usize>,
+    /// Otherwise: element e's per-particle entries are `start[e]..start[e + 1]` (k + 1 values).
     start: Vec<usize>,
-    /// Element e's per-pair entries are `pair_start[e]..pair_start[e + 1]` (k + 1 values).
+    /// Otherwise: element e's per-pair entries are `pair_start[e]..pair_start[e + 1]`.
     pair_start: Vec<usize>,
 }
 
 impl ElementOffsets {
     /// The offsets of elements touching the given particles, in order.
-    pub fn new<'a>(elements: impl Iterator<Item = &'a [usize]>) -> ElementOffsets {
-        let (lower, _) = elements.size_hint();
-        let mut start = Vec::with_capacity(lower + 1);
-        let mut pair_start = Vec::with_capacity(lower + 1);
+    pub fn new<'a>(elements: impl Iterator<Item = &'a [usize]> + Clone) -> ElementOffsets {
+        let count = elements.clone().count();
+        let first = elements.clone().next().map_or(0, |p| p.len());
+        if elements.clone().all(|p| p.len() == first) {
+            return ElementOffsets {
+                count,
+                uniform: Some(first),
+                start: Vec::new(),
+                pair_start: Vec::new(),
+            };
+        }
+        let mut start = Vec::with_capacity(count + 1);
+        let mut pair_start = Vec::with_capacity(count + 1);
         start.push(0);
         pair_start.push(0);
         let (mut s, mut p) = (0, 0);
@@ -32,44 +47,67 @@ impl ElementOffsets {
             start.push(s);
             pair_start.push(p);
         }
-        ElementOffsets { start, pair_start }
+        ElementOffsets {
+            count,
+            uniform: None,
+            start,
+            pair_start,
+        }
     }
 
     /// Number of elements.
     pub fn len(&self) -> usize {
-        self.start.len() - 1
+        self.count
     }
 
     /// True when there is no element.
     pub fn is_empty(&self) -> bool {
-        self.len() == 0
+        self.count == 0
+    }
+
+    /// Start of element e's entries in a per-particle table (e may be k: the table's length).
+    #[inline(always)]
+    fn start(&self, e: usize) -> usize {
+        match self.uniform {
+            Some(n) => e * n,
+            None => self.start[e],
+        }
+    }
+
+    /// Start of element e's entries in a per-pair table (e may be k: the table's length).
+    #[inline(always)]
+    fn pair_start(&self, e: usize) -> usize {
+        match self.uniform {
+            Some(n) => e * n * n,
+            None => self.pair_start[e],
+        }
     }
 
     /// Element e's entries in a per-particle table.
     #[inline(always)]
     pub fn particles(&self, e: usize) -> Range<usize> {
-        self.start[e]..self.start[e + 1]
+        self.start(e)..self.start(e + 1)
     }
 
     /// Element e's entries in a per-pair table.
     #[inline(always)]
     pub fn pairs(&self, e: usize) -> Range<usize> {
-        self.pair_start[e]..self.pair_start[e + 1]
+        self.pair_start(e)..self.pair_start(e + 1)
     }
 
     /// Length of a per-particle table (the sum of the elements' particle counts).
     pub fn particle_entries(&self) -> usize {
-        self.start[self.len()]
+        self.start(self.count)
     }
 
     /// Length of a per-pair table (the sum of the squares of the elements' particle counts).
     pub fn pair_entries(&self) -> usize {
-        self.pair_start[self.len()]
+        self.pair_start(self.count)
     }
 
     /// The per-particle entries of elements `first..last` (contiguous).
     pub fn particles_of(&self, elements: Range<usize>) -> Range<usize> {
-        self.start[elements.start]..self.start[elements.end]
+        self.start(elements.start)..self.start(elements.end)
     }
 }
 
@@ -152,5 +190,23 @@ mod tests {
         assert_eq!(o.particle_entries(), 6);
         assert_eq!(o.pair_entries(), 14);
         assert_eq!(o.particles_of(1..3), 2..6);
+    }
+
+    /// Elements of one size store no starts, and give the same ranges as the general case
+    /// would: element e of n particles starts at e n (particles) and e n^2 (pairs).
+    #[test]
+    fn offsets_of_elements_of_one_size_are_multiples() {
+        let parts: [&[usize]; 3] = [&[0, 1, 2], &[1, 2, 3], &[2, 3, 4]];
+        let o = ElementOffsets::new(parts.iter().copied());
+        assert!(o.start.is_empty() && o.pair_start.is_empty());
+        assert_eq!(o.particles(1), 3..6);
+        assert_eq!(o.pairs(2), 18..27);
+        assert_eq!((o.particle_entries(), o.pair_entries()), (9, 27));
+        assert_eq!(o.particles_of(1..3), 3..9);
+        let none = ElementOffsets::new(std::iter::empty::<&[usize]>());
+        assert_eq!(
+            (none.len(), none.particle_entries(), none.pair_entries()),
+            (0, 0, 0)
+        );
     }
 }
