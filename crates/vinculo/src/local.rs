@@ -77,12 +77,17 @@ impl From<PerParticle> for Rows {
 }
 
 /// One 3x3 block per ordered pair (x, y) of an element's touched particles: `b[x][y]` is the
-/// block of particle x's rows and particle y's columns.
+/// block of particle x's rows and particle y's columns. Up to [`INLINE`] particles the blocks
+/// live in a fixed array (no allocation, and the compiler sees them as one), beyond it on the
+/// heap.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Blocks {
     n: usize,
-    data: SmallVec<[Mat3; INLINE * INLINE]>,
+    inline: [Mat3; INLINE * INLINE],
+    heap: Vec<Mat3>,
 }
+
+const ZERO: Mat3 = [[0.0; 3]; 3];
 
 impl Blocks {
     /// n x n zero blocks (for an element over n particles).
@@ -90,20 +95,33 @@ impl Blocks {
     pub fn zeros(n: usize) -> Blocks {
         Blocks {
             n,
-            data: SmallVec::from_elem([[0.0; 3]; 3], n * n),
+            inline: [ZERO; INLINE * INLINE],
+            heap: if n > INLINE {
+                vec![ZERO; n * n]
+            } else {
+                Vec::new()
+            },
         }
     }
 
     /// The blocks in one slice, x-major: block (x, y) is entry x n + y.
     #[inline(always)]
     pub fn as_slice(&self) -> &[Mat3] {
-        &self.data
+        if self.n <= INLINE {
+            &self.inline[..self.n * self.n]
+        } else {
+            &self.heap
+        }
     }
 
     /// The blocks in one mutable slice, x-major.
     #[inline(always)]
     pub fn as_mut_slice(&mut self) -> &mut [Mat3] {
-        &mut self.data
+        if self.n <= INLINE {
+            &mut self.inline[..self.n * self.n]
+        } else {
+            &mut self.heap
+        }
     }
 
     /// Number of touched particles n.
@@ -115,21 +133,19 @@ impl Blocks {
     /// Sets every block to zero, keeping n (reuse between elements of the same size).
     #[inline]
     pub fn clear(&mut self) {
-        for b in self.data.iter_mut() {
-            *b = [[0.0; 3]; 3];
-        }
+        self.as_mut_slice().fill(ZERO);
     }
 
     /// Makes these n x n zero blocks, reusing the storage (the assembler keeps one buffer for
     /// all its elements).
     #[inline]
     pub fn reset(&mut self, n: usize) {
-        if n == self.n {
-            self.clear();
+        self.n = n;
+        if n > INLINE {
+            self.heap.clear();
+            self.heap.resize(n * n, ZERO);
         } else {
-            self.n = n;
-            self.data.clear();
-            self.data.resize(n * n, [[0.0; 3]; 3]);
+            self.clear();
         }
     }
 }
@@ -139,14 +155,15 @@ impl std::ops::Index<usize> for Blocks {
     /// The row of blocks of particle x: `self[x][y]` is block (x, y).
     #[inline(always)]
     fn index(&self, x: usize) -> &[Mat3] {
-        &self.data[x * self.n..(x + 1) * self.n]
+        &self.as_slice()[x * self.n..(x + 1) * self.n]
     }
 }
 
 impl std::ops::IndexMut<usize> for Blocks {
     #[inline(always)]
     fn index_mut(&mut self, x: usize) -> &mut [Mat3] {
-        &mut self.data[x * self.n..(x + 1) * self.n]
+        let n = self.n;
+        &mut self.as_mut_slice()[x * n..(x + 1) * n]
     }
 }
 

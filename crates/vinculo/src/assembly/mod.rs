@@ -237,20 +237,77 @@ impl Layout {
         add: impl Fn(&mut V, Slot, f64),
     ) {
         let blocks = &self.constraint_hessian[self.constraint_offsets.pairs(c)];
-        for (b, m) in blocks.iter().zip(hess.as_slice()) {
-            add_block(values, b, m);
-        }
         let range = self.constraint_offsets.particles(c);
-        let columns = &self.constraint_column[range.clone()];
-        let rows = &self.constraint_row[range];
-        for (x, (column, row)) in columns.iter().zip(rows).enumerate() {
-            for k in 0..3 {
-                add(values, column[k], -s * grad_column[x][k]);
-                add(values, row[k], s * grad_row[x][k]);
+        let strips = (
+            &self.constraint_column[range.clone()],
+            &self.constraint_row[range],
+        );
+        let grads = (grad_column, grad_row);
+        // Most constraints are distances: their two particles get loops of fixed length.
+        match two_particles(blocks, hess.as_slice(), strips, grads) {
+            Some((blocks, hess, (columns, rows), (gc, gr))) => {
+                let (strips, grads) = ((&columns[..], &rows[..]), (&gc[..], &gr[..]));
+                place_constraint(values, (blocks, hess), s, strips, grads, &add_block, &add)
+            }
+            None => {
+                let blocks = (blocks, hess.as_slice());
+                place_constraint(values, blocks, s, strips, grads, &add_block, &add)
             }
         }
     }
+}
 
+/// A constraint's column and row slots, per touched particle.
+type Strips<'a> = (&'a [[Slot; 3]], &'a [[Slot; 3]]);
+/// A constraint's two gradients (for its column and its row), per touched particle.
+type Grads<'a> = (&'a [crate::math::Vec3], &'a [crate::math::Vec3]);
+
+/// The local tables of a two-particle element as arrays (their lengths known to the compiler),
+/// or None for another size.
+#[inline(always)]
+#[allow(clippy::type_complexity)]
+fn two_particles<'a>(
+    blocks: &'a [Block],
+    hess: &'a [crate::math::Mat3],
+    (columns, rows): Strips<'a>,
+    (grad_column, grad_row): Grads<'a>,
+) -> Option<(
+    &'a [Block; 4],
+    &'a [crate::math::Mat3; 4],
+    (&'a [[Slot; 3]; 2], &'a [[Slot; 3]; 2]),
+    (&'a [crate::math::Vec3; 2], &'a [crate::math::Vec3; 2]),
+)> {
+    Some((
+        blocks.try_into().ok()?,
+        hess.try_into().ok()?,
+        (columns.try_into().ok()?, rows.try_into().ok()?),
+        (grad_column.try_into().ok()?, grad_row.try_into().ok()?),
+    ))
+}
+
+/// The placement of [`Layout::add_constraint_blocks`] on an element's tables.
+#[inline(always)]
+fn place_constraint<V: ?Sized>(
+    values: &mut V,
+    (blocks, hess): (&[Block], &[crate::math::Mat3]),
+    s: f64,
+    (columns, rows): Strips<'_>,
+    (grad_column, grad_row): Grads<'_>,
+    add_block: &impl Fn(&mut V, &Block, &crate::math::Mat3),
+    add: &impl Fn(&mut V, Slot, f64),
+) {
+    for (b, m) in blocks.iter().zip(hess) {
+        add_block(values, b, m);
+    }
+    for (x, (column, row)) in columns.iter().zip(rows).enumerate() {
+        for k in 0..3 {
+            add(values, column[k], -s * grad_column[x][k]);
+            add(values, row[k], s * grad_row[x][k]);
+        }
+    }
+}
+
+impl Layout {
     /// Adds `m` to the three diagonal entries of particle `i`'s block (nothing for a fixed
     /// particle): the mass term of the iteration matrix.
     #[inline]
@@ -313,7 +370,7 @@ pub trait InertiaRows: Sync {
 }
 
 /// Adds `value` at `slot` unless the slot is absent.
-#[inline]
+#[inline(always)]
 pub fn add(values: &mut [f64], slot: Slot, value: f64) {
     if slot != NO_SLOT {
         values[slot as usize] += value;
@@ -341,7 +398,7 @@ pub fn add_force_blocks(
 }
 
 /// Adds the 3x3 matrix `m` (scaled by `s`) into the block `b`.
-#[inline]
+#[inline(always)]
 pub fn add_block(values: &mut [f64], b: &Block, s: f64, m: &crate::math::Mat3) {
     if b[0] == NO_SLOT {
         return;

@@ -52,11 +52,12 @@ impl Distance {
     #[inline]
     pub(crate) fn add_hessian(&self, _q: &[Vec3], _t: f64, w: f64, out: &mut Hessian) {
         // Blocks (i, i), (i, j), (j, i), (j, j): -2 w I, 2 w I, 2 w I, -2 w I.
-        for (k, block) in out.as_mut_slice().iter_mut().enumerate() {
-            let s = if k == 0 || k == 3 { -2.0 * w } else { 2.0 * w };
-            for r in 0..3 {
-                block[r][r] += s;
-            }
+        let blocks: &mut [_; 4] = out.as_mut_slice().try_into().expect("2 x 2 blocks");
+        for r in 0..3 {
+            blocks[0][r][r] -= 2.0 * w;
+            blocks[1][r][r] += 2.0 * w;
+            blocks[2][r][r] += 2.0 * w;
+            blocks[3][r][r] -= 2.0 * w;
         }
     }
 
