@@ -33,7 +33,14 @@ fn fill_saddle(system: &System, ws: &mut StepWorkspace, q: &[Vec3], t: f64) {
         let none = crate::local::Blocks::zeros(g.len());
         let add_block = |v: &mut [f64], b: &_, m: &_| crate::assembly::add_block(v, b, 1.0, m);
         let values: &mut [f64] = values;
-        layout.add_constraint_blocks(values, (c, &none), ws.scales[c], (&g, &g), add_block, add);
+        layout.add_constraint_blocks(
+            values,
+            (c, none.as_slice()),
+            ws.scales[c],
+            (&g, &g),
+            add_block,
+            add,
+        );
     }
 }
 

@@ -197,17 +197,18 @@ impl Layout {
     pub fn add_constraint_terms<V: ?Sized>(
         &self,
         values: &mut V,
-        (c, con, hess): (
+        (c, con, buffer): (
             usize,
             &crate::constraints::Constraint,
-            &crate::local::Blocks,
+            &mut crate::local::Blocks,
         ),
         at: &JacobianTerms<'_>,
         add_block: impl Fn(&mut V, &Block, &crate::math::Mat3),
         add: impl Fn(&mut V, Slot, f64),
     ) {
         let s = at.scales[c];
-        con.with_gradient(at.q_eval, at.t_eval, |grad_eval| {
+        let w = at.hessian * at.lambda[c];
+        con.with_hessian_and_gradient((at.q_eval, at.t_eval), w, buffer, |hess, grad_eval| {
             if at.same_point() {
                 let grads = (grad_eval, grad_eval);
                 self.add_constraint_blocks(values, (c, hess), s, grads, &add_block, &add);
@@ -230,7 +231,7 @@ impl Layout {
     pub fn add_constraint_blocks<V: ?Sized>(
         &self,
         values: &mut V,
-        (c, hess): (usize, &crate::local::Blocks),
+        (c, hess): (usize, &[crate::math::Mat3]),
         s: f64,
         (grad_column, grad_row): (&[crate::math::Vec3], &[crate::math::Vec3]),
         add_block: impl Fn(&mut V, &Block, &crate::math::Mat3),
@@ -244,13 +245,13 @@ impl Layout {
         );
         let grads = (grad_column, grad_row);
         // Most constraints are distances: their two particles get loops of fixed length.
-        match two_particles(blocks, hess.as_slice(), strips, grads) {
+        match two_particles(blocks, hess, strips, grads) {
             Some((blocks, hess, (columns, rows), (gc, gr))) => {
                 let (strips, grads) = ((&columns[..], &rows[..]), (&gc[..], &gr[..]));
                 place_constraint(values, (blocks, hess), s, strips, grads, &add_block, &add)
             }
             None => {
-                let blocks = (blocks, hess.as_slice());
+                let blocks = (blocks, hess);
                 place_constraint(values, blocks, s, strips, grads, &add_block, &add)
             }
         }

@@ -437,8 +437,6 @@ impl ParallelAssembly {
                 let mut hess = Hessian::zeros(0);
                 for c in chunk * CHUNK..end {
                     let con = &constraints[c];
-                    hess.reset(con.particles().len());
-                    con.add_hessian(at.q_eval, at.t_eval, at.hessian * at.lambda[c], &mut hess);
                     // SAFETY (both): the Hessian blocks and the column entries are in rows of
                     // this chunk's free particles, which no other chunk of this colour touches;
                     // the row entries are in this constraint's own row (see `SharedValues`).
@@ -447,7 +445,13 @@ impl ParallelAssembly {
                     };
                     let add = |v: &mut &SharedValues, slot, x| unsafe { v.add(slot, x) };
                     let mut target = shared;
-                    layout.add_constraint_terms(&mut target, (c, con, &hess), at, add_block, add);
+                    layout.add_constraint_terms(
+                        &mut target,
+                        (c, con, &mut hess),
+                        at,
+                        add_block,
+                        add,
+                    );
                 }
             });
         }

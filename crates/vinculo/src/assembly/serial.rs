@@ -86,10 +86,8 @@ impl Layout {
         }
         let mut hess = Hessian::zeros(0);
         for (c, con) in system.constraints().iter().enumerate() {
-            hess.reset(con.particles().len());
-            con.add_hessian(at.q_eval, at.t_eval, at.hessian * at.lambda[c], &mut hess);
             let add_block = |v: &mut [f64], b: &Block, m: &Mat3| super::add_block(v, b, 1.0, m);
-            self.add_constraint_terms(values, (c, con, &hess), at, add_block, super::add);
+            self.add_constraint_terms(values, (c, con, &mut hess), at, add_block, super::add);
         }
     }
 

@@ -12,7 +12,7 @@
 //! tension of the link is 2 lambda L.
 
 use super::Hessian;
-use crate::math::{dot, sub, Vec3};
+use crate::math::{diag, dot, sub, Mat3, Vec3};
 
 /// |q_i - q_j| = L.
 #[derive(Debug, Clone, PartialEq)]
@@ -51,14 +51,18 @@ impl Distance {
 
     #[inline]
     pub(crate) fn add_hessian(&self, _q: &[Vec3], _t: f64, w: f64, out: &mut Hessian) {
-        // Blocks (i, i), (i, j), (j, i), (j, j): -2 w I, 2 w I, 2 w I, -2 w I.
-        let blocks: &mut [_; 4] = out.as_mut_slice().try_into().expect("2 x 2 blocks");
-        for r in 0..3 {
-            blocks[0][r][r] -= 2.0 * w;
-            blocks[1][r][r] += 2.0 * w;
-            blocks[2][r][r] += 2.0 * w;
-            blocks[3][r][r] -= 2.0 * w;
+        for (o, h) in out.as_mut_slice().iter_mut().zip(self.hessian(w)) {
+            for r in 0..3 {
+                o[r][r] += h[r][r];
+            }
         }
+    }
+
+    /// `w` times the Hessian blocks (i, i), (i, j), (j, i), (j, j): -2 w I, 2 w I, 2 w I, -2 w I.
+    #[inline(always)]
+    pub(crate) fn hessian(&self, w: f64) -> [Mat3; 4] {
+        let (same, other) = (diag(-2.0 * w), diag(2.0 * w));
+        [same, other, other, same]
     }
 
     pub(crate) fn phi_t(&self, _q: &[Vec3], _t: f64) -> f64 {

@@ -104,6 +104,27 @@ impl Constraint {
         use_it(&self.gradient_rows(q, t))
     }
 
+    /// Calls `use_it(hessian, gradient)` with `w` times d2Phi/dq2 (n x n blocks, x-major) and
+    /// dPhi/dq at (q, t): the Jacobian's constraint terms in one dispatch. A distance hands
+    /// both over from the stack; the other kinds fill `buffer` with their Hessian.
+    #[inline(always)]
+    pub fn with_hessian_and_gradient<R>(
+        &self,
+        (q, t): (&[Vec3], f64),
+        w: f64,
+        buffer: &mut Hessian,
+        use_it: impl FnOnce(&[crate::math::Mat3], &[Vec3]) -> R,
+    ) -> R {
+        match self {
+            Constraint::Distance(c) => use_it(&c.hessian(w), &c.gradient(q, t)),
+            other => {
+                buffer.reset(other.particles().len());
+                other.add_hessian(q, t, w, buffer);
+                use_it(buffer.as_slice(), &other.gradient_rows(q, t))
+            }
+        }
+    }
+
     /// Adds `w` times the Hessian d2Phi/dq2 to `out`.
     #[inline(always)]
     pub fn add_hessian(&self, q: &[Vec3], t: f64, w: f64, out: &mut Hessian) {
