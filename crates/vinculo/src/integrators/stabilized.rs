@@ -393,13 +393,16 @@ impl NewtonProblem for StabilizedProblem<'_> {
                 add(values, layout.dynamic_v[i][4 * x], m);
             }
         }
+        // One buffer of local blocks for all elements, reset to each one's size.
+        let (mut dq, mut dv) = (Jacobian::zeros(0), Jacobian::zeros(0));
+        let (mut dyn_hess, mut hess) = (Hessian::zeros(0), Hessian::zeros(0));
         for (fi, f) in system.forces().iter().enumerate() {
             if !f.has_jacobian() {
                 continue;
             }
             let n = f.particles().len();
-            let mut dq = Jacobian::zeros(n);
-            let mut dv = Jacobian::zeros(n);
+            dq.reset(n);
+            dv.reset(n);
             f.add_jacobian(self.q_eval, self.v_eval, point.t_eval, &mut dq, &mut dv);
             let (wq, wv) = (-point.sigma * rule.w, -point.sigma * rule.w / rule.kappa);
             let pairs = layout.force_offsets.pairs(fi);
@@ -412,10 +415,10 @@ impl NewtonProblem for StabilizedProblem<'_> {
             let parts = con.particles();
             let n = parts.len();
             let s = self.scales[c];
-            let mut dyn_hess = Hessian::zeros(n);
+            dyn_hess.reset(n);
             let w_lambda = -point.sigma * rule.w * b.lambda[c];
             con.add_hessian(self.q_eval, point.t_eval, w_lambda, &mut dyn_hess);
-            let mut hess = Hessian::zeros(n);
+            hess.reset(n);
             con.add_hessian(&b.q, point.t_end, 1.0, &mut hess);
             let grad_e = con.gradient(self.q_eval, point.t_eval);
             let grad_1 = con.gradient(&b.q, point.t_end);
