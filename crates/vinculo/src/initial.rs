@@ -11,7 +11,7 @@
 //!   `[M, -G^T; G, 0] [dq; mu] = [0; -Phi]`; then velocities in one solve of
 //!   `[M, -G^T; G, 0] [dv; mu] = [0; -(G v + Phi_t)]`.
 
-use crate::assembly::{add, Layout, NONE};
+use crate::assembly::{Layout, NONE};
 use crate::constraints::Constraint;
 use crate::error::{Error, Result};
 use crate::integrators::StepWorkspace;
@@ -31,16 +31,8 @@ fn fill_saddle(system: &System, ws: &mut StepWorkspace, q: &[Vec3], t: f64) {
         let g = con.gradient(q, t);
         // The saddle matrix has no Hessian term: zero blocks.
         let none = crate::local::Blocks::zeros(g.len());
-        let add_block = |v: &mut [f64], b: &_, m: &_| crate::assembly::add_block(v, b, 1.0, m);
         let values: &mut [f64] = values;
-        layout.add_constraint_blocks(
-            values,
-            (c, none.as_slice()),
-            ws.scales[c],
-            (&g, &g),
-            add_block,
-            add,
-        );
+        layout.add_constraint_blocks(values, (c, none.as_slice()), ws.scales[c], (&g, &g));
     }
 }
 

@@ -194,7 +194,7 @@ impl Layout {
     /// point in its multiplier's column and the gradient at the step's end in its row (one
     /// evaluation when the two points are the same), as [`Layout::add_constraint_blocks`].
     #[inline(always)]
-    pub fn add_constraint_terms<V: ?Sized>(
+    pub fn add_constraint_terms<V: Entries + ?Sized>(
         &self,
         values: &mut V,
         (c, con, buffer): (
@@ -203,19 +203,17 @@ impl Layout {
             &mut crate::local::Blocks,
         ),
         at: &JacobianTerms<'_>,
-        add_block: impl Fn(&mut V, &Block, &crate::math::Mat3),
-        add: impl Fn(&mut V, Slot, f64),
     ) {
         let s = at.scales[c];
         let w = at.hessian * at.lambda[c];
         con.with_hessian_and_gradient((at.q_eval, at.t_eval), w, buffer, |hess, grad_eval| {
             if at.same_point() {
                 let grads = (grad_eval, grad_eval);
-                self.add_constraint_blocks(values, (c, hess), s, grads, &add_block, &add);
+                self.add_constraint_blocks(values, (c, hess), s, grads);
             } else {
                 con.with_gradient(at.q_end, at.t_end, |grad_end| {
                     let grads = (grad_eval, grad_end);
-                    self.add_constraint_blocks(values, (c, hess), s, grads, &add_block, &add);
+                    self.add_constraint_blocks(values, (c, hess), s, grads);
                 });
             }
         });
@@ -228,14 +226,12 @@ impl Layout {
     /// nothing at an absent one). The schemes differ only in where they evaluate the two
     /// gradients and the Hessian.
     #[inline(always)]
-    pub fn add_constraint_blocks<V: ?Sized>(
+    pub fn add_constraint_blocks<V: Entries + ?Sized>(
         &self,
         values: &mut V,
         (c, hess): (usize, &[crate::math::Mat3]),
         s: f64,
         (grad_column, grad_row): (&[crate::math::Vec3], &[crate::math::Vec3]),
-        add_block: impl Fn(&mut V, &Block, &crate::math::Mat3),
-        add: impl Fn(&mut V, Slot, f64),
     ) {
         let blocks = &self.constraint_hessian[self.constraint_offsets.pairs(c)];
         let range = self.constraint_offsets.particles(c);
@@ -248,11 +244,11 @@ impl Layout {
         match two_particles(blocks, hess, strips, grads) {
             Some((blocks, hess, (columns, rows), (gc, gr))) => {
                 let (strips, grads) = ((&columns[..], &rows[..]), (&gc[..], &gr[..]));
-                place_constraint(values, (blocks, hess), s, strips, grads, &add_block, &add)
+                place_constraint(values, (blocks, hess), s, strips, grads)
             }
             None => {
                 let blocks = (blocks, hess);
-                place_constraint(values, blocks, s, strips, grads, &add_block, &add)
+                place_constraint(values, blocks, s, strips, grads)
             }
         }
     }
@@ -288,22 +284,20 @@ fn two_particles<'a>(
 
 /// The placement of [`Layout::add_constraint_blocks`] on an element's tables.
 #[inline(always)]
-fn place_constraint<V: ?Sized>(
+fn place_constraint<V: Entries + ?Sized>(
     values: &mut V,
     (blocks, hess): (&[Block], &[crate::math::Mat3]),
     s: f64,
     (columns, rows): Strips<'_>,
     (grad_column, grad_row): Grads<'_>,
-    add_block: &impl Fn(&mut V, &Block, &crate::math::Mat3),
-    add: &impl Fn(&mut V, Slot, f64),
 ) {
     for (b, m) in blocks.iter().zip(hess) {
-        add_block(values, b, m);
+        values.add_block(b, m);
     }
     for (x, (column, row)) in columns.iter().zip(rows).enumerate() {
         for k in 0..3 {
-            add(values, column[k], -s * grad_column[x][k]);
-            add(values, row[k], s * grad_row[x][k]);
+            values.add(column[k], -s * grad_column[x][k]);
+            values.add(row[k], s * grad_row[x][k]);
         }
     }
 }
@@ -368,6 +362,26 @@ pub fn number_particles(system: &System) -> (Vec<usize>, usize) {
 pub trait InertiaRows: Sync {
     /// The three rows of particle `i`.
     fn rows(&self, i: usize) -> crate::math::Vec3;
+}
+
+/// Where assembled entries of the iteration matrix are added: the value array itself (one
+/// thread), or a value array shared by the tasks of the parallel assembly (`parallel.rs`).
+pub trait Entries {
+    /// Adds `value` at `slot` unless the slot is absent.
+    fn add(&mut self, slot: Slot, value: f64);
+    /// Adds the 3x3 matrix `m` into the block `b` unless it is absent.
+    fn add_block(&mut self, b: &Block, m: &crate::math::Mat3);
+}
+
+impl Entries for [f64] {
+    #[inline(always)]
+    fn add(&mut self, slot: Slot, value: f64) {
+        add(self, slot, value)
+    }
+    #[inline(always)]
+    fn add_block(&mut self, b: &Block, m: &crate::math::Mat3) {
+        add_block(self, b, 1.0, m)
+    }
 }
 
 /// Adds `value` at `slot` unless the slot is absent.

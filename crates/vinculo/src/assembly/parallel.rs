@@ -21,7 +21,9 @@
 
 use rayon::prelude::*;
 
-use super::{add_force_blocks, Block, ElementOffsets, InertiaRows, Layout, Slot, NONE, NO_SLOT};
+use super::{
+    add_force_blocks, Block, ElementOffsets, Entries, InertiaRows, Layout, Slot, NONE, NO_SLOT,
+};
 use crate::constraints::Hessian;
 use crate::forces::Jacobian;
 use crate::math::{Mat3, Vec3};
@@ -184,6 +186,31 @@ impl SharedValues {
                 unsafe { self.add(b[3 * r + c], s * m[r][c]) };
             }
         }
+    }
+}
+
+/// The [`Entries`] of one task of a colour: additions into the shared value array.
+struct ChunkEntries<'a>(&'a SharedValues);
+
+impl<'a> ChunkEntries<'a> {
+    /// # Safety
+    /// The caller adds only at slots that no other task accesses concurrently (see
+    /// [`SharedValues`]): the rows of its chunk's free particles and its elements' own rows.
+    unsafe fn new(shared: &'a SharedValues) -> ChunkEntries<'a> {
+        ChunkEntries(shared)
+    }
+}
+
+impl Entries for ChunkEntries<'_> {
+    #[inline(always)]
+    fn add(&mut self, slot: Slot, value: f64) {
+        // SAFETY: the slots are this task's alone, as promised to `ChunkEntries::new`.
+        unsafe { self.0.add(slot, value) }
+    }
+    #[inline(always)]
+    fn add_block(&mut self, b: &Block, m: &Mat3) {
+        // SAFETY: as for `add`.
+        unsafe { self.0.add_block(b, 1.0, m) }
     }
 }
 
@@ -437,21 +464,11 @@ impl ParallelAssembly {
                 let mut hess = Hessian::zeros(0);
                 for c in chunk * CHUNK..end {
                     let con = &constraints[c];
-                    // SAFETY (both): the Hessian blocks and the column entries are in rows of
-                    // this chunk's free particles, which no other chunk of this colour touches;
-                    // the row entries are in this constraint's own row (see `SharedValues`).
-                    let add_block = |v: &mut &SharedValues, b: &Block, m: &Mat3| unsafe {
-                        v.add_block(b, 1.0, m)
-                    };
-                    let add = |v: &mut &SharedValues, slot, x| unsafe { v.add(slot, x) };
-                    let mut target = shared;
-                    layout.add_constraint_terms(
-                        &mut target,
-                        (c, con, &mut hess),
-                        at,
-                        add_block,
-                        add,
-                    );
+                    // SAFETY: the Hessian blocks and the column entries are in rows of this
+                    // chunk's free particles, which no other chunk of this colour touches; the
+                    // row entries are in this constraint's own row (see `SharedValues`).
+                    let mut entries = unsafe { ChunkEntries::new(shared) };
+                    layout.add_constraint_terms(&mut entries, (c, con, &mut hess), at);
                 }
             });
         }

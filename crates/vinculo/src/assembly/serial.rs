@@ -4,10 +4,10 @@
 //! residual equals this one bit for bit.
 
 use super::JacobianTerms;
-use super::{add_force_blocks, Block, InertiaRows, Layout, ResidualTerms, NONE};
+use super::{add_force_blocks, InertiaRows, Layout, ResidualTerms, NONE};
 use crate::constraints::Hessian;
 use crate::forces::Jacobian;
-use crate::math::{Mat3, Vec3};
+use crate::math::Vec3;
 use crate::model::System;
 
 impl Layout {
@@ -86,8 +86,7 @@ impl Layout {
         }
         let mut hess = Hessian::zeros(0);
         for (c, con) in system.constraints().iter().enumerate() {
-            let add_block = |v: &mut [f64], b: &Block, m: &Mat3| super::add_block(v, b, 1.0, m);
-            self.add_constraint_terms(values, (c, con, &mut hess), at, add_block, super::add);
+            self.add_constraint_terms(values, (c, con, &mut hess), at);
         }
     }
 
