@@ -219,11 +219,10 @@ impl Layout {
         });
     }
 
-    /// Adds constraint `c`'s part of the iteration matrix `values`: its Hessian-term blocks
-    /// `hess` between its touched particles (through `add_block`, which adds a 3x3 matrix into
-    /// a block), `-s grad_column` into its multiplier's column (the -Phi_q^T block) and
-    /// `s grad_row` into its row (the Phi_q block), through `add` (which adds a value at a slot,
-    /// nothing at an absent one). The schemes differ only in where they evaluate the two
+    /// Adds constraint `c`'s part of the iteration matrix `values` ([`Entries`], which skip
+    /// absent slots): its Hessian-term blocks `hess` between its touched particles,
+    /// `-s grad_column` into its multiplier's column (the -Phi_q^T block) and `s grad_row` into
+    /// its row (the Phi_q block). The schemes differ only in where they evaluate the two
     /// gradients and the Hessian.
     #[inline(always)]
     pub fn add_constraint_blocks<V: Entries + ?Sized>(
