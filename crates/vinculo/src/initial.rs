@@ -29,10 +29,9 @@ fn fill_saddle(system: &System, ws: &mut StepWorkspace, q: &[Vec3], t: f64) {
     }
     for (c, con) in system.constraints().iter().enumerate() {
         let g = con.gradient(q, t);
-        // The saddle matrix has no Hessian term: zero blocks.
-        let none = crate::local::Blocks::zeros(g.len());
+        // The saddle matrix has no Hessian term: no blocks.
         let values: &mut [f64] = values;
-        layout.add_constraint_blocks(values, (c, none.as_slice()), ws.scales[c], (&g, &g));
+        layout.add_constraint_blocks(values, (c, &[]), ws.scales[c], (&g, &g));
     }
 }
 

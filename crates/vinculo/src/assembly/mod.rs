@@ -189,6 +189,32 @@ impl Layout {
 }
 
 impl Layout {
+    /// Adds force `fi` (`f`)'s Jacobian, weighted by the terms' `force_dq` and `force_dv`, to
+    /// `values` (nothing for a force without one); `dq` and `dv` are reusable block buffers.
+    #[inline(always)]
+    pub fn add_force_terms<V: Entries + ?Sized>(
+        &self,
+        values: &mut V,
+        (fi, f): (usize, &crate::forces::Force),
+        (dq, dv): (&mut crate::local::Blocks, &mut crate::local::Blocks),
+        at: &JacobianTerms<'_>,
+    ) {
+        if !f.has_jacobian() {
+            return;
+        }
+        let n = f.particles().len();
+        dq.reset(n);
+        dv.reset(n);
+        f.add_jacobian(at.q_eval, at.v_eval, at.t_eval, dq, dv);
+        let blocks = &self.force_block[self.force_offsets.pairs(fi)];
+        add_force_blocks(
+            values,
+            (blocks, blocks),
+            (at.force_dq, dq),
+            (at.force_dv, dv),
+        );
+    }
+
     /// Adds constraint `c` (`con`)'s part of the iteration matrix `values` at the Jacobian's
     /// evaluation points `at`: its Hessian-term blocks `hess`, the gradient at the evaluation
     /// point in its multiplier's column and the gradient at the step's end in its row (one
@@ -291,7 +317,7 @@ fn place_constraint<V: Entries + ?Sized>(
     (grad_column, grad_row): Grads<'_>,
 ) {
     for (b, m) in blocks.iter().zip(hess) {
-        values.add_block(b, m);
+        values.add_block(b, 1.0, m);
     }
     for (x, (column, row)) in columns.iter().zip(rows).enumerate() {
         for k in 0..3 {
@@ -368,8 +394,8 @@ pub trait InertiaRows: Sync {
 pub trait Entries {
     /// Adds `value` at `slot` unless the slot is absent.
     fn add(&mut self, slot: Slot, value: f64);
-    /// Adds the 3x3 matrix `m` into the block `b` unless it is absent.
-    fn add_block(&mut self, b: &Block, m: &crate::math::Mat3);
+    /// Adds the 3x3 matrix `m`, scaled by `s`, into the block `b` unless it is absent.
+    fn add_block(&mut self, b: &Block, s: f64, m: &crate::math::Mat3);
 }
 
 impl Entries for [f64] {
@@ -378,8 +404,8 @@ impl Entries for [f64] {
         add(self, slot, value)
     }
     #[inline(always)]
-    fn add_block(&mut self, b: &Block, m: &crate::math::Mat3) {
-        add_block(self, b, 1.0, m)
+    fn add_block(&mut self, b: &Block, s: f64, m: &crate::math::Mat3) {
+        add_block(self, b, s, m)
     }
 }
 
@@ -391,23 +417,21 @@ pub fn add(values: &mut [f64], slot: Slot, value: f64) {
     }
 }
 
-/// Places a force's local Jacobians: `dq[x][y]` weighted by `wq` into block x n + y of
-/// `blocks_q` and `dv[x][y]` weighted by `wv` into that of `blocks_v`, for its n particles,
-/// through `add` (which adds a weighted 3x3 matrix into a block). The index-3 layout has one
-/// block per pair (`blocks_q` and `blocks_v` the same), the GGL layout one in the position and
-/// one in the velocity columns.
-#[inline]
-pub fn add_force_blocks(
-    blocks_q: &[Block],
-    blocks_v: &[Block],
+/// Places a force's local Jacobians into `values`: `dq[x][y]` weighted by `wq` into block
+/// x n + y of `blocks_q` and `dv[x][y]` weighted by `wv` into that of `blocks_v`, for its n
+/// particles. The index-3 layout has one block per pair (`blocks_q` and `blocks_v` the same),
+/// the GGL layout one in the position and one in the velocity columns.
+#[inline(always)]
+pub fn add_force_blocks<V: Entries + ?Sized>(
+    values: &mut V,
+    (blocks_q, blocks_v): (&[Block], &[Block]),
     (wq, dq): (f64, &crate::forces::Jacobian),
     (wv, dv): (f64, &crate::forces::Jacobian),
-    mut add: impl FnMut(&Block, f64, &crate::math::Mat3),
 ) {
     let pairs = blocks_q.iter().zip(blocks_v);
     for ((bq, bv), (mq, mv)) in pairs.zip(dq.as_slice().iter().zip(dv.as_slice())) {
-        add(bq, wq, mq);
-        add(bv, wv, mv);
+        values.add_block(bq, wq, mq);
+        values.add_block(bv, wv, mv);
     }
 }
 

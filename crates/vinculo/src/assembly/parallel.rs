@@ -21,9 +21,7 @@
 
 use rayon::prelude::*;
 
-use super::{
-    add_force_blocks, Block, ElementOffsets, Entries, InertiaRows, Layout, Slot, NONE, NO_SLOT,
-};
+use super::{Block, ElementOffsets, Entries, InertiaRows, Layout, Slot, NONE, NO_SLOT};
 use crate::constraints::Hessian;
 use crate::forces::Jacobian;
 use crate::math::{Mat3, Vec3};
@@ -208,9 +206,9 @@ impl Entries for ChunkEntries<'_> {
         unsafe { self.0.add(slot, value) }
     }
     #[inline(always)]
-    fn add_block(&mut self, b: &Block, m: &Mat3) {
+    fn add_block(&mut self, b: &Block, s: f64, m: &Mat3) {
         // SAFETY: as for `add`.
-        unsafe { self.0.add_block(b, 1.0, m) }
+        unsafe { self.0.add_block(b, s, m) }
     }
 }
 
@@ -436,22 +434,11 @@ impl ParallelAssembly {
             group.par_iter().for_each(|&chunk| {
                 let end = (chunk * CHUNK + CHUNK).min(forces.len());
                 let (mut dq, mut dv) = (Jacobian::zeros(0), Jacobian::zeros(0));
+                // SAFETY: the blocks of this chunk's forces are in rows of its free particles,
+                // which no other chunk of this colour touches (see `SharedValues`).
+                let mut entries = unsafe { ChunkEntries::new(shared) };
                 for (fi, f) in forces.iter().enumerate().take(end).skip(chunk * CHUNK) {
-                    if !f.has_jacobian() {
-                        continue;
-                    }
-                    let n = f.particles().len();
-                    dq.reset(n);
-                    dv.reset(n);
-                    f.add_jacobian(at.q_eval, at.v_eval, at.t_eval, &mut dq, &mut dv);
-                    let blocks = &layout.force_block[layout.force_offsets.pairs(fi)];
-                    let (wq, wv) = ((at.force_dq, &dq), (at.force_dv, &dv));
-                    add_force_blocks(blocks, blocks, wq, wv, |b, s, m| {
-                        // SAFETY: the blocks of this force, in rows of this chunk's free
-                        // particles, which no other chunk of this colour touches (see
-                        // `SharedValues`).
-                        unsafe { shared.add_block(b, s, m) }
-                    });
+                    layout.add_force_terms(&mut entries, (fi, f), (&mut dq, &mut dv), at);
                 }
             });
         }

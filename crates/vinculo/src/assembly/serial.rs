@@ -4,7 +4,7 @@
 //! residual equals this one bit for bit.
 
 use super::JacobianTerms;
-use super::{add_force_blocks, InertiaRows, Layout, ResidualTerms, NONE};
+use super::{InertiaRows, Layout, ResidualTerms, NONE};
 use crate::constraints::Hessian;
 use crate::forces::Jacobian;
 use crate::math::Vec3;
@@ -68,21 +68,7 @@ impl Layout {
         // One buffer of local blocks for all elements, reset to each one's size.
         let (mut dq, mut dv) = (Jacobian::zeros(0), Jacobian::zeros(0));
         for (fi, f) in system.forces().iter().enumerate() {
-            if !f.has_jacobian() {
-                continue;
-            }
-            let n = f.particles().len();
-            dq.reset(n);
-            dv.reset(n);
-            f.add_jacobian(at.q_eval, at.v_eval, at.t_eval, &mut dq, &mut dv);
-            let blocks = &self.force_block[self.force_offsets.pairs(fi)];
-            add_force_blocks(
-                blocks,
-                blocks,
-                (at.force_dq, &dq),
-                (at.force_dv, &dv),
-                |b, s, m| super::add_block(values, b, s, m),
-            );
+            self.add_force_terms(values, (fi, f), (&mut dq, &mut dv), at);
         }
         let mut hess = Hessian::zeros(0);
         for (c, con) in system.constraints().iter().enumerate() {

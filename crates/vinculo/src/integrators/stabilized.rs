@@ -407,9 +407,7 @@ impl NewtonProblem for StabilizedProblem<'_> {
             let (wq, wv) = (-point.sigma * rule.w, -point.sigma * rule.w / rule.kappa);
             let pairs = layout.force_offsets.pairs(fi);
             let (blocks_q, blocks_v) = (&layout.force_q[pairs.clone()], &layout.force_v[pairs]);
-            add_force_blocks(blocks_q, blocks_v, (wq, &dq), (wv, &dv), |b, s, m| {
-                add_block(values, b, s, m)
-            });
+            add_force_blocks(values, (blocks_q, blocks_v), (wq, &dq), (wv, &dv));
         }
         for (c, con) in system.constraints().iter().enumerate() {
             let parts = con.particles();
