@@ -490,7 +490,8 @@ class RunSettings:
                  rho_inf: float | None = None, formulation: str = "index-3",
                  adaptive: bool = False, rtol: float = 1e-6, atol: float = 1e-6,
                  h_min: float = 1e-10, h_max: float | None = None,
-                 t_eval: list[float] | None = None) -> None: ...
+                 t_eval: list[float] | None = None,
+                 max_output_bytes: float | None = None) -> None: ...
 
 class RunResult:
     """A run as the compiled core returns it (``simulate``, ``Simulation.solution``): the stored

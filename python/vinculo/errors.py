@@ -11,6 +11,10 @@ The compiled core builds them as ``cls(message, name=..., value=...)``, in one p
 (``crates/vinculo-python/src/errors.rs``): the class is chosen by the variant of the core's error,
 for an error of a call and for the error that stopped a run alike; a stopped run's exception
 carries its partial :class:`vinculo.Solution` as ``solution``.
+
+One class is not a :class:`VinculoError`: :class:`Interrupted`, the ``KeyboardInterrupt`` of a run
+stopped by Ctrl-C, which derives from ``KeyboardInterrupt`` (and not from ``Exception``) so that
+``except KeyboardInterrupt`` catches it and ``except Exception`` does not.
 """
 
 from __future__ import annotations
@@ -21,8 +25,11 @@ __all__ = [
     "ConvergenceError",
     "InconsistentInitialStateError",
     "InternalError",
+    "Interrupted",
     "InvalidInputError",
     "NegativeTensionError",
+    "OutputTooLargeError",
+    "ReentrantRunError",
     "RedundantConstraintsError",
     "SchedulerError",
     "StepSizeTooSmallError",
@@ -36,21 +43,17 @@ __all__ = [
 _RESERVED = frozenset({"args", "message", "details", "with_traceback", "add_note", "__notes__"})
 
 
-def _rebuild(cls: type[VinculoError], message: str, details: dict[str, Any]) -> VinculoError:
+def _rebuild(cls: type[_Detailed], message: str, details: dict[str, Any]) -> _Detailed:
     """Recreate an exception from its message and details (used by pickle)."""
     return cls(message, **details)
 
 
-class VinculoError(Exception):
-    """Root of every exception vinculo raises.
+class _Detailed:
+    """The message and details of vinculo's exceptions (shared by :class:`VinculoError` and
+    :class:`Interrupted`, which have different built-in bases)."""
 
-    Raised directly only for conditions no subclass describes; catch it to handle any vinculo error.
-
-    Arguments:
-        message: what went wrong, with the offending value, and what to do about it.
-        **details: machine-readable facts about the error (for example ``name`` and ``value`` of a
-            bad argument); each is stored as an attribute and in :attr:`details`.
-    """
+    message: str
+    details: dict[str, Any]
 
     def __init__(self, message: str = "", **details: Any) -> None:
         super().__init__(message)
@@ -70,6 +73,46 @@ class VinculoError(Exception):
 
     def __reduce__(self) -> tuple[Any, ...]:
         return (_rebuild, (type(self), self.message, self.details))
+
+
+class VinculoError(_Detailed, Exception):
+    """Root of every exception vinculo raises (but :class:`Interrupted`, a ``KeyboardInterrupt``).
+
+    Raised directly only for conditions no subclass describes; catch it to handle any vinculo error.
+
+    Arguments:
+        message: what went wrong, with the offending value, and what to do about it.
+        **details: machine-readable facts about the error (for example ``name`` and ``value`` of a
+            bad argument); each is stored as an attribute and in :attr:`details`.
+    """
+
+
+class Interrupted(_Detailed, KeyboardInterrupt):
+    """A run stopped by Ctrl-C (SIGINT), with everything it computed.
+
+    Raised by :func:`vinculo.simulate` and ``Simulation.step_to`` wherever the interrupt lands:
+    in the core's steps (which look for it about ten times a second), in the progress callback,
+    or inside a user function (a force or constraint group's function, a law's callable). It is
+    a ``KeyboardInterrupt``, so ``except KeyboardInterrupt`` catches it (and ``except Exception``
+    does not). ``solution`` holds every state stored before the interrupt: each one a completed,
+    converged step, so its states satisfy the constraints as in a complete run and match it up to
+    the interrupt.
+
+    Arguments:
+        message: where the run stopped.
+        **details: ``time`` (the last completed step's end, s), ``solution``; for an interrupt
+            inside a user function also ``group`` and ``call`` (as :class:`UserFunctionError`).
+
+    Attributes:
+        time: the time the run reached (s).
+        solution: the partial :class:`vinculo.Solution` (None when the run was interrupted before
+            its first state was computed).
+    """
+
+    time: float | None = None
+    group: str | None = None
+    call: str | None = None
+    solution: Any = None
 
 
 class InvalidInputError(VinculoError, ValueError):
@@ -225,6 +268,51 @@ class UserFunctionOutputError(UserFunctionError, ValueError):
     first element with NaN or infinity) and says what to return. Same attributes as
     :class:`UserFunctionError`.
     """
+
+
+class ReentrantRunError(VinculoError, RuntimeError):
+    """A user function of a running system called back into a run of the same system.
+
+    Raised by :func:`vinculo.simulate`, ``Simulation`` and the ``System`` and ``UserGroup`` methods
+    that evaluate the model's user functions, when called from inside a user function (force or
+    constraint group) of the run of that system (or of a copy of it, which shares its user groups):
+    the outer run is in the middle of a call of that group, which a second run cannot share. Run a
+    separate model (a System built anew) inside the function, or move the inner computation out of
+    it. The outer run stops with this error (its ``solution`` holds the states before).
+
+    Attributes:
+        call: what was called ("simulate", "Simulation", "project_initial_state", ...).
+        solution: the outer run's partial :class:`vinculo.Solution`, once it has stopped.
+    """
+
+    call: str | None = None
+    solution: Any = None
+
+
+class OutputTooLargeError(VinculoError, MemoryError):
+    """The stored output of a run would not fit in the memory available.
+
+    Raised by :func:`vinculo.simulate` and ``Simulation`` before a run starts when the states it
+    would store (about ``(t_end - t_start) / dt / save_every`` of them, or ``len(t_eval)``, each of
+    56 + 48 n + 8 m bytes for n particles and m constraint equations, plus 8 bytes per step for the
+    step sizes) exceed ``max_output_bytes`` (default: half the memory available, since the output
+    is copied once when it is returned), and during a run whose number of steps cannot be told
+    beforehand (error-controlled steps) when its output reaches that size: then ``solution`` holds
+    the states stored until then. Raise ``save_every``, give fewer ``t_eval`` times, shorten the
+    run, or set ``max_output_bytes`` if you know better.
+
+    Attributes:
+        estimate: the stored output's size, in bytes (the estimate before the run, what was
+            stored when it stopped during the run).
+        limit: the largest output allowed, in bytes.
+        states: the number of stored states it corresponds to.
+        solution: the partial :class:`vinculo.Solution` when the run stopped during its steps.
+    """
+
+    estimate: int | None = None
+    limit: int | None = None
+    states: int | None = None
+    solution: Any = None
 
 
 class InternalError(VinculoError):

@@ -76,6 +76,15 @@ class RunOptions:
             Hermite positions, its derivative for velocities, linear multipliers) without forcing
             the steps onto them. Default: the state after every accepted step (every
             ``save_every``-th).
+        max_output_bytes: the largest memory the stored output may take, in bytes (default:
+            a third of the memory available when the run starts, ``MemAvailable`` of
+            ``/proc/meminfo``, since the arrays grow by doubling and are copied once when
+            returned; no limit where it cannot be read). A run whose output would be larger
+            (about ``(t_end - t_start) / dt / save_every`` states, or ``len(t_eval)``, of
+            56 + 48 n + 8 m bytes each for n particles and m constraint equations, and 8 bytes
+            per step) is refused before it starts with :class:`OutputTooLargeError`; an
+            error-controlled run, whose number of steps is known only as it goes, stops with
+            that error when its output reaches the limit (``solution`` keeps what it stored).
     """
 
     scheme: str = "trapezoidal"
@@ -94,6 +103,7 @@ class RunOptions:
     h_min: float = 1e-10
     h_max: float | None = None
     t_eval: Sequence[float] | np.ndarray | None = None
+    max_output_bytes: float | None = None
 
     @classmethod
     def of(cls, caller: str, options: dict[str, Any]) -> RunOptions:

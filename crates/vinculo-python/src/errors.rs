@@ -1,7 +1,7 @@
 //! Maps core errors onto the exception classes of `vinculo.errors` (one root, `VinculoError`).
 
 use crate::user_physics::PendingError;
-use pyo3::exceptions::PyRuntimeError;
+use pyo3::exceptions::{PyException, PyKeyboardInterrupt, PyRuntimeError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use vinculo::Error;
@@ -81,6 +81,18 @@ fn details<'py>(py: Python<'py>, e: &Error) -> PyResult<Bound<'py, PyDict>> {
             d.set_item("error_norm", error)?;
         }
         Error::Interrupted { t } => d.set_item("time", t)?,
+        Error::OutputTooLarge {
+            t,
+            states,
+            bytes,
+            limit,
+            ..
+        } => {
+            d.set_item("time", t)?;
+            d.set_item("states", states.round() as u64)?;
+            d.set_item("estimate", bytes.round() as u64)?;
+            d.set_item("limit", limit.round() as u64)?;
+        }
         Error::Snapshot { what, .. } => {
             d.set_item("name", "snapshot")?;
             d.set_item("value", what)?;
@@ -123,17 +135,51 @@ fn details<'py>(py: Python<'py>, e: &Error) -> PyResult<Bound<'py, PyDict>> {
 /// details as keyword arguments, and, for a failed user function, the user's own exception (with
 /// its traceback) taken from `pending` as the cause. A run's partial solution is attached
 /// afterwards by [`with_solution`] (it is built from the run's result, which holds this exception).
+///
+/// A user function's exception that is not a failure of the function passes through instead:
+/// a `KeyboardInterrupt` (Ctrl-C landed in the function) becomes `vinculo.errors.Interrupted`
+/// (the user's exception, with its traceback, as the cause), and a `ReentrantRunError` (the
+/// function called back into its own system) or a `BaseException` that is not an `Exception`
+/// (`SystemExit`, ...) is raised as it is.
 pub fn exception(py: Python<'_>, e: &Error, pending: Option<&PendingError>) -> PyErr {
+    // The pending exception is the one a user function raised in this run; it is the cause of
+    // this error only when the error is that function's failure.
+    let cause = pending.and_then(|p| p.lock().unwrap_or_else(|p| p.into_inner()).take());
+    let (Error::UserFunction { group, call, t, .. }, Some(cause)) = (e, cause) else {
+        return match details(py, e) {
+            Ok(d) => raise(py, e.kind(), e.to_string(), d),
+            Err(err) => err,
+        };
+    };
+    let value = cause.value(py);
+    if value.is_instance_of::<PyKeyboardInterrupt>() {
+        let d = PyDict::new(py);
+        let built = d
+            .set_item("time", t)
+            .and_then(|_| d.set_item("group", group))
+            .and_then(|_| d.set_item("call", call));
+        if let Err(err) = built {
+            return err;
+        }
+        let message =
+            format!("run interrupted at t = {t:.6} s, inside {call}() of group '{group}'");
+        let err = raise(py, "Interrupted", message, d);
+        err.set_cause(py, Some(cause));
+        return err;
+    }
+    let reentrant = py
+        .import("vinculo.errors")
+        .and_then(|m| m.getattr("ReentrantRunError"))
+        .and_then(|cls| value.is_instance(&cls))
+        .unwrap_or(false);
+    if reentrant || !value.is_instance_of::<PyException>() {
+        return cause;
+    }
     let err = match details(py, e) {
         Ok(d) => raise(py, e.kind(), e.to_string(), d),
         Err(err) => return err,
     };
-    // The pending exception is the one a user function raised in this run; it is the cause of
-    // this error only when the error is that function's failure.
-    let cause = pending.and_then(|p| p.lock().unwrap_or_else(|p| p.into_inner()).take());
-    if let (Error::UserFunction { .. }, Some(cause)) = (e, cause) {
-        err.set_cause(py, Some(cause));
-    }
+    err.set_cause(py, Some(cause));
     err
 }
 
@@ -143,7 +189,8 @@ pub fn with_solution(py: Python<'_>, err: &PyErr, partial: &Bound<'_, PyAny>) ->
     let exc = err.value(py);
     exc.setattr("solution", partial)?;
     if let Ok(details) = exc.getattr("details") {
-        details.set_item("solution", partial)?;
+        // (a user's exception may have a `details` of its own that is not a dict)
+        let _ = details.set_item("solution", partial);
     }
     Ok(())
 }

@@ -3,6 +3,7 @@
 
 mod errors;
 mod laws;
+mod reentry;
 mod run;
 mod run_result;
 mod stepping;

@@ -1,30 +1,54 @@
 //! `simulate`: runs the core without the GIL, reports progress, returns numpy arrays.
 
-use crate::errors::{exception, invalid};
+use crate::errors::{exception, invalid, with_solution};
+use crate::reentry::refuse_reentry;
 use crate::run_result::PyRunResult;
 use crate::system::PySystem;
+use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
 use std::time::{Duration, Instant};
 use vinculo::integrators::{Formulation, NewtonOptions, Scheme};
 use vinculo::{simulate_with_observer, AdaptiveOptions, Observer, SimulationOptions, StepControl};
 
-/// Calls the Python progress callback and checks for Ctrl-C about twice a second.
-struct Progress {
+/// Looks for Ctrl-C (SIGINT) about ten times a second of wall time and calls the Python progress
+/// callback about twice a second; an exception of either stops the run after the step just
+/// completed (the run's status is then `Interrupted`).
+pub(crate) struct Progress {
     callback: Option<Py<PyAny>>,
-    last: Instant,
-    error: Option<PyErr>,
+    signals_checked: Instant,
+    reported: Instant,
+    /// The exception that stopped the run (a `KeyboardInterrupt`, or the callback's).
+    pub(crate) error: Option<PyErr>,
+}
+
+impl Progress {
+    /// Signals checked from now on, and `callback` (if any) called.
+    pub(crate) fn new(callback: Option<Py<PyAny>>) -> Progress {
+        Progress {
+            callback,
+            signals_checked: Instant::now(),
+            reported: Instant::now(),
+            error: None,
+        }
+    }
 }
 
 impl Observer for Progress {
     fn step(&mut self, t: f64, t_end: f64) -> bool {
-        if self.last.elapsed() < Duration::from_millis(500) {
+        let now = Instant::now();
+        if now.duration_since(self.signals_checked) < Duration::from_millis(100) {
             return true;
         }
-        self.last = Instant::now();
+        self.signals_checked = now;
+        let report = self.callback.is_some()
+            && now.duration_since(self.reported) >= Duration::from_millis(500);
+        if report {
+            self.reported = now;
+        }
         Python::attach(|py| {
             let result = py.check_signals().and_then(|_| match &self.callback {
-                Some(cb) => cb.call1(py, (t, t_end)).map(|_| ()),
-                None => Ok(()),
+                Some(cb) if report => cb.call1(py, (t, t_end)).map(|_| ()),
+                _ => Ok(()),
             });
             match result {
                 Ok(()) => true,
@@ -35,6 +59,41 @@ impl Observer for Progress {
             }
         })
     }
+}
+
+/// The exception that stopped a run from its observer, to raise: a `KeyboardInterrupt` is
+/// reported by the run's own exception (`vinculo.errors.Interrupted`, with the partial
+/// solution), any other exception (the progress callback's) is raised as it is, with the
+/// partial solution attached as its `solution` attribute and a note saying so.
+pub(crate) fn observer_failure(
+    py: Python<'_>,
+    error: Option<PyErr>,
+    result: &Bound<'_, PyRunResult>,
+) -> Option<PyErr> {
+    let e = error?;
+    if e.is_instance_of::<PyKeyboardInterrupt>(py) {
+        return None;
+    }
+    if let Some(partial) = result
+        .get()
+        .stopped_by(py)
+        .and_then(|x| x.getattr("solution").ok())
+    {
+        let _ = with_solution(py, &e, &partial);
+        let t = partial
+            .getattr("times")
+            .and_then(|times| times.call_method0("max"))
+            .and_then(|x| x.extract::<f64>())
+            .unwrap_or(f64::NAN);
+        let _ = e.value(py).call_method1(
+            "add_note",
+            (format!(
+                "vinculo: the run stopped at t = {t} s; the states it computed are in this \
+                 exception's `solution` attribute"
+            ),),
+        );
+    }
+    Some(e)
 }
 
 /// The scheme a name and its parameters select. A parameter of another scheme is refused rather
@@ -101,27 +160,25 @@ pub fn simulate<'py>(
     let options = &settings.options;
     let this = system.borrow();
     let model = &this.inner;
-    // The exception of a user function of an earlier run is no longer of interest.
     let pending = this.user_errors.clone();
+    refuse_reentry(py, &pending, "simulate")?;
+    // The exception of a user function of an earlier run is no longer of interest.
     pending.lock().unwrap_or_else(|p| p.into_inner()).take();
-    let mut observer = Progress {
-        callback: progress,
-        last: Instant::now(),
-        error: None,
-    };
+    let mut observer = Progress::new(progress);
     let result = py.detach(|| {
         std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             simulate_with_observer(model, options, &mut observer)
         }))
     });
-    if let Some(e) = observer.error.take() {
-        return Err(e);
-    }
     let sol = result
         .map_err(crate::errors::internal)?
         .map_err(|e| exception(py, &e, Some(&pending)))?;
     drop(this);
-    PyRunResult::finished(py, sol, &pending, system.as_any())
+    let result = PyRunResult::finished(py, sol, &pending, system.as_any())?;
+    match observer_failure(py, observer.error.take(), &result) {
+        Some(e) => Err(e),
+        None => Ok(result),
+    }
 }
 
 /// The settings of a run (the keyword arguments of `vinculo.simulate`, less `progress`), converted
@@ -138,7 +195,7 @@ impl PyRunSettings {
                         max_halvings=4, initial_tolerance=1e-8, save_every=1,
                         jacobian_reuse=false, scheme="trapezoidal", rho_inf=None,
                         formulation="index-3", adaptive=false, rtol=1e-6, atol=1e-6, h_min=1e-10,
-                        h_max=None, t_eval=None))]
+                        h_max=None, t_eval=None, max_output_bytes=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         t_end: f64,
@@ -160,6 +217,7 @@ impl PyRunSettings {
         h_min: f64,
         h_max: Option<f64>,
         t_eval: Option<Vec<f64>>,
+        max_output_bytes: Option<f64>,
     ) -> PyResult<Self> {
         let count = |name: &str, v: i64, min: i64| -> PyResult<usize> {
             if v < min {
@@ -194,6 +252,7 @@ impl PyRunSettings {
                 StepControl::Fixed
             },
             output_times: t_eval,
+            max_output_bytes,
             ..Default::default()
         };
         Ok(Self { options })

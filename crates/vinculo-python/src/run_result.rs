@@ -61,6 +61,11 @@ impl PyRunResult {
             .map(|e| PyErr::from_value(e.bind(py).clone()))
     }
 
+    /// The exception of the error that stopped the run, as an object (None: it reached its end).
+    pub fn stopped_by<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyAny>> {
+        self.error.as_ref().map(|e| e.bind(py).clone())
+    }
+
     /// A per-step statistic as an array.
     fn stat<'py, T: numpy::Element>(
         &self,

@@ -1,7 +1,8 @@
 //! `Simulation`: the core's stepping object behind a Python class (glue only).
 
 use crate::errors::{invalid, to_py};
-use crate::run::PyRunSettings;
+use crate::reentry::refuse_reentry;
+use crate::run::{Progress, PyRunSettings};
 use crate::run_result::PyRunResult;
 use crate::system::PySystem;
 use crate::user_physics::PendingError;
@@ -95,7 +96,9 @@ impl PySimulation {
         system: Bound<'_, PySystem>,
         settings: PyRef<'_, PyRunSettings>,
     ) -> PyResult<PySimulation> {
+        let py = system.py();
         let options = &settings.options;
+        refuse_reentry(py, &system.borrow().user_errors, "Simulation")?;
         let copy = system.call_method0("copy")?.unbind();
         let system = system.borrow();
         // The simulation's own copy: editing the Python system afterwards does not reach it
@@ -106,7 +109,8 @@ impl PySimulation {
         // SAFETY: the reference points into the box, which lives as long as `sim` (dropped
         // first, field order) and is never moved out of or mutated.
         let borrowed: &'static System = unsafe { &*(model.as_ref() as *const System) };
-        let sim = Simulation::new(borrowed, options).map_err(to_py)?;
+        let sim = Simulation::new(borrowed, options)
+            .map_err(|e| crate::errors::exception(py, &e, Some(&user_errors)))?;
         Ok(PySimulation {
             sim: Mutex::new(sim),
             _system: model,
@@ -131,10 +135,15 @@ impl PySimulation {
         if self.sim().status().is_err() {
             return self.stopped(py);
         }
+        refuse_reentry(py, &self.user_errors, "Simulation.step_to")?;
         self.clear_pending();
         let sim = self.sim.get_mut().unwrap_or_else(|p| p.into_inner());
+        // Ctrl-C stops the steps (the run's status is then `Interrupted`).
+        let mut observer = Progress::new(None);
         let result = py.detach(|| {
-            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| sim.step_to(t).is_ok()))
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                sim.step_to_with_observer(t, &mut observer).is_ok()
+            }))
         });
         if result.map_err(crate::errors::internal)? {
             Ok(())

@@ -478,7 +478,7 @@ impl PySystem {
             .inner
             .add_user_force_group(elements, Box::new(functions), name)
             .map_err(to_py)?;
-        Ok(up::PyUserGroup::force(group))
+        Ok(up::PyUserGroup::force(group, self.user_errors.clone()))
     }
 
     /// Constraint equations Phi_i(q, t) = 0, one per element, computed by Python functions for
@@ -522,7 +522,11 @@ impl PySystem {
             .inner
             .add_user_constraint_group(elements, Box::new(functions), scale.unwrap_or(1.0), name)
             .map_err(to_py)?;
-        Ok(up::PyUserGroup::constraint(group, first))
+        Ok(up::PyUserGroup::constraint(
+            group,
+            first,
+            self.user_errors.clone(),
+        ))
     }
 
     /// Declares a distance constraint a string: a run stops with NegativeTensionError when it
@@ -636,6 +640,7 @@ impl PySystem {
         positions: PyReadonlyArrayDyn<'py, f64>,
         t: f64,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        crate::reentry::refuse_reentry(py, &self.user_errors, "System.constraint_residual")?;
         let (outer, frames) = self.frames(&positions, "positions")?;
         if !outer.is_empty() {
             return Err(invalid(
@@ -689,6 +694,7 @@ impl PySystem {
         max_iterations: usize,
         t: f64,
     ) -> PyResult<Bound<'py, PyDict>> {
+        crate::reentry::refuse_reentry(py, &self.user_errors, "System.project_initial_state")?;
         if !(tolerance.is_finite() && tolerance > 0.0) {
             return Err(invalid("tolerance", tolerance, "must be finite and > 0"));
         }

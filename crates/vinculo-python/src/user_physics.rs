@@ -8,6 +8,7 @@
 //! re-raise it as the cause of `UserFunctionError`.
 
 use crate::errors::{invalid, to_py};
+use crate::reentry::{refuse_reentry, InUserFunction};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -150,7 +151,10 @@ impl ForceGroup for PyForceFunctions {
                 (t, Ok(q), Ok(v)) => (t, q, v),
                 (_, Err(e), _) | (_, _, Err(e)) => return Err(c.raised(py, e)),
             };
-            let out = self.force.call1(py, args).map_err(|e| c.raised(py, e))?;
+            let inside = InUserFunction::enter(&c.pending);
+            let out = self.force.call1(py, args).map_err(|e| c.raised(py, e));
+            drop(inside);
+            let out = out?;
             c.read(py, out.bind(py), &[state_shape(c.k, c.arity)], f)
         })
     }
@@ -178,9 +182,10 @@ impl ForceGroup for PyForceFunctions {
                 (Ok(q), Ok(v)) => (q, v),
                 (Err(e), _) | (_, Err(e)) => return Err(c.raised(py, e)),
             };
-            let out = jacobian
-                .call1(py, (t, qa, va))
-                .map_err(|e| c.raised(py, e))?;
+            let inside = InUserFunction::enter(&c.pending);
+            let out = jacobian.call1(py, (t, qa, va));
+            drop(inside);
+            let out = out.map_err(|e| c.raised(py, e))?;
             let pair = out.bind(py);
             let pair = match pair.cast::<PyTuple>() {
                 Ok(p) if p.len() == 2 => p,
@@ -240,6 +245,7 @@ impl ConstraintGroup for PyConstraintFunctions {
         };
         Python::attach(|py| {
             let qa = c.state(py, q).map_err(|e| c.raised(py, e))?;
+            let _inside = InUserFunction::enter(&c.pending);
             let result = if call == ConstraintCall::Gamma {
                 let va = c.state(py, v).map_err(|e| c.raised(py, e))?;
                 function.call1(py, (t, qa, va))
@@ -356,25 +362,40 @@ enum Group {
 #[pyclass(name = "UserGroup", module = "vinculo._core", frozen)]
 pub struct PyUserGroup {
     group: Group,
+    /// The pending-exception slot of the group's system (which identifies the system for
+    /// [`refuse_reentry`]).
+    pending: PendingError,
 }
 
 impl PyUserGroup {
-    pub fn force(group: Arc<UserForces>) -> PyUserGroup {
+    pub fn force(group: Arc<UserForces>, pending: PendingError) -> PyUserGroup {
         PyUserGroup {
             group: Group::Force(group),
+            pending,
         }
     }
 
-    pub fn constraint(group: Arc<UserConstraints>, first: usize) -> PyUserGroup {
+    pub fn constraint(
+        group: Arc<UserConstraints>,
+        first: usize,
+        pending: PendingError,
+    ) -> PyUserGroup {
         PyUserGroup {
             group: Group::Constraint(group, first),
+            pending,
         }
     }
 
     /// The call counts. Read without the GIL: a run holds a group's lock while it waits for the
-    /// GIL to call the group's function.
-    fn counts(&self, py: Python<'_>) -> Vec<(&'static str, vinculo::user::CallCount)> {
-        py.detach(|| self.counts_now())
+    /// GIL to call the group's function (from inside such a call, where the lock is held on
+    /// this thread, `ReentrantRunError`).
+    fn counts(
+        &self,
+        py: Python<'_>,
+        call: &str,
+    ) -> PyResult<Vec<(&'static str, vinculo::user::CallCount)>> {
+        refuse_reentry(py, &self.pending, call)?;
+        Ok(py.detach(|| self.counts_now()))
     }
 
     fn counts_now(&self) -> Vec<(&'static str, vinculo::user::CallCount)> {
@@ -448,7 +469,7 @@ impl PyUserGroup {
     #[getter]
     fn calls<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for (name, c) in self.counts(py) {
+        for (name, c) in self.counts(py, "UserGroup.calls")? {
             d.set_item(name, c.calls)?;
         }
         Ok(d)
@@ -459,7 +480,7 @@ impl PyUserGroup {
     #[getter]
     fn seconds<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for (name, c) in self.counts(py) {
+        for (name, c) in self.counts(py, "UserGroup.seconds")? {
             d.set_item(name, c.seconds)?;
         }
         Ok(d)

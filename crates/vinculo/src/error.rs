@@ -185,6 +185,27 @@ pub enum Error {
         /// What is wrong and what to do instead.
         problem: String,
     },
+    /// The stored output of a run would exceed (or has reached) the memory allowed
+    /// ([`crate::SimulationOptions::max_output_bytes`]; `output_size.rs`).
+    #[error("{}", output_message(*.t, *.states, *.state_bytes, *.steps, *.bytes, *.limit, .limit_source, *.save_every))]
+    OutputTooLarge {
+        /// Where the run stopped (None: refused before it started).
+        t: Option<f64>,
+        /// Stored states (estimated before the run).
+        states: f64,
+        /// Bytes of one stored state.
+        state_bytes: usize,
+        /// Accepted steps (their sizes are stored too).
+        steps: f64,
+        /// The output's size, in bytes.
+        bytes: f64,
+        /// The largest size allowed, in bytes.
+        limit: f64,
+        /// Where the limit comes from.
+        limit_source: String,
+        /// The run's `save_every`.
+        save_every: usize,
+    },
     /// The run was stopped by its observer (for instance a keyboard interrupt).
     #[error("run interrupted at t = {t:.6} s")]
     Interrupted {
@@ -212,10 +233,36 @@ impl Error {
             Error::UserFunctionOutput { .. } => "UserFunctionOutputError",
             Error::ProjectionFailed { .. }
             | Error::NewtonFailed { .. }
-            | Error::SingularMatrix { .. }
-            | Error::Interrupted { .. } => "ConvergenceError",
+            | Error::SingularMatrix { .. } => "ConvergenceError",
+            Error::Interrupted { .. } => "Interrupted",
+            Error::OutputTooLarge { .. } => "OutputTooLargeError",
         }
     }
+}
+
+/// The message of [`Error::OutputTooLarge`].
+#[allow(clippy::too_many_arguments)]
+fn output_message(
+    t: Option<f64>,
+    states: f64,
+    state_bytes: usize,
+    steps: f64,
+    bytes: f64,
+    limit: f64,
+    source: &str,
+    save_every: usize,
+) -> String {
+    let what = match t {
+        None => "the run would store".to_string(),
+        Some(t) => format!("the run stopped at t = {t:.6} s: it has stored"),
+    };
+    format!(
+        "{what} about {states:.3e} states of {state_bytes} bytes and {steps:.3e} step sizes of 8 \
+         bytes, {:.3} GB, more than the {:.3} GB allowed ({source}): raise save_every (now \
+         {save_every}), give fewer t_eval times, shorten the run, or set max_output_bytes",
+        bytes / 1e9,
+        limit / 1e9
+    )
 }
 
 /// Checks that `value` is finite and strictly positive.
@@ -275,7 +322,7 @@ mod tests {
     use super::*;
 
     /// Number of variants of [`Error`] (the arms of [`ordinal`]).
-    const VARIANTS: usize = 17;
+    const VARIANTS: usize = 18;
 
     /// The position of a variant. An exhaustive match: a new variant does not compile until it
     /// has an arm here, and then [`one_of_each`] must give an example of it.
@@ -298,6 +345,7 @@ mod tests {
             Error::UserFunctionOutput { .. } => 14,
             Error::Snapshot { .. } => 15,
             Error::Interrupted { .. } => 16,
+            Error::OutputTooLarge { .. } => 17,
         }
     }
 
@@ -382,6 +430,16 @@ mod tests {
                 problem: s("truncated"),
             },
             Error::Interrupted { t: 0.4 },
+            Error::OutputTooLarge {
+                t: None,
+                states: 1e12,
+                state_bytes: 112,
+                steps: 1e12,
+                bytes: 1.2e14,
+                limit: 1e9,
+                limit_source: s("max_output_bytes"),
+                save_every: 1,
+            },
         ]
     }
 

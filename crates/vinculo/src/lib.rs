@@ -52,6 +52,7 @@ pub mod local;
 pub mod math;
 pub mod model;
 mod options;
+pub mod output_size;
 pub mod run;
 pub mod simulate;
 pub mod snapshot_file;

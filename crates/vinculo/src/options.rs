@@ -38,8 +38,12 @@ pub struct SimulationOptions {
     /// Solver for larger systems: tree elimination when the constraint graph is a forest
     /// (`Auto`), or always the general sparse LU. [`crate::Solution::linear_solver`] names the one used.
     pub sparse_solver: SparseSolver,
-    /// Largest memory the stored states may take (bytes); larger runs are refused up front.
-    pub max_output_bytes: f64,
+    /// Largest memory the stored output may take, in bytes (None: a third of the memory
+    /// available when the run starts, no limit where it cannot be read): a run whose output
+    /// would exceed it is refused before it starts, and a run whose output reaches it (error
+    /// controlled steps, whose number is known only as they go) stops with the states stored
+    /// (`output_size.rs`).
+    pub max_output_bytes: Option<f64>,
     /// Models with at least this many free particles assemble their residuals and Jacobians
     /// in parallel, on rayon's global thread pool (as many threads as cores, or
     /// `RAYON_NUM_THREADS`): the kinematics and the inertia and gravity rows per particle, the
@@ -71,7 +75,7 @@ impl Default for SimulationOptions {
             save_every: 1,
             dense_limit: 48,
             sparse_solver: SparseSolver::Auto,
-            max_output_bytes: 8.0 * (1u64 << 30) as f64,
+            max_output_bytes: None,
             parallel_from: PARALLEL_FROM,
             step_control: StepControl::Fixed,
             output_times: None,

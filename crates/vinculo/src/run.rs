@@ -48,6 +48,7 @@ use crate::integrators::{
 use crate::math::Vec3;
 use crate::model::System;
 use crate::options::{check_options, Observer, SimulationOptions};
+use crate::output_size::OutputLimit;
 use crate::solution::{Solution, StepStats};
 use crate::step_control::{ErrorWeights, StepControl};
 
@@ -272,6 +273,8 @@ pub struct Simulation<'a> {
     sol: Solution,
     fingerprint: u64,
     run: u64,
+    /// The largest stored output allowed (None: no limit known; `output_size.rs`).
+    output_limit: Option<OutputLimit>,
 }
 
 impl<'a> Simulation<'a> {
@@ -283,6 +286,14 @@ impl<'a> Simulation<'a> {
     /// [`Simulation::status`] holds the cause and which takes no step.
     pub fn new(system: &'a System, options: &SimulationOptions) -> Result<Simulation<'a>> {
         check_options(system, options)?;
+        // A run whose stored output would not fit in memory is refused before it starts.
+        let output_limit = OutputLimit::of(options)?;
+        if let Some(e) = output_limit
+            .as_ref()
+            .and_then(|l| l.refused(system, options))
+        {
+            return Err(e);
+        }
         // User groups start the run with empty caches and counters.
         system.reset_user_groups();
         let length = system.length_scale();
@@ -451,6 +462,7 @@ impl<'a> Simulation<'a> {
             sol,
             fingerprint: fingerprint(system),
             run: NEXT_RUN.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+            output_limit,
         })
     }
 
@@ -881,6 +893,15 @@ impl Simulation<'_> {
         }
         if let Controller::Adaptive(control) = &mut c.controller {
             control.accepted(h);
+        }
+        // A run whose number of steps could not be told beforehand stops when its output
+        // reaches the memory allowed, keeping what it stored.
+        if let Some(limit) = &self.output_limit {
+            let (states, steps) = (sol.len() as f64, sol.accepted_step_sizes.len() as f64);
+            if let Some(e) = limit.exceeded(system, &self.options, states, steps, Some(c.t)) {
+                sol.status = Err(e);
+                return Next::Stop;
+            }
         }
         if !observer.step(c.t, self.options.t_end) {
             sol.status = Err(Error::Interrupted { t: c.t });
