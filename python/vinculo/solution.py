@@ -302,7 +302,8 @@ class Solution:
         else:
             assert self.error is not None
             stop = self.times[-1] if len(self.times) else float("nan")
-            lines.append(f"FAILED at t = {stop:.6g} s: {self.error.get('message', '')}")
+            outcome = "INTERRUPTED" if self.error.get("kind") == "Interrupted" else "FAILED"
+            lines.append(f"{outcome} at t = {stop:.6g} s: {self.error.get('message', '')}")
         lines.append(
             f"steps: {self.num_steps} ({self.system.num_particles} particles, "
             f"{self.system.num_constraints} constraint equations)"
@@ -326,6 +327,8 @@ class Solution:
 
     def __repr__(self) -> str:
         status = "success" if self.success else "failed"
+        if self.error is not None and self.error.get("kind") == "Interrupted":
+            status = "interrupted"
         return (
             f"Solution({status}, steps={self.num_steps}, particles={self.positions.shape[1]}, "
             f"constraint equations={self.multipliers.shape[1]})"
