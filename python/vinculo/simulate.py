@@ -77,12 +77,14 @@ def simulate(
             trapezoidal rule (second order, no numerical damping), 1 is backward Euler (first
             order, strongly damped); values between add damping but are first order.
         progress: True draws a progress bar on standard error; a callable is called as
-            ``progress(t, t_end)`` about twice a second of wall time.
+            ``progress(t, t_end)`` about twice a second of wall time (an exception it raises
+            stops the run and propagates with the partial solution as its ``solution``
+            attribute).
         **options: the run's options, by name, each described in :class:`RunOptions`:
             ``scheme``, ``rho_inf``, ``formulation``, ``t_start``, ``tolerance``,
             ``max_iterations``, ``max_halvings``, ``initial_tolerance``, ``save_every``,
-            ``jacobian_reuse``, ``adaptive``, ``rtol``, ``atol``, ``h_min``, ``h_max`` and
-            ``t_eval``.
+            ``jacobian_reuse``, ``adaptive``, ``rtol``, ``atol``, ``h_min``, ``h_max``,
+            ``t_eval`` and ``max_output_bytes``.
 
     Returns:
         The :class:`Solution`.
@@ -103,6 +105,12 @@ def simulate(
         UserFunctionError: a function of a user force or constraint group raised (its exception
             is the ``__cause__``; ``solution`` holds the steps completed before).
         UserFunctionOutputError: such a function returned a wrong shape or a non-finite value.
+        Interrupted: (a ``KeyboardInterrupt``) Ctrl-C, in the core's steps, the progress
+            callback or a user function; ``solution`` holds every state stored before.
+        ReentrantRunError: a user function of ``system`` ran ``system`` (or a copy of it) again.
+        OutputTooLargeError: the stored output would exceed ``max_output_bytes`` (by default a
+            third of the memory available): refused before the run starts, or, for adaptive
+            steps, stopped when it reaches it (``solution`` holds what was stored).
     """
     settings = RunOptions.of("simulate", options).settings(t_end, dt, alpha)
     bar: ProgressBar | None = None

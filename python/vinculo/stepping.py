@@ -38,6 +38,8 @@ class Simulation:
         InvalidInputError: a bad argument (as :func:`vinculo.simulate`).
         TypeError: a keyword argument that is not one of the options.
         InconsistentInitialStateError: the initial state violates a constraint.
+        OutputTooLargeError: the stored output would exceed ``max_output_bytes``.
+        ReentrantRunError: created from inside a user function of ``system``.
     """
 
     def __init__(
@@ -58,6 +60,9 @@ class Simulation:
             ConvergenceError: (or its subclasses, as :func:`vinculo.simulate`) the run stopped;
                 its ``solution`` holds every state stored before, and the simulation keeps them
                 (restore a snapshot to go on from an earlier state).
+            Interrupted: (a ``KeyboardInterrupt``) Ctrl-C stopped the steps; ``solution`` as
+                above (restore a snapshot to go on).
+            ReentrantRunError: called from inside a user function of the simulation's system.
         """
         self._core.step_to(float(t))
 
