@@ -77,7 +77,7 @@ def test_ctrl_c_in_the_steps_raises_keyboard_interrupt_with_the_partial_solution
     system = pendulum()
     sent = time.perf_counter() + 0.3
     with pytest.raises(KeyboardInterrupt) as info, interrupt_after(0.3):
-        vinculo.simulate(system, t_end=1e3, dt=1e-3)
+        vinculo.simulate(system, t_end=1e3, dt=1e-3, save_every=7)
     latency = time.perf_counter() - sent
     error = info.value
     assert isinstance(error, vinculo.Interrupted)
@@ -86,8 +86,10 @@ def test_ctrl_c_in_the_steps_raises_keyboard_interrupt_with_the_partial_solution
     assert latency < 1.0
     partial = error.solution
     assert partial.error["kind"] == "Interrupted"
+    # The state where it stopped is kept, even between two stored steps of save_every (an
+    # uninterrupted run to that time stores it too, as its last state).
     assert error.time == partial.times[-1]
-    assert_is_the_run_up_to_its_end(partial, system, 1e-3)
+    assert_is_the_run_up_to_its_end(partial, system, 1e-3, save_every=7)
 
 
 def test_ctrl_c_inside_a_user_force_stays_a_keyboard_interrupt(sigint_raises):

@@ -567,7 +567,8 @@ def simulate(system: System, settings: RunSettings,
              progress: Callable[[float, float], None] | None = None) -> RunResult:
     """Integrate.
 
-    progress(t, t_end) is called about twice a second of wall time.
+    progress(t, t_end) is called about twice a second of wall time; Ctrl-C is looked for about
+    ten times a second.
 
     Arguments:
         system: the model.
@@ -575,12 +576,15 @@ def simulate(system: System, settings: RunSettings,
         progress: the progress callback, or None.
 
     Returns:
-        The run; a run that stopped early returns the states computed before, with its
-        ``error``.
+        The run; a run that stopped early (Ctrl-C included: ``vinculo.errors.Interrupted``)
+        returns the states computed before, with its ``error``.
 
     Raises:
         VinculoError: the ``vinculo.errors`` class of an error found before the first step (bad
-            settings, an inconsistent initial state, ...).
+            settings, an inconsistent initial state, an output too large for memory, a run
+            started from a user function of the same system, ...).
+        BaseException: the exception the progress callback raised (but a ``KeyboardInterrupt``,
+            reported as the run's ``error``), with the partial solution as its ``solution``.
     """
 
 class Snapshot:

@@ -94,7 +94,8 @@ class Interrupted(_Detailed, KeyboardInterrupt):
     in the core's steps (which look for it about ten times a second), in the progress callback,
     or inside a user function (a force or constraint group's function, a law's callable). It is
     a ``KeyboardInterrupt``, so ``except KeyboardInterrupt`` catches it (and ``except Exception``
-    does not). ``solution`` holds every state stored before the interrupt: each one a completed,
+    does not). ``solution`` holds every state stored before the interrupt, and the state where
+    the run stopped (stored even between two rows of ``save_every``): each one a completed,
     converged step, so its states satisfy the constraints as in a complete run and match it up to
     the interrupt.
 

@@ -51,7 +51,7 @@ impl OutputLimit {
     /// The limit of a run with options `o` (checks `max_output_bytes`).
     pub(crate) fn of(o: &SimulationOptions) -> Result<Option<OutputLimit>> {
         if let Some(bytes) = o.max_output_bytes {
-            if !(bytes > 0.0) {
+            if bytes.is_nan() || bytes <= 0.0 {
                 return Err(Error::InvalidParameter {
                     name: "max_output_bytes".into(),
                     value: bytes,

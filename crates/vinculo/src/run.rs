@@ -904,6 +904,10 @@ impl Simulation<'_> {
             }
         }
         if !observer.step(c.t, self.options.t_end) {
+            // The state where the run stopped is kept, stored or not by `save_every`.
+            if sol.times.last() != Some(&c.t) {
+                store(sol, system, c.t, (&c.q, &c.v, &c.lambda), stats);
+            }
             sol.status = Err(Error::Interrupted { t: c.t });
             return Next::Stop;
         }
