@@ -40,6 +40,8 @@ def pendulum_system() -> tuple[vinculo.System, vinculo.ParticleId, vinculo.Const
         (errors.UnknownHandleError, LookupError),
         (errors.InconsistentInitialStateError, errors.InvalidInputError),
         (errors.ConvergenceError, RuntimeError),
+        (errors.ReentrantRunError, RuntimeError),
+        (errors.OutputTooLargeError, MemoryError),
         (errors.InternalError, Exception),
     ],
 )
@@ -59,6 +61,17 @@ def test_details_become_attributes_and_survive_pickling():
     copy = pickle.loads(pickle.dumps(error))
     assert type(copy) is errors.InvalidInputError
     assert (str(copy), copy.name, copy.value) == (str(error), "mass", -1.0)
+
+
+def test_an_interrupt_is_a_keyboard_interrupt_with_details_not_an_exception():
+    # Ctrl-C must not be swallowed by `except Exception`, nor missed by `except KeyboardInterrupt`.
+    assert issubclass(errors.Interrupted, KeyboardInterrupt)
+    assert not issubclass(errors.Interrupted, Exception)
+    assert vinculo.Interrupted is errors.Interrupted
+    error = errors.Interrupted("run interrupted at t = 0.5 s", time=0.5)
+    assert (str(error), error.time, error.solution) == ("run interrupted at t = 0.5 s", 0.5, None)
+    copy = pickle.loads(pickle.dumps(error))
+    assert type(copy) is errors.Interrupted and copy.time == 0.5
 
 
 def test_convergence_error_has_its_attributes_even_when_not_given():
