@@ -80,6 +80,11 @@ fn details<'py>(py: Python<'py>, e: &Error) -> PyResult<Bound<'py, PyDict>> {
             d.set_item("h_min", h_min)?;
             d.set_item("error_norm", error)?;
         }
+        Error::StepBelowTimeResolution { t, h, smallest, .. } => {
+            d.set_item("time", t)?;
+            d.set_item("step_size", h)?;
+            d.set_item("h_min", smallest)?;
+        }
         Error::Interrupted { t } => d.set_item("time", t)?,
         Error::Snapshot { what, .. } => {
             d.set_item("name", "snapshot")?;

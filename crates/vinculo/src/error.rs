@@ -151,6 +151,19 @@ pub enum Error {
         /// Weighted error norm of the last attempt (1 meets the tolerances).
         error: f64,
     },
+    /// A step is too small for the floating-point times to resolve: t + h would not advance t
+    /// by h (to 1 %), so times would repeat or the steps taken differ from the ones integrated.
+    #[error("at t = {t:e} s the step {h:.3e} s is below the resolution of the time (floating-point spacing {spacing:.3e} s; a step must be >= {smallest:.3e} s there): use a larger dt (or, with error-controlled steps, looser rtol/atol), or count time from nearer 0 (a smaller t_start)")]
+    StepBelowTimeResolution {
+        /// Time at the start of the step.
+        t: f64,
+        /// The step that could not be taken.
+        h: f64,
+        /// The spacing of floating-point numbers at t.
+        spacing: f64,
+        /// The smallest step resolved there.
+        smallest: f64,
+    },
     /// A user function of a force or constraint group failed (raised an error).
     #[error("user function {call}() of group '{group}' failed at t = {t:.6} s: {message}")]
     UserFunction {
@@ -207,7 +220,9 @@ impl Error {
             Error::InconsistentInitialState { .. } => "InconsistentInitialStateError",
             Error::RedundantConstraints { .. } => "RedundantConstraintsError",
             Error::NegativeTension { .. } => "NegativeTensionError",
-            Error::StepSizeTooSmall { .. } => "StepSizeTooSmallError",
+            Error::StepSizeTooSmall { .. } | Error::StepBelowTimeResolution { .. } => {
+                "StepSizeTooSmallError"
+            }
             Error::UserFunction { .. } => "UserFunctionError",
             Error::UserFunctionOutput { .. } => "UserFunctionOutputError",
             Error::ProjectionFailed { .. }
@@ -275,7 +290,7 @@ mod tests {
     use super::*;
 
     /// Number of variants of [`Error`] (the arms of [`ordinal`]).
-    const VARIANTS: usize = 17;
+    const VARIANTS: usize = 18;
 
     /// The position of a variant. An exhaustive match: a new variant does not compile until it
     /// has an arm here, and then [`one_of_each`] must give an example of it.
@@ -298,6 +313,7 @@ mod tests {
             Error::UserFunctionOutput { .. } => 14,
             Error::Snapshot { .. } => 15,
             Error::Interrupted { .. } => 16,
+            Error::StepBelowTimeResolution { .. } => 17,
         }
     }
 
@@ -382,6 +398,12 @@ mod tests {
                 problem: s("truncated"),
             },
             Error::Interrupted { t: 0.4 },
+            Error::StepBelowTimeResolution {
+                t: 1e6,
+                h: 1e-12,
+                spacing: 1.16e-10,
+                smallest: 5.8e-9,
+            },
         ]
     }
 

@@ -80,9 +80,43 @@ enum StepEnd {
     At(f64),
 }
 
+/// Most halvings the fixed-step grid holds: dt / 2^60 is below the resolution of any time
+/// farther than dt / 2^8 from 0, so more halvings could only fail with
+/// [`Error::StepBelowTimeResolution`]; a larger `max_halvings` means as many as the times
+/// resolve.
+pub(crate) const MAX_GRID_HALVINGS: u32 = 60;
+
+/// Grid units after which the grid is restarted at the current time: beyond 2^52 the count no
+/// longer converts exactly to a float (and 2^64 would overflow), at 2^(52 - 60) nominal steps
+/// between restarts with the deepest grid, and never in practice with the default 4 halvings.
+const MAX_GRID_UNITS: u64 = 1 << 52;
+
+/// Fewest floating-point spacings of t a step must span: t + h then advances t by h to within
+/// 1 % (the sum rounds by at most half a spacing). A smaller step would repeat times or take
+/// steps other than the ones the scheme integrates over.
+pub const STEP_IN_TIME_SPACINGS: f64 = 50.0;
+
+/// The spacing of floating-point numbers at `t` (the unit in the last place of |t|).
+pub fn time_spacing(t: f64) -> f64 {
+    let a = t.abs();
+    f64::from_bits(a.to_bits() + 1) - a
+}
+
+/// The error of a step `h` from `t` that the floating-point times cannot resolve (it spans fewer
+/// than [`STEP_IN_TIME_SPACINGS`] spacings at the larger of |t| and |t + h|), if it is one.
+pub(crate) fn unresolved_step(t: f64, h: f64) -> Option<Error> {
+    let spacing = time_spacing(t.abs().max((t + h).abs()));
+    (h < STEP_IN_TIME_SPACINGS * spacing).then_some(Error::StepBelowTimeResolution {
+        t,
+        h,
+        spacing,
+        smallest: STEP_IN_TIME_SPACINGS * spacing,
+    })
+}
+
 impl FixedSteps {
     fn new(dt: f64, max_halvings: usize, t0: f64) -> FixedSteps {
-        let top = max_halvings as u32;
+        let top = max_halvings.min(MAX_GRID_HALVINGS as usize) as u32;
         FixedSteps {
             top,
             unit: dt / f64::powi(2.0, top as i32),
@@ -121,7 +155,12 @@ impl FixedSteps {
         let t = match end {
             StepEnd::Natural => {
                 self.units += 1u64 << self.level;
-                self.t_grid + self.units as f64 * self.unit
+                let t = self.t_grid + self.units as f64 * self.unit;
+                if self.units >= MAX_GRID_UNITS {
+                    self.t_grid = t;
+                    self.units = 0;
+                }
+                t
             }
             StepEnd::At(t) => {
                 // Off the grid: start it afresh here.
@@ -283,6 +322,24 @@ impl<'a> Simulation<'a> {
     /// [`Simulation::status`] holds the cause and which takes no step.
     pub fn new(system: &'a System, options: &SimulationOptions) -> Result<Simulation<'a>> {
         check_options(system, options)?;
+        // Fixed steps of dt must be resolved by the times of the whole run.
+        if options.step_control == StepControl::Fixed && options.t_end > options.t_start {
+            let far = options.t_start.abs().max(options.t_end.abs());
+            let spacing = time_spacing(far);
+            if options.dt < STEP_IN_TIME_SPACINGS * spacing {
+                return Err(Error::InvalidParameter {
+                    name: "dt".into(),
+                    value: options.dt,
+                    expected: format!(
+                        "must be at least {STEP_IN_TIME_SPACINGS} times the spacing of \
+                         floating-point times at t = {far:e} s ({spacing:.3e} s), i.e. >= \
+                         {:.3e} s, or t + dt does not advance t by dt; use a larger dt or \
+                         count time from nearer 0 (a smaller t_start)",
+                        STEP_IN_TIME_SPACINGS * spacing
+                    ),
+                });
+            }
+        }
         // User groups start the run with empty caches and counters.
         system.reset_user_groups();
         let length = system.length_scale();
@@ -709,6 +766,12 @@ impl Simulation<'_> {
             }
         };
         let ends_run = end == StepEnd::At(t_end);
+        // A step the times cannot resolve (a halved step, or an error-controlled one, far from
+        // t = 0) stops the run rather than repeat times.
+        if let Some(e) = unresolved_step(c.t, h_try) {
+            self.sol.status = Err(e);
+            return Next::Stop;
+        }
         let mut fresh_retry = false;
         loop {
             // Predictor: constant-acceleration extrapolation, last multipliers.
