@@ -105,13 +105,14 @@ pub enum Error {
         equation: String,
     },
     /// The iteration matrix could not be factorised.
-    #[error("singular iteration matrix at t = {t:.6} s near {equation}: {detail}; the constraints may be redundant or leave the model under-determined")]
+    #[error("singular iteration matrix at t = {t:.6} s near {equation}: {detail}")]
     SingularMatrix {
         /// Time at the start of the failing step.
         t: f64,
         /// The equation (particle or constraint) where elimination found no pivot, if known.
         equation: String,
-        /// What the linear solver reported.
+        /// What the linear solver reported, and what the structure of the matrix says of the
+        /// cause (redundant constraints, or the mass and force block).
         detail: String,
     },
     /// Some constraint equations are combinations of others: the constraint gradients are

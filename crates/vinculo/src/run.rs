@@ -35,7 +35,7 @@
 
 use crate::adaptive::ErrorControl;
 use crate::assembly::Layout;
-use crate::constraints::find_redundant;
+use crate::constraints::explain_singular;
 use crate::dense_output::StepEnds;
 use crate::error::{Error, Result};
 use crate::initial::{
@@ -80,15 +80,14 @@ enum StepEnd {
     At(f64),
 }
 
-/// Most halvings the fixed-step grid holds: dt / 2^60 is below the resolution of any time
-/// farther than dt / 2^8 from 0, so more halvings could only fail with
-/// [`Error::StepBelowTimeResolution`]; a larger `max_halvings` means as many as the times
-/// resolve.
-pub(crate) const MAX_GRID_HALVINGS: u32 = 60;
+/// Most halvings the fixed-step grid holds: a step that fails at dt / 2^30 (a billionth of dt)
+/// has no step-size problem that further halving would solve, and the grid's count of units of
+/// dt / 2^30 stays exact in a float for 2^22 steps of dt; a larger `max_halvings` means 30.
+pub(crate) const MAX_GRID_HALVINGS: u32 = 30;
 
 /// Grid units after which the grid is restarted at the current time: beyond 2^52 the count no
-/// longer converts exactly to a float (and 2^64 would overflow), at 2^(52 - 60) nominal steps
-/// between restarts with the deepest grid, and never in practice with the default 4 halvings.
+/// longer converts exactly to a float (and 2^64 would overflow); with the deepest grid that is
+/// every 2^22 steps of dt, and never in practice with the default 4 halvings.
 const MAX_GRID_UNITS: u64 = 1 << 52;
 
 /// Fewest floating-point spacings of t a step must span: t + h then advances t by h to within
@@ -397,7 +396,7 @@ impl<'a> Simulation<'a> {
         sol.formulation = options.formulation;
         let start = consistent_accelerations(system, &mut ws, &q, &v, t0).map_err(|e| match e {
             // Name the culprits when the matrix is singular because constraints are redundant.
-            Error::SingularMatrix { .. } => find_redundant(system, &q, t0, None).unwrap_or(e),
+            e @ Error::SingularMatrix { .. } => explain_singular(system, &q, t0, e),
             e => e,
         });
         // A failed user function is the cause of whatever else went wrong at the start.
@@ -820,7 +819,8 @@ impl Simulation<'_> {
                     if retry {
                         return Next::Go;
                     }
-                    self.sol.status = Err(step_failure(system, &ws.layout, failure, c.t, h_try));
+                    let e = step_failure(system, &ws.layout, failure, c.t, h_try);
+                    self.sol.status = Err(explain_singular(system, &c.q, c.t, e));
                     return Next::Stop;
                 }
             }
