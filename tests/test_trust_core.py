@@ -237,3 +237,38 @@ def test_a_halving_below_the_resolution_of_t_stops_with_a_typed_error():
     assert 1e6 <= caught.value.time < 1e6 + 1e-6
     assert caught.value.step_size == pytest.approx(5e-9)
     assert caught.value.step_size < caught.value.h_min
+
+
+# --- Mass ratios ------------------------------------------------------------------------------
+
+
+def _alternating_chain(links: int, scale: float, closed: bool = False):
+    """A chain of 0.1 m links released horizontally from a fixed anchor, its particles'
+    masses alternating between 1e-9 kg and 1e3 kg (times ``scale``)."""
+    system = vinculo.System(gravity=(0.0, 0.0, -G))
+    previous = system.add_particle(mass=1.0, position=(0.0, 0.0, 0.0), fixed=True)
+    chain = []
+    for i in range(1, links + 1):
+        mass = (1e-9 if i % 2 else 1e3) * scale
+        joint = system.add_particle(mass=mass, position=(0.1 * i, 0.0, 0.0))
+        system.add_distance(previous, joint)
+        previous = joint
+        chain.append(joint)
+    if closed:
+        system.add_spring_damper(chain[0], chain[-1], stiffness=0.0)
+    return system, chain
+
+
+def test_mass_ratio_of_a_trillion_runs_and_is_scale_invariant():
+    # Used to stop at t = 0: "singular iteration matrix ... the constraints may be redundant".
+    runs = {}
+    for scale, closed in ((1.0, False), (1e-3, False), (1.0, True)):
+        system, chain = _alternating_chain(10, scale, closed)
+        solution = vinculo.simulate(system, t_end=0.3, dt=1e-3, save_every=10)
+        assert solution.success
+        runs[scale, closed] = _positions(solution, chain)
+    # References: the motion under gravity alone does not depend on the unit of mass (every
+    # mass times 1e-3), and the general sparse LU gives the same steps.
+    assert np.max(np.abs(runs[1.0, False] - runs[1e-3, False])) < 1e-9
+    assert np.max(np.abs(runs[1.0, False] - runs[1.0, True])) < 1e-9
+    assert np.max(np.abs(runs[1.0, False][-1] - runs[1.0, False][0])) > 0.1  # it fell

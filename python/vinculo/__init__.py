@@ -18,6 +18,7 @@ from vinculo._core import ConstraintId, ForceId, Law, ParticleId, System, UserGr
 from vinculo.errors import (
     ConvergenceError,
     InconsistentInitialStateError,
+    InstabilityError,
     InternalError,
     InvalidInputError,
     NegativeTensionError,
@@ -48,6 +49,7 @@ __all__ = [
     "ConvergenceError",
     "ForceId",
     "InconsistentInitialStateError",
+    "InstabilityError",
     "InternalError",
     "InvalidInputError",
     "Law",

@@ -165,6 +165,23 @@ pub enum Error {
         /// The smallest step resolved there.
         smallest: f64,
     },
+    /// Index-3 generalised-alpha went unstable: the mechanical energy of a model that takes in
+    /// none grew beyond everything the model holds (`integrators/energy_guard.rs`).
+    #[error("index-3 generalised-alpha is unstable at this step: at t = {t:.6} s the mechanical energy is {energy:.4e} J, above {bound:.4e} J (initial {initial:.4e} J plus all the energy the model can exchange; it takes in none), with rho_inf = {rho_inf} and dt = {dt:.3e} s; use formulation='ggl' (stable at every step measured), or rho_inf <= 0.6, or a smaller step (rho_inf = 0.9 needs about 100 steps per period of the fastest motion resolved; docs/theory/time-rules.md has the measured table)")]
+    EnergyGrowth {
+        /// Time at the end of the step where the energy passed the bound.
+        t: f64,
+        /// The step size.
+        dt: f64,
+        /// The scheme's spectral radius at infinite frequency.
+        rho_inf: f64,
+        /// The mechanical energy reached (J).
+        energy: f64,
+        /// The initial mechanical energy (J).
+        initial: f64,
+        /// The bound it passed (J).
+        bound: f64,
+    },
     /// A user function of a force or constraint group failed (raised an error).
     #[error("user function {call}() of group '{group}' failed at t = {t:.6} s: {message}")]
     UserFunction {
@@ -221,6 +238,7 @@ impl Error {
             Error::InconsistentInitialState { .. } => "InconsistentInitialStateError",
             Error::RedundantConstraints { .. } => "RedundantConstraintsError",
             Error::NegativeTension { .. } => "NegativeTensionError",
+            Error::EnergyGrowth { .. } => "InstabilityError",
             Error::StepSizeTooSmall { .. } | Error::StepBelowTimeResolution { .. } => {
                 "StepSizeTooSmallError"
             }
@@ -291,7 +309,7 @@ mod tests {
     use super::*;
 
     /// Number of variants of [`Error`] (the arms of [`ordinal`]).
-    const VARIANTS: usize = 18;
+    const VARIANTS: usize = 19;
 
     /// The position of a variant. An exhaustive match: a new variant does not compile until it
     /// has an arm here, and then [`one_of_each`] must give an example of it.
@@ -315,6 +333,7 @@ mod tests {
             Error::Snapshot { .. } => 15,
             Error::Interrupted { .. } => 16,
             Error::StepBelowTimeResolution { .. } => 17,
+            Error::EnergyGrowth { .. } => 18,
         }
     }
 
@@ -404,6 +423,14 @@ mod tests {
                 h: 1e-12,
                 spacing: 1.16e-10,
                 smallest: 5.8e-9,
+            },
+            Error::EnergyGrowth {
+                t: 5.0,
+                dt: 0.05,
+                rho_inf: 0.9,
+                energy: 1e3,
+                initial: 0.0,
+                bound: 9.81,
             },
         ]
     }

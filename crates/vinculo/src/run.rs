@@ -41,8 +41,9 @@ use crate::error::{Error, Result};
 use crate::initial::{
     consistent_accelerations, scaled_velocity_violation, scaled_violation, singular_error,
 };
+use crate::integrators::energy_guard::EnergyGuard;
 use crate::integrators::{
-    Formulation, NewtonFailure, NewtonOptions, RuleState, StabilizedWorkspace, StepStart,
+    Formulation, NewtonFailure, NewtonOptions, RuleState, Scheme, StabilizedWorkspace, StepStart,
     StepWorkspace,
 };
 use crate::math::Vec3;
@@ -310,6 +311,8 @@ pub struct Simulation<'a> {
     sol: Solution,
     fingerprint: u64,
     run: u64,
+    /// The growth guard of index-3 generalised-alpha (`integrators/energy_guard.rs`).
+    guard: Option<EnergyGuard>,
 }
 
 impl<'a> Simulation<'a> {
@@ -466,6 +469,12 @@ impl<'a> Simulation<'a> {
             }
         }
         let rule = options.scheme.initial_state(&acc);
+        let guard = match (options.scheme, options.formulation) {
+            (Scheme::GeneralizedAlpha { rho_inf }, Formulation::Index3) => {
+                EnergyGuard::new(system, rho_inf, &q, &v)
+            }
+            _ => None,
+        };
         // Buffers of what only some runs do (allocated empty otherwise: at 10^6 particles each
         // array of 3-vectors is 24 MB).
         let adaptive = matches!(controller, Controller::Adaptive(_));
@@ -505,6 +514,7 @@ impl<'a> Simulation<'a> {
             },
             scratch,
             sol,
+            guard,
             fingerprint: fingerprint(system),
             run: NEXT_RUN.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         })
@@ -939,6 +949,10 @@ impl Simulation<'_> {
         std::mem::swap(&mut c.lambda, &mut s.lambda_new);
         c.t = t_new;
         if let Some(e) = slack {
+            sol.status = Err(e);
+            return Next::Stop;
+        }
+        if let Some(e) = self.guard.and_then(|g| g.check(system, &c.q, &c.v, c.t, h)) {
             sol.status = Err(e);
             return Next::Stop;
         }
