@@ -19,8 +19,8 @@
 //! S = T0 + |V_elastic,0| + m_total |g| D
 //! ```
 //!
-//! (the initial kinetic energy, the initial elastic energy, and the weight lifted across the
-//! model's extent D, [`System::length_scale`]); the guard fires when E > E0 + S, an energy
+//! (the initial kinetic energy, the initial elastic energy, and the weight of the free
+//! particles lifted across the model's extent D, [`System::length_scale`]); the guard fires when E > E0 + S, an energy
 //! error as large as everything the model holds, which no correct run approaches. Models with
 //! an energy source (applied, fluid or user forces, moving or user constraints) are not
 //! watched: there the bound would need their work, which is not known.
@@ -73,7 +73,12 @@ impl EnergyGuard {
         }
         let kinetic = system.kinetic_energy(v0);
         let elastic: f64 = system.forces().iter().map(|f| f.potential(q0)).sum();
-        let mass: f64 = system.particles().iter().map(|p| p.mass).sum();
+        let mass: f64 = system
+            .particles()
+            .iter()
+            .filter(|p| !p.fixed)
+            .map(|p| p.mass)
+            .sum();
         let lift = mass * norm(system.gravity()) * system.length_scale();
         let slack = kinetic + elastic.abs() + lift;
         let initial = kinetic + system.potential_energy(q0);
