@@ -37,7 +37,9 @@ def _four_bars(n: int) -> tuple[vinculo.System, list]:
     top: list = []
     for i in range(n + 1):
         ground = system.add_particle(mass=1.0, position=(float(i), 0.0, 0.0), fixed=True)
-        joint = system.add_particle(mass=1.0, position=(float(i), 1.0, 0.0), velocity=(1.0, 0.0, 0.0))
+        joint = system.add_particle(
+            mass=1.0, position=(float(i), 1.0, 0.0), velocity=(1.0, 0.0, 0.0)
+        )
         system.add_distance(ground, joint, length=1.0)
         system.add_fixed_coordinate(joint, "z")
         if top:
@@ -295,7 +297,9 @@ def test_unstable_generalized_alpha_raises_instead_of_reporting_success():
     assert error.solution.energy()[-1] == pytest.approx(error.energy)
     # rho_inf = 1 blows up even at 1000 steps a period (measured: 2.4e9 m g L in 20 periods).
     with pytest.raises(vinculo.InstabilityError):
-        vinculo.simulate(_pendulum(), t_end=20.0, dt=2.4e-3, scheme="generalized-alpha", rho_inf=1.0)
+        vinculo.simulate(
+            _pendulum(), t_end=20.0, dt=2.4e-3, scheme="generalized-alpha", rho_inf=1.0
+        )
 
 
 @pytest.mark.parametrize(

@@ -20,8 +20,8 @@ from typing import Any
 __all__ = [
     "ConvergenceError",
     "InconsistentInitialStateError",
-    "InternalError",
     "InstabilityError",
+    "InternalError",
     "InvalidInputError",
     "NegativeTensionError",
     "RedundantConstraintsError",
@@ -204,7 +204,7 @@ class InstabilityError(ConvergenceError):
     formulation when the mechanical energy of a model that takes in no energy (gravity, springs,
     bending, drag, constraints that do not move) exceeds its initial value plus all the energy
     the model can exchange: the scheme is unstable at that ``rho_inf`` and step (measured table in
-    the theory page "Time rules"). Use ``formulation='ggl'``, ``rho_inf <= 0.6``, or a smaller
+    the theory page "Time rules"). Use ``formulation='ggl'``, ``rho_inf <= 0.5``, or a smaller
     step. ``solution`` holds every step before.
 
     Attributes:

@@ -167,7 +167,7 @@ pub enum Error {
     },
     /// Index-3 generalised-alpha went unstable: the mechanical energy of a model that takes in
     /// none grew beyond everything the model holds (`integrators/energy_guard.rs`).
-    #[error("index-3 generalised-alpha is unstable at this step: at t = {t:.6} s the mechanical energy is {energy:.4e} J, above {bound:.4e} J (initial {initial:.4e} J plus all the energy the model can exchange; it takes in none), with rho_inf = {rho_inf} and dt = {dt:.3e} s; use formulation='ggl' (stable at every step measured), or rho_inf <= 0.6, or a smaller step (rho_inf = 0.9 needs about 100 steps per period of the fastest motion resolved; docs/theory/time-rules.md has the measured table)")]
+    #[error("index-3 generalised-alpha is unstable at this step: at t = {t:.6} s the mechanical energy is {energy:.4e} J, above {bound:.4e} J (initial {initial:.4e} J plus all the energy the model can exchange; it takes in none), with rho_inf = {rho_inf} and dt = {dt:.3e} s; use formulation='ggl' (stable at every step measured), or rho_inf <= 0.5 (stable from 10 steps a period on a pendulum), or a smaller step (rho_inf = 0.9 needs 100 steps a period of the fastest motion; docs/theory/time-rules.md has the measured table)")]
     EnergyGrowth {
         /// Time at the end of the step where the energy passed the bound.
         t: f64,
