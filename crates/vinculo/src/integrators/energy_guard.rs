@@ -93,7 +93,7 @@ impl EnergyGuard {
     /// beyond the bound.
     pub fn check(&self, system: &System, q: &[Vec3], v: &[Vec3], t: f64, h: f64) -> Option<Error> {
         let energy = system.kinetic_energy(v) + system.potential_energy(q);
-        (energy.is_nan() || energy > self.initial + self.slack).then(|| Error::EnergyGrowth {
+        (energy.is_nan() || energy > self.initial + self.slack).then_some(Error::EnergyGrowth {
             t,
             dt: h,
             rho_inf: self.rho_inf,
