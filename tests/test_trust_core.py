@@ -320,3 +320,21 @@ def test_the_advised_choices_are_stable_at_the_same_step(options):
     energy = solution.energy() / G
     assert np.max(energy - energy[0]) < 1e-2
     assert np.min(energy - energy[0]) > -0.2
+
+
+def test_an_adaptive_step_below_the_resolution_of_t_stops_with_a_typed_error():
+    # Error-controlled steps at t = 1e6 s whose Newton solves cannot converge (a tolerance of
+    # 1e-30 m, below round-off) shrink towards h_min = 1e-15 s; below 50 float spacings of t
+    # (5.8e-9 s) t + h no longer advances t by h, and the run stops there, naming the step, the
+    # time and the smallest resolved step (50 np.spacing(t), the reference), instead of taking
+    # steps that repeat times.
+    with pytest.raises(vinculo.StepSizeTooSmallError) as caught:
+        vinculo.simulate(
+            _pendulum(), t_start=1e6, t_end=1e6 + 0.01, dt=1e-6, adaptive=True, h_min=1e-15,
+            tolerance=1e-30, max_iterations=3,
+        )
+    error = caught.value
+    assert 1e6 <= error.time < 1e6 + 0.01
+    assert error.h_min == pytest.approx(50 * np.spacing(error.time), rel=1e-12)
+    assert error.step_size < error.h_min
+    assert np.all(np.diff(error.solution.times) > 0)
