@@ -18,6 +18,7 @@ from vinculo._core import ConstraintId, ForceId, Law, ParticleId, System, UserGr
 from vinculo.errors import (
     ConvergenceError,
     InconsistentInitialStateError,
+    InstabilityError,
     InternalError,
     Interrupted,
     InvalidInputError,
@@ -51,6 +52,7 @@ __all__ = [
     "ConvergenceError",
     "ForceId",
     "InconsistentInitialStateError",
+    "InstabilityError",
     "InternalError",
     "Interrupted",
     "InvalidInputError",

@@ -24,6 +24,7 @@ from typing import Any
 __all__ = [
     "ConvergenceError",
     "InconsistentInitialStateError",
+    "InstabilityError",
     "InternalError",
     "Interrupted",
     "InvalidInputError",
@@ -240,6 +241,32 @@ class StepSizeTooSmallError(ConvergenceError):
 
     h_min: float | None = None
     error_norm: float | None = None
+class InstabilityError(ConvergenceError):
+    """Index-3 generalised-alpha went unstable: the energy grew beyond what the model holds.
+
+    Raised by :func:`vinculo.simulate` with ``scheme='generalized-alpha'`` and the index-3
+    formulation when the mechanical energy of a model that takes in no energy (gravity, springs,
+    bending, drag, constraints that do not move) exceeds its initial value plus all the energy
+    the model can exchange: the scheme is unstable at that ``rho_inf`` and step (measured table in
+    the theory page "Time rules"). Use ``formulation='ggl'``, ``rho_inf <= 0.5``, or a smaller
+    step. ``solution`` holds every step before.
+
+    Attributes:
+        time: the time at the end of the step where the energy passed the bound (s).
+        step_size: the step size (s).
+        rho_inf: the scheme's spectral radius at infinite frequency.
+        energy: the mechanical energy reached (J).
+        initial_energy: the initial mechanical energy (J).
+        energy_bound: the bound it passed (J).
+        solution: the partial :class:`vinculo.Solution`.
+    """
+
+    rho_inf: float | None = None
+    energy: float | None = None
+    initial_energy: float | None = None
+    energy_bound: float | None = None
+
+
 class UserFunctionError(VinculoError, RuntimeError):
     """A Python function of a user force or constraint group raised an exception.
 

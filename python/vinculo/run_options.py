@@ -40,7 +40,10 @@ class RunOptions:
         tolerance: Newton stops when the scaled residual and the last increment (both lengths, see
             docs/theory/formulation.md) are below ``tolerance * system.length_scale()``.
         max_iterations: Newton iterations allowed per attempt.
-        max_halvings: how many times a failing step may be halved before giving up.
+        max_halvings: how many times a failing step may be halved before giving up (at most 30
+            are made: dt / 2^30 is a billionth of dt; larger values mean 30). A halved step
+            that the floating-point times cannot resolve (fewer than 50 spacings of t) stops
+            the run with a ``StepSizeTooSmallError`` instead.
         initial_tolerance: largest initial violation accepted, relative to the model's scales:
             ``|s_k Phi_k| <= initial_tolerance * length_scale`` for positions and
             ``|s_k (Phi_q v + Phi_t)| <= initial_tolerance * speed`` for velocities, the speed being

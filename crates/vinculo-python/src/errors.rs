@@ -80,6 +80,26 @@ fn details<'py>(py: Python<'py>, e: &Error) -> PyResult<Bound<'py, PyDict>> {
             d.set_item("h_min", h_min)?;
             d.set_item("error_norm", error)?;
         }
+        Error::StepBelowTimeResolution { t, h, smallest, .. } => {
+            d.set_item("time", t)?;
+            d.set_item("step_size", h)?;
+            d.set_item("h_min", smallest)?;
+        }
+        Error::EnergyGrowth {
+            t,
+            dt,
+            rho_inf,
+            energy,
+            initial,
+            bound,
+        } => {
+            d.set_item("time", t)?;
+            d.set_item("step_size", dt)?;
+            d.set_item("rho_inf", rho_inf)?;
+            d.set_item("energy", energy)?;
+            d.set_item("initial_energy", initial)?;
+            d.set_item("energy_bound", bound)?;
+        }
         Error::Interrupted { t } => d.set_item("time", t)?,
         Error::OutputTooLarge {
             t,

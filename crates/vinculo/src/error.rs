@@ -105,13 +105,14 @@ pub enum Error {
         equation: String,
     },
     /// The iteration matrix could not be factorised.
-    #[error("singular iteration matrix at t = {t:.6} s near {equation}: {detail}; the constraints may be redundant or leave the model under-determined")]
+    #[error("singular iteration matrix at t = {t:.6} s near {equation}: {detail}")]
     SingularMatrix {
         /// Time at the start of the failing step.
         t: f64,
         /// The equation (particle or constraint) where elimination found no pivot, if known.
         equation: String,
-        /// What the linear solver reported.
+        /// What the linear solver reported, and what the structure of the matrix says of the
+        /// cause (redundant constraints, or the mass and force block).
         detail: String,
     },
     /// Some constraint equations are combinations of others: the constraint gradients are
@@ -150,6 +151,36 @@ pub enum Error {
         h_min: f64,
         /// Weighted error norm of the last attempt (1 meets the tolerances).
         error: f64,
+    },
+    /// A step is too small for the floating-point times to resolve: t + h would not advance t
+    /// by h (to 1 %), so times would repeat or the steps taken differ from the ones integrated.
+    #[error("at t = {t:e} s the step {h:.3e} s is below the resolution of the time (floating-point spacing {spacing:.3e} s; a step must be >= {smallest:.3e} s there): use a larger dt (or, with error-controlled steps, looser rtol/atol), or count time from nearer 0 (a smaller t_start)")]
+    StepBelowTimeResolution {
+        /// Time at the start of the step.
+        t: f64,
+        /// The step that could not be taken.
+        h: f64,
+        /// The spacing of floating-point numbers at t.
+        spacing: f64,
+        /// The smallest step resolved there.
+        smallest: f64,
+    },
+    /// Index-3 generalised-alpha went unstable: the mechanical energy of a model that takes in
+    /// none grew beyond everything the model holds (`integrators/energy_guard.rs`).
+    #[error("index-3 generalised-alpha is unstable at this step: at t = {t:.6} s the mechanical energy is {energy:.4e} J, above {bound:.4e} J (initial {initial:.4e} J plus all the energy the model can exchange; it takes in none), with rho_inf = {rho_inf} and dt = {dt:.3e} s; use formulation='ggl' (stable at every step measured), or rho_inf <= 0.5 (stable from 10 steps a period on a pendulum), or a smaller step (rho_inf = 0.9 needs 100 steps a period of the fastest motion; docs/theory/time-rules.md has the measured table)")]
+    EnergyGrowth {
+        /// Time at the end of the step where the energy passed the bound.
+        t: f64,
+        /// The step size.
+        dt: f64,
+        /// The scheme's spectral radius at infinite frequency.
+        rho_inf: f64,
+        /// The mechanical energy reached (J).
+        energy: f64,
+        /// The initial mechanical energy (J).
+        initial: f64,
+        /// The bound it passed (J).
+        bound: f64,
     },
     /// A user function of a force or constraint group failed (raised an error).
     #[error("user function {call}() of group '{group}' failed at t = {t:.6} s: {message}")]
@@ -228,7 +259,10 @@ impl Error {
             Error::InconsistentInitialState { .. } => "InconsistentInitialStateError",
             Error::RedundantConstraints { .. } => "RedundantConstraintsError",
             Error::NegativeTension { .. } => "NegativeTensionError",
-            Error::StepSizeTooSmall { .. } => "StepSizeTooSmallError",
+            Error::EnergyGrowth { .. } => "InstabilityError",
+            Error::StepSizeTooSmall { .. } | Error::StepBelowTimeResolution { .. } => {
+                "StepSizeTooSmallError"
+            }
             Error::UserFunction { .. } => "UserFunctionError",
             Error::UserFunctionOutput { .. } => "UserFunctionOutputError",
             Error::ProjectionFailed { .. }
@@ -322,7 +356,7 @@ mod tests {
     use super::*;
 
     /// Number of variants of [`Error`] (the arms of [`ordinal`]).
-    const VARIANTS: usize = 18;
+    const VARIANTS: usize = 20;
 
     /// The position of a variant. An exhaustive match: a new variant does not compile until it
     /// has an arm here, and then [`one_of_each`] must give an example of it.
@@ -346,6 +380,8 @@ mod tests {
             Error::Snapshot { .. } => 15,
             Error::Interrupted { .. } => 16,
             Error::OutputTooLarge { .. } => 17,
+            Error::StepBelowTimeResolution { .. } => 18,
+            Error::EnergyGrowth { .. } => 19,
         }
     }
 
@@ -439,6 +475,20 @@ mod tests {
                 limit: 1e9,
                 limit_source: s("max_output_bytes"),
                 save_every: 1,
+            },
+            Error::StepBelowTimeResolution {
+                t: 1e6,
+                h: 1e-12,
+                spacing: 1.16e-10,
+                smallest: 5.8e-9,
+            },
+            Error::EnergyGrowth {
+                t: 5.0,
+                dt: 0.05,
+                rho_inf: 0.9,
+                energy: 1e3,
+                initial: 0.0,
+                bound: 9.81,
             },
         ]
     }

@@ -44,7 +44,10 @@ pub(crate) fn singular_error(system: &System, layout: &Layout, t: f64, s: Singul
     Error::SingularMatrix {
         t,
         equation,
-        detail: s.detail,
+        detail: format!(
+            "{}; the constraints may be redundant or leave the model under-determined",
+            s.detail
+        ),
     }
 }
 
@@ -72,7 +75,9 @@ fn solve_saddle(system: &System, ws: &mut StepWorkspace, q: &[Vec3], t: f64) -> 
         return Err(Error::SingularMatrix {
             t,
             equation: "an unidentified equation".into(),
-            detail: "the solution is not finite".into(),
+            detail: "the solution is not finite; the constraints may be redundant or leave the \
+                     model under-determined"
+                .into(),
         });
     }
     Ok(())

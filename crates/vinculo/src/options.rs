@@ -26,7 +26,9 @@ pub struct SimulationOptions {
     pub formulation: Formulation,
     /// Newton options (tolerance relative to the length scale).
     pub newton: NewtonOptions,
-    /// How many times a failing step may be halved before the run stops.
+    /// How many times a failing step may be halved before the run stops (at most 30 are
+    /// made, larger values mean 30; a halved step below the resolution of the time stops the
+    /// run with [`Error::StepBelowTimeResolution`]).
     pub max_halvings: usize,
     /// Largest scaled initial constraint violation accepted, relative to the length scale.
     pub initial_tolerance: f64,

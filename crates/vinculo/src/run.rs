@@ -35,14 +35,15 @@
 
 use crate::adaptive::ErrorControl;
 use crate::assembly::Layout;
-use crate::constraints::find_redundant;
+use crate::constraints::explain_singular;
 use crate::dense_output::StepEnds;
 use crate::error::{Error, Result};
 use crate::initial::{
     consistent_accelerations, scaled_velocity_violation, scaled_violation, singular_error,
 };
+use crate::integrators::energy_guard::EnergyGuard;
 use crate::integrators::{
-    Formulation, NewtonFailure, NewtonOptions, RuleState, StabilizedWorkspace, StepStart,
+    Formulation, NewtonFailure, NewtonOptions, RuleState, Scheme, StabilizedWorkspace, StepStart,
     StepWorkspace,
 };
 use crate::math::Vec3;
@@ -81,9 +82,42 @@ enum StepEnd {
     At(f64),
 }
 
+/// Most halvings the fixed-step grid holds: a step that fails at dt / 2^30 (a billionth of dt)
+/// has no step-size problem that further halving would solve, and the grid's count of units of
+/// dt / 2^30 stays exact in a float for 2^22 steps of dt; a larger `max_halvings` means 30.
+pub(crate) const MAX_GRID_HALVINGS: u32 = 30;
+
+/// Grid units after which the grid is restarted at the current time: beyond 2^52 the count no
+/// longer converts exactly to a float (and 2^64 would overflow); with the deepest grid that is
+/// every 2^22 steps of dt, and never in practice with the default 4 halvings.
+const MAX_GRID_UNITS: u64 = 1 << 52;
+
+/// Fewest floating-point spacings of t a step must span: t + h then advances t by h to within
+/// 1 % (the sum rounds by at most half a spacing). A smaller step would repeat times or take
+/// steps other than the ones the scheme integrates over.
+pub const STEP_IN_TIME_SPACINGS: f64 = 50.0;
+
+/// The spacing of floating-point numbers at `t` (the unit in the last place of |t|).
+pub fn time_spacing(t: f64) -> f64 {
+    let a = t.abs();
+    f64::from_bits(a.to_bits() + 1) - a
+}
+
+/// The error of a step `h` from `t` that the floating-point times cannot resolve (it spans fewer
+/// than [`STEP_IN_TIME_SPACINGS`] spacings at the larger of |t| and |t + h|), if it is one.
+pub(crate) fn unresolved_step(t: f64, h: f64) -> Option<Error> {
+    let spacing = time_spacing(t.abs().max((t + h).abs()));
+    (h < STEP_IN_TIME_SPACINGS * spacing).then_some(Error::StepBelowTimeResolution {
+        t,
+        h,
+        spacing,
+        smallest: STEP_IN_TIME_SPACINGS * spacing,
+    })
+}
+
 impl FixedSteps {
     fn new(dt: f64, max_halvings: usize, t0: f64) -> FixedSteps {
-        let top = max_halvings as u32;
+        let top = max_halvings.min(MAX_GRID_HALVINGS as usize) as u32;
         FixedSteps {
             top,
             unit: dt / f64::powi(2.0, top as i32),
@@ -122,7 +156,12 @@ impl FixedSteps {
         let t = match end {
             StepEnd::Natural => {
                 self.units += 1u64 << self.level;
-                self.t_grid + self.units as f64 * self.unit
+                let t = self.t_grid + self.units as f64 * self.unit;
+                if self.units >= MAX_GRID_UNITS {
+                    self.t_grid = t;
+                    self.units = 0;
+                }
+                t
             }
             StepEnd::At(t) => {
                 // Off the grid: start it afresh here.
@@ -275,6 +314,8 @@ pub struct Simulation<'a> {
     run: u64,
     /// The largest stored output allowed (None: no limit known; `output_size.rs`).
     output_limit: Option<OutputLimit>,
+    /// The growth guard of index-3 generalised-alpha (`integrators/energy_guard.rs`).
+    guard: Option<EnergyGuard>,
 }
 
 impl<'a> Simulation<'a> {
@@ -286,6 +327,24 @@ impl<'a> Simulation<'a> {
     /// [`Simulation::status`] holds the cause and which takes no step.
     pub fn new(system: &'a System, options: &SimulationOptions) -> Result<Simulation<'a>> {
         check_options(system, options)?;
+        // Fixed steps of dt must be resolved by the times of the whole run.
+        if options.step_control == StepControl::Fixed && options.t_end > options.t_start {
+            let far = options.t_start.abs().max(options.t_end.abs());
+            let spacing = time_spacing(far);
+            if options.dt < STEP_IN_TIME_SPACINGS * spacing {
+                return Err(Error::InvalidParameter {
+                    name: "dt".into(),
+                    value: options.dt,
+                    expected: format!(
+                        "must be at least {STEP_IN_TIME_SPACINGS} times the spacing of \
+                         floating-point times at t = {far:e} s ({spacing:.3e} s), i.e. >= \
+                         {:.3e} s, or t + dt does not advance t by dt; use a larger dt or \
+                         count time from nearer 0 (a smaller t_start)",
+                        STEP_IN_TIME_SPACINGS * spacing
+                    ),
+                });
+            }
+        }
         // A run whose stored output would not fit in memory is refused before it starts.
         let output_limit = OutputLimit::of(options)?;
         if let Some(e) = output_limit
@@ -351,7 +410,7 @@ impl<'a> Simulation<'a> {
         sol.formulation = options.formulation;
         let start = consistent_accelerations(system, &mut ws, &q, &v, t0).map_err(|e| match e {
             // Name the culprits when the matrix is singular because constraints are redundant.
-            Error::SingularMatrix { .. } => find_redundant(system, &q, t0, None).unwrap_or(e),
+            e @ Error::SingularMatrix { .. } => explain_singular(system, &q, t0, e),
             e => e,
         });
         // A failed user function is the cause of whatever else went wrong at the start.
@@ -421,6 +480,12 @@ impl<'a> Simulation<'a> {
             }
         }
         let rule = options.scheme.initial_state(&acc);
+        let guard = match (options.scheme, options.formulation) {
+            (Scheme::GeneralizedAlpha { rho_inf }, Formulation::Index3) => {
+                EnergyGuard::new(system, rho_inf, &q, &v)
+            }
+            _ => None,
+        };
         // Buffers of what only some runs do (allocated empty otherwise: at 10^6 particles each
         // array of 3-vectors is 24 MB).
         let adaptive = matches!(controller, Controller::Adaptive(_));
@@ -460,6 +525,7 @@ impl<'a> Simulation<'a> {
             },
             scratch,
             sol,
+            guard,
             fingerprint: fingerprint(system),
             run: NEXT_RUN.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
             output_limit,
@@ -721,6 +787,12 @@ impl Simulation<'_> {
             }
         };
         let ends_run = end == StepEnd::At(t_end);
+        // A step the times cannot resolve (a halved step, or an error-controlled one, far from
+        // t = 0) stops the run rather than repeat times.
+        if let Some(e) = unresolved_step(c.t, h_try) {
+            self.sol.status = Err(e);
+            return Next::Stop;
+        }
         let mut fresh_retry = false;
         loop {
             // Predictor: constant-acceleration extrapolation, last multipliers.
@@ -769,7 +841,8 @@ impl Simulation<'_> {
                     if retry {
                         return Next::Go;
                     }
-                    self.sol.status = Err(step_failure(system, &ws.layout, failure, c.t, h_try));
+                    let e = step_failure(system, &ws.layout, failure, c.t, h_try);
+                    self.sol.status = Err(explain_singular(system, &c.q, c.t, e));
                     return Next::Stop;
                 }
             }
@@ -888,6 +961,10 @@ impl Simulation<'_> {
         std::mem::swap(&mut c.lambda, &mut s.lambda_new);
         c.t = t_new;
         if let Some(e) = slack {
+            sol.status = Err(e);
+            return Next::Stop;
+        }
+        if let Some(e) = self.guard.and_then(|g| g.check(system, &c.q, &c.v, c.t, h)) {
             sol.status = Err(e);
             return Next::Stop;
         }

@@ -34,7 +34,7 @@ pub use distance::Distance;
 pub use fixed_coordinate::FixedCoordinate;
 pub use plane::Plane;
 pub use point_distance::PointDistance;
-pub use redundancy::{find_redundant, MAX_ENTRIES, RANK_TOLERANCE};
+pub use redundancy::{explain_singular, find_redundant, MAX_ENTRIES, RANK_TOLERANCE};
 pub use user::{ConstraintCall, ConstraintGroup, UserConstraint, UserConstraints};
 
 use crate::local::{Blocks, PerParticle, Rows};

@@ -120,6 +120,51 @@ pub fn find_redundant(
     None
 }
 
+/// What the structure of the matrix says of a singular-matrix error `e` at (q, t): the
+/// constraints named by [`find_redundant`] when their gradients are linearly dependent (the
+/// KKT matrix `[A, G^T; G, 0]` is singular whenever G loses row rank, whatever A); otherwise G
+/// has full rank, so the singular part is the block A = M/(beta h^2) + K + D/(gamma h) of the
+/// mass, the forces' stiffness K and damping D, restricted to the motions the constraints allow,
+/// and the error says so instead of suspecting the constraints. Other errors pass unchanged.
+pub fn explain_singular(system: &System, q: &[Vec3], t: f64, e: Error) -> Error {
+    let Error::SingularMatrix {
+        t: at,
+        equation,
+        detail,
+    } = e
+    else {
+        return e;
+    };
+    if let Some(redundant) = find_redundant(system, q, t, None) {
+        return redundant;
+    }
+    let m = system.constraints().len();
+    let free = system.particles().iter().filter(|p| !p.fixed).count();
+    if m.saturating_mul((3 * free).max(m)) > MAX_ENTRIES {
+        return Error::SingularMatrix {
+            t: at,
+            equation,
+            detail,
+        };
+    }
+    let reported = detail
+        .split("; the constraints may be redundant")
+        .next()
+        .unwrap_or(&detail)
+        .to_string();
+    Error::SingularMatrix {
+        t: at,
+        equation,
+        detail: format!(
+            "{reported}; the constraint gradients have full rank at this configuration (no \
+             constraint is redundant), so the singular part is the mass and force block on the \
+             motions the constraints allow: look for a force whose stiffness or damping cancels \
+             the inertia (a user force's Jacobian, a negative or huge stiffness), or a step too \
+             large for it"
+        ),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -190,5 +235,46 @@ mod tests {
             }
             other => panic!("expected a redundancy, got {other:?}"),
         }
+    }
+}
+
+#[cfg(test)]
+mod explain_tests {
+    use super::*;
+
+    fn singular() -> Error {
+        Error::SingularMatrix {
+            t: 0.5,
+            equation: "dynamics of particle 1 (x)".into(),
+            detail: "zero pivot; the constraints may be redundant or leave the model \
+                     under-determined"
+                .into(),
+        }
+    }
+
+    /// The structure decides the culprit: a repeated distance (G loses rank) is named as
+    /// redundant; a pendulum's single distance has a gradient of full rank, so the error points
+    /// at the mass and force block and no longer suspects the constraint.
+    #[test]
+    fn a_singular_matrix_is_blamed_on_what_its_structure_shows() {
+        let mut s = System::new([0.0, 0.0, -9.81]);
+        let a = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
+        let b = s
+            .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], false)
+            .unwrap();
+        s.add_distance(a, b, None).unwrap();
+        let q = s.initial_positions();
+        match explain_singular(&s, &q, 0.5, singular()) {
+            Error::SingularMatrix { detail, .. } => {
+                assert!(detail.contains("full rank"), "{detail}");
+                assert!(!detail.contains("may be redundant"), "{detail}");
+            }
+            other => panic!("expected a singular matrix, got {other:?}"),
+        }
+        s.add_distance(b, a, None).unwrap();
+        assert!(matches!(
+            explain_singular(&s, &q, 0.5, singular()),
+            Error::RedundantConstraints { index: 1, .. }
+        ));
     }
 }

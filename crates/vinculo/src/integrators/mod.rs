@@ -8,6 +8,7 @@
 //! A new rule is one file implementing [`TimeRule`] and one registration: a variant of
 //! [`Scheme`] and its arm in `with_rule!` below, the only `match` on the scheme.
 
+pub mod energy_guard;
 pub mod error_estimate;
 #[cfg(test)]
 pub(crate) mod fixtures;

@@ -5,6 +5,17 @@
 //! [`StepProblem`](super::StepProblem)); it reports the equation that dominates the residual when
 //! it fails.
 //!
+//! It also stops, converged, when the residual is below the tolerance and the increments have
+//! stopped decreasing: an increment made with a fresh matrix that is more than
+//! [`FLOOR_CONTRACTION`] of the one before. Newton's increments shrink quadratically until the
+//! residual reaches the round-off of the terms that cancel in it; from there each new increment
+//! is the matrix's inverse applied to that round-off, a random vector that does not shrink.
+//! Near a singular configuration (a mechanism whose bars are all collinear, where the constraint
+//! gradients lose rank and the multipliers of a self-stress are not determined) the inverse is
+//! large, so that those increments stay above the tolerance while the residual is 1e-15: no
+//! iterate is better than the current one, and going on could only fail. A residual above the
+//! tolerance never counts as converged.
+//!
 //! Full Newton assembles and factorises the iteration matrix J(x_k) at every iteration. Modified
 //! Newton ([`NewtonOptions::jacobian_reuse`]) keeps the last factorisation, across iterations and
 //! across steps, as long as it was made for the same step size and scheme coefficients (the
@@ -39,6 +50,13 @@ pub const MAX_CONTRACTION: f64 = 0.5;
 
 /// Iterations modified Newton makes with one matrix before refreshing it.
 pub const MAX_STALE_ITERATIONS: usize = 8;
+
+/// Ratio |dx_k| / |dx_{k-1}| (with a fresh matrix for dx_k) above which the increments count as
+/// no longer decreasing: with the residual below the tolerance, the iteration has reached the
+/// round-off floor and stops, converged (module documentation). Newton's method converges at
+/// least linearly with ratio 1/2 even at a singular solution, so a ratio above 0.9 is not
+/// convergence still under way.
+pub const FLOOR_CONTRACTION: f64 = 0.9;
 
 /// What the linear solver's current factorisation is, for reuse by modified Newton.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -207,6 +225,10 @@ pub fn solve(
     let mut increment = f64::INFINITY;
     let mut residual = f64::INFINITY;
     let mut worst = 0;
+    // The last increment and the one before, and whether the last one was made with a matrix
+    // factorised at that iteration.
+    let mut increment_before = f64::INFINITY;
+    let mut fresh = false;
     for iteration in 0..=options.max_iterations {
         problem.residual(r);
         residual = inf_norm(r);
@@ -217,7 +239,11 @@ pub fn solve(
                 worst: worst_entry(r),
             });
         }
-        if iteration > 0 && residual <= options.tolerance && increment <= options.tolerance {
+        let at_floor = fresh && increment > FLOOR_CONTRACTION * increment_before;
+        if iteration > 0
+            && residual <= options.tolerance
+            && (increment <= options.tolerance || at_floor)
+        {
             return Ok(NewtonReport {
                 iterations: iteration,
                 factorisations,
@@ -229,7 +255,8 @@ pub fn solve(
             worst = worst_entry(r);
             break;
         }
-        if refresh || stale_iterations >= MAX_STALE_ITERATIONS {
+        fresh = refresh || stale_iterations >= MAX_STALE_ITERATIONS;
+        if fresh {
             values.fill(0.0);
             problem.jacobian(values);
             matrix.invalidate();
@@ -241,6 +268,7 @@ pub fn solve(
             previous = f64::INFINITY;
         }
         solver.solve_in_place(r);
+        increment_before = increment;
         increment = inf_norm(r);
         stale_iterations += 1;
         refresh = !reuse || increment > MAX_CONTRACTION * previous;
@@ -258,4 +286,72 @@ pub fn solve(
         residual,
         worst,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::linear::DenseLu;
+
+    /// R(x) = a (x - 1) + e_k on one unknown, where e_k alternates between +e and -e: a residual
+    /// whose evaluation carries an error e (the round-off of terms that cancel) and a slope `a`.
+    struct Noisy {
+        x: f64,
+        slope: f64,
+        noise: f64,
+        calls: usize,
+    }
+
+    impl NewtonProblem for Noisy {
+        fn residual(&mut self, r: &mut [f64]) {
+            self.calls += 1;
+            let sign = if self.calls % 2 == 0 { 1.0 } else { -1.0 };
+            r[0] = self.slope * (self.x - 1.0) + sign * self.noise;
+        }
+        fn jacobian(&mut self, values: &mut [f64]) {
+            values[0] = self.slope;
+        }
+        fn update(&mut self, dx: &[f64]) {
+            self.x -= dx[0];
+        }
+    }
+
+    fn run(slope: f64, noise: f64) -> (Result<NewtonReport, NewtonFailure>, f64) {
+        let mut problem = Noisy {
+            x: 0.0,
+            slope,
+            noise,
+            calls: 0,
+        };
+        let mut solver: Box<dyn LinearSolver> = Box::new(DenseLu::new(1));
+        let (mut values, mut r) = (vec![0.0], vec![0.0]);
+        let mut matrix = IterationMatrix::default();
+        let work = LinearWork::new(&mut solver, &mut values, &mut r, &mut matrix);
+        let result = solve(&mut problem, work, [1.0, 1.0], &NewtonOptions::default());
+        (result, problem.x)
+    }
+
+    /// A slope of 1e-7 (a nearly singular matrix) and a residual round-off of 4e-15: the
+    /// increments bounce at noise / slope = 4e-8, above the tolerance 1e-10, while the residual
+    /// holds below it. The solve stops converged at the round-off floor, with x within
+    /// 2 noise / slope of the root x = 1 (the exact solution of the perturbed equation).
+    #[test]
+    fn a_residual_at_round_off_converges_even_when_the_increment_cannot_shrink() {
+        let (result, x) = run(1e-7, 4e-15);
+        let report = result.expect("converged at the round-off floor");
+        assert!(report.residual <= 1e-10, "{report:?}");
+        assert!(report.increment > 1e-10, "{report:?}");
+        assert!((x - 1.0).abs() <= 2.0 * 4e-15 / 1e-7, "x = {x}");
+    }
+
+    /// A residual that stagnates above the tolerance is still a failure: the floor is accepted
+    /// only where the equations hold to the tolerance.
+    #[test]
+    fn a_stagnating_residual_above_the_tolerance_fails() {
+        let (result, _) = run(1e-7, 4e-9);
+        assert!(
+            matches!(result, Err(NewtonFailure::NotConverged { .. })),
+            "{result:?}"
+        );
+    }
 }

@@ -29,6 +29,11 @@ pub trait LinearSolver: Send {
     fn solve_in_place(&mut self, rhs: &mut [f64]);
     /// Short name, for statistics.
     fn name(&self) -> &'static str;
+    /// Factorisations that a solver specialised to a structure handed to the general sparse LU
+    /// because its own pivots were (nearly) singular (see [`TreeElimination`]).
+    fn fallbacks(&self) -> usize {
+        0
+    }
 }
 
 /// Which solver a sparse pattern gets.

@@ -19,13 +19,29 @@
 //! entry). The solve is a forward sweep (leaves to roots, `z_b = D_b^-1 r_b`,
 //! `r_P -= A_Pb z_b`) and a backward sweep (roots to leaves, `x_b = z_b - W_b x_P`).
 //!
+//! The elimination pivots only inside a block, so a block may be singular or nearly so while the
+//! whole matrix is regular: the end particle of a straight leg whose link to its parent is
+//! parallel to its anchor (a chain hung as a V of two straight legs at rest), where the block
+//! holds two parallel conditions on one particle and only the parent's freedom makes the matrix
+//! regular. A block pivot below [`NEAR_SINGULAR`] of the block's largest entry therefore stops
+//! the elimination, and that factorisation is made by the general sparse LU (partial pivoting
+//! across the whole matrix, analysed on first need); only its failure is reported as a singular
+//! matrix. The next factorisation tries the tree again (the configuration moves on).
+//!
 //! The analysis works on the matrix pattern alone and checks that every structural entry lies
 //! inside a block or between a block and its parent's particle part; otherwise (a loop, a
 //! constraint on three particles, coupled multipliers) it declines and the caller falls back to
 //! the general sparse LU.
 
-use super::{LinearSolver, Singular};
+use super::{LinearSolver, Singular, SparseLu};
 use crate::assembly::{Pattern, Storage};
+
+/// Smallest pivot of a block, relative to the block's largest entry, that the elimination
+/// accepts; below it the factorisation falls back to the general sparse LU. The growth of the
+/// elimination's error is about the ratio of the block's largest entry to its smallest pivot,
+/// so this keeps at least half the digits of a double in the solve where the block is nearly
+/// singular.
+pub const NEAR_SINGULAR: f64 = 1e-8;
 
 const ABSENT: u32 = u32::MAX;
 const ROOT: u32 = u32::MAX;
@@ -57,6 +73,13 @@ pub struct TreeElimination {
     /// Per block: its diagonal block was gathered in the current factorisation.
     gathered: Vec<bool>,
     factored: bool,
+    /// The general sparse LU that factorises the matrices whose blocks are (nearly) singular,
+    /// analysed on first need.
+    fallback: Option<SparseLu>,
+    /// The last factorisation is the fallback's.
+    on_fallback: bool,
+    /// Factorisations made by the fallback.
+    fallbacks: usize,
 }
 
 /// Union-find root with path halving.
@@ -160,10 +183,25 @@ impl TreeElimination {
         }
         drop(fill);
         drop(edges);
+        // Each tree is rooted at its particle with the most multipliers of its own (fixed
+        // coordinates, planes, anchors): a particle whose three coordinates are prescribed then
+        // keeps the links to its neighbours out of its block, which would otherwise hold four
+        // conditions on three coordinates (a singular block in a regular matrix).
+        let mut own = vec![0u32; np];
+        for t in &touched {
+            if t[1] == ABSENT {
+                own[t[0] as usize] += 1;
+            }
+        }
+        let mut roots: Vec<u32> = (0..np as u32).collect();
+        if own.iter().any(|&k| k > 0) {
+            roots.sort_by_key(|&p| std::cmp::Reverse(own[p as usize]));
+        }
+        drop(own);
         let mut parent_particle = vec![ROOT; np];
         let mut seen = vec![false; np];
         let mut order: Vec<u32> = Vec::with_capacity(np);
-        for root in 0..np {
+        for root in roots.into_iter().map(|p| p as usize) {
             if seen[root] {
                 continue;
             }
@@ -202,6 +240,11 @@ impl TreeElimination {
         let mut size = vec![3usize; np];
         for t in &touched {
             size[owner(*t)] += 1;
+        }
+        // A block with more than three conditions on its particle's three coordinates is
+        // singular whatever the values: the general sparse LU pivots across blocks instead.
+        if size.iter().any(|&s| s > 6) {
+            return None;
         }
         let mut start = vec![0usize; np + 1];
         let mut diag_at = vec![0usize; np + 1];
@@ -288,12 +331,84 @@ impl TreeElimination {
             low_slots,
             up_slots,
             factored: false,
+            fallback: None,
+            on_fallback: false,
+            fallbacks: 0,
         })
     }
 
     /// Number of blocks (free particles).
     pub fn blocks(&self) -> usize {
         self.parent.len()
+    }
+
+    /// The matrix pattern, rebuilt from the slots of the blocks and couplings (which cover it
+    /// entry for entry, so the slots are the same), for the fallback's analysis.
+    fn pattern(&self) -> Pattern {
+        let n = self.unknowns.len();
+        let mut entries = Vec::with_capacity(self.diag_slots.len() + 2 * self.low_slots.len());
+        for b in 0..self.blocks() {
+            let local = &self.unknowns[self.start[b]..self.start[b + 1]];
+            let nb = local.len();
+            for (i, &ui) in local.iter().enumerate() {
+                for (j, &uj) in local.iter().enumerate() {
+                    if self.diag_slots[self.diag_at[b] + i * nb + j] != ABSENT {
+                        entries.push((ui as usize, uj as usize));
+                    }
+                }
+            }
+            if self.parent[b] != ROOT {
+                let pb = self.parent[b] as usize;
+                for r in 0..3 {
+                    let up = self.unknowns[self.start[pb] + r] as usize;
+                    for (j, &uj) in local.iter().enumerate() {
+                        if self.low_slots[3 * self.start[b] + r * nb + j] != ABSENT {
+                            entries.push((up, uj as usize));
+                        }
+                        if self.up_slots[3 * self.start[b] + j * 3 + r] != ABSENT {
+                            entries.push((uj as usize, up));
+                        }
+                    }
+                }
+            }
+        }
+        Pattern::new(n, entries, false)
+    }
+
+    /// Factorises with the general sparse LU (analysed on first use), after the block of local
+    /// unknown `failed` had a (nearly) singular pivot. The sparse LU's factors are checked by a
+    /// solve of a vector of ones: a zero pivot (an exactly singular matrix, which the numeric
+    /// factorisation does not report) makes it non-finite, and the matrix is then reported
+    /// singular at the block where the tree elimination stopped.
+    fn factor_by_fallback(&mut self, values: &[f64], failed: usize) -> Result<(), Singular> {
+        if self.fallback.is_none() {
+            self.fallback = Some(SparseLu::new(&self.pattern()));
+        }
+        let lu = self.fallback.as_mut().expect("analysed above");
+        self.fallbacks += 1;
+        let column = self.unknowns[failed] as usize;
+        let singular = |detail: String| Singular {
+            column: Some(column),
+            detail,
+        };
+        lu.factor(values).map_err(|e| {
+            singular(format!(
+                "negligible pivot in the block of unknown {column} (tree elimination), and the \
+                 general sparse LU failed too: {}",
+                e.detail
+            ))
+        })?;
+        self.z.fill(1.0);
+        lu.solve_in_place(&mut self.z);
+        if self.z.iter().any(|x| !x.is_finite()) {
+            return Err(singular(format!(
+                "negligible pivot in the block of unknown {column} (tree elimination), and a \
+                 zero pivot in the general sparse LU"
+            )));
+        }
+        self.on_fallback = true;
+        self.factored = true;
+        Ok(())
     }
 }
 
@@ -305,7 +420,7 @@ fn gather(out: &mut [f64], slots: &[u32], values: &[f64]) {
 }
 
 /// In-place LU with partial pivoting of the n x n row-major matrix `a`; returns the local
-/// column of a negligible pivot. On return the strict lower triangle holds L (unit diagonal),
+/// column of a pivot below [`NEAR_SINGULAR`] of the largest entry. On return the strict lower triangle holds L (unit diagonal),
 /// the strict upper triangle U, and the diagonal the reciprocals of U's pivots, so that the
 /// solves multiply where they would divide.
 #[inline(always)]
@@ -313,7 +428,7 @@ fn lu_in_place(a: &mut [f64], n: usize, perm: &mut [u32]) -> Result<(), usize> {
     // Slices of known length let the unrolled copies drop their bounds checks.
     let (a, perm) = (&mut a[..n * n], &mut perm[..n]);
     let largest = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let tiny = largest * 1e3 * f64::EPSILON * n as f64;
+    let tiny = largest * NEAR_SINGULAR;
     for k in 0..n {
         let mut p = k;
         for i in k + 1..n {
@@ -490,6 +605,7 @@ fn backward_fixed<const N: usize>(w: &[f64], xp: [f64; 3], zb: &mut [f64]) {
 impl LinearSolver for TreeElimination {
     fn factor(&mut self, values: &[f64]) -> Result<(), Singular> {
         self.factored = false;
+        self.on_fallback = false;
         // The matrix's entries are gathered block by block as the elimination reaches them (a
         // parent's diagonal block when its first child updates it), so that each block's numbers
         // are used while they are in cache: on a 10^6-particle chain the three separate passes
@@ -533,13 +649,9 @@ impl LinearSolver for TreeElimination {
                 _ => eliminate(d, nb, perm, coupling),
             };
             if let Err(k) = result {
-                let column = self.unknowns[s + k] as usize;
-                return Err(Singular {
-                    column: Some(column),
-                    detail: format!(
-                        "negligible pivot in the block of unknown {column} (tree elimination)"
-                    ),
-                });
+                // A (nearly) singular block need not mean a singular matrix: the sparse LU
+                // pivots across blocks, and its failure is the one reported.
+                return self.factor_by_fallback(values, s + k);
             }
         }
         self.factored = true;
@@ -548,6 +660,11 @@ impl LinearSolver for TreeElimination {
 
     fn solve_in_place(&mut self, rhs: &mut [f64]) {
         assert!(self.factored, "solve before a successful factorisation");
+        if self.on_fallback {
+            let lu = self.fallback.as_mut().expect("the fallback factorised");
+            lu.solve_in_place(rhs);
+            return;
+        }
         for (z, &u) in self.z.iter_mut().zip(&self.unknowns) {
             *z = rhs[u as usize];
         }
@@ -564,6 +681,10 @@ impl LinearSolver for TreeElimination {
 
     fn name(&self) -> &'static str {
         "tree elimination"
+    }
+
+    fn fallbacks(&self) -> usize {
+        self.fallbacks
     }
 }
 
@@ -793,6 +914,87 @@ mod tests {
         assert_eq!(name(&t), "tree elimination");
         t.add_distance(p[2], p[0], None).unwrap();
         assert_eq!(name(&t), "sparse LU");
+    }
+
+    /// Well-posed chains whose tree blocks are singular. `pinned` false: a chain hung from two
+    /// anchors 2 m apart as a V of two straight legs of `n` links each, at rest (the end particle
+    /// of the leg eliminated first holds two parallel conditions, its anchor and its link).
+    /// `pinned` true: a chain of `n` links hanging straight down from a free particle whose
+    /// three coordinates are prescribed, released with a sideways speed (the pinned particle's
+    /// block would hold four conditions on three coordinates, were it not the root).
+    fn awkward_chain(n: usize, pinned: bool) -> System {
+        let mut s = System::new([0.0, 0.0, -9.81]);
+        if pinned {
+            let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], false).unwrap();
+            for axis in 0..3 {
+                s.add_fixed_coordinate(prev, axis, None).unwrap();
+            }
+            for i in 1..=n {
+                let z = -(i as f64) / n as f64;
+                let v = [0.5 * i as f64 / n as f64, 0.0, 0.0];
+                let p = s.add_particle(0.1, [0.0, 0.0, z], v, false).unwrap();
+                s.add_distance(prev, p, None).unwrap();
+                prev = p;
+            }
+            return s;
+        }
+        let left = s
+            .add_particle(1.0, [-1.0, 0.0, 0.0], [0.0; 3], true)
+            .unwrap();
+        let right = s
+            .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], true)
+            .unwrap();
+        let mut prev = left;
+        for i in 1..2 * n {
+            let x = -1.0 + i as f64 / n as f64;
+            let z = -(1.0 - x.abs());
+            let p = s.add_particle(0.1, [x, 0.0, z], [0.0; 3], false).unwrap();
+            s.add_distance(prev, p, None).unwrap();
+            prev = p;
+        }
+        s.add_distance(prev, right, None).unwrap();
+        s
+    }
+
+    /// A V chain and a chain hanging from a pinned particle run with the tree elimination and
+    /// agree with the general sparse LU run to round-off (the reference: the same steps with
+    /// partial pivoting across the whole matrix), the chains having moved.
+    #[test]
+    fn singular_blocks_of_a_regular_matrix_fall_back_to_sparse_lu() {
+        for pinned in [false, true] {
+            let system = awkward_chain(12, pinned);
+            let run = |sparse_solver| {
+                let options = crate::SimulationOptions {
+                    t_end: 0.05,
+                    dt: 1e-3,
+                    sparse_solver,
+                    ..Default::default()
+                };
+                crate::simulate(&system, &options).unwrap()
+            };
+            let tree = run(SparseSolver::Auto);
+            let lu = run(SparseSolver::SparseLu);
+            assert_eq!(tree.linear_solver, "tree elimination");
+            assert!(tree.status.is_ok(), "pinned {pinned}: {:?}", tree.status);
+            assert!(lu.status.is_ok(), "pinned {pinned}: {:?}", lu.status);
+            let (a, b) = (&tree.positions, &lu.positions);
+            assert_eq!(a.len(), b.len());
+            let gap = a
+                .iter()
+                .zip(b)
+                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+            assert!(
+                gap < 1e-9,
+                "pinned {pinned}: positions differ by {gap:.3e} m"
+            );
+            // The chain moved (the legs sag): a run that stood still would agree trivially.
+            let last = &a[a.len() - 3 * tree.particles..];
+            let moved = last
+                .iter()
+                .zip(&a[..3 * tree.particles])
+                .fold(0.0f64, |m, (x, x0)| m.max((x - x0).abs()));
+            assert!(moved > 1e-4, "pinned {pinned}: moved {moved:.3e} m");
+        }
     }
 
     /// A rank-deficient tree matrix (a particle held by two identical fixed coordinates) is
