@@ -323,8 +323,15 @@ impl<'a> Simulation<'a> {
 
         let mut ws = StepWorkspace::with_solver(system, options.dense_limit, options.sparse_solver);
         ws.assemble_in_parallel_from(system, options.parallel_from);
+        // Error-controlled steps tie Newton's tolerance to theirs (`step_control.rs`).
+        let relative = match options.step_control {
+            StepControl::Adaptive(control) => {
+                control.newton_tolerance(options.newton.tolerance, length)
+            }
+            StepControl::Fixed => options.newton.tolerance,
+        };
         let newton = NewtonOptions {
-            tolerance: options.newton.tolerance * length,
+            tolerance: relative * length,
             ..options.newton
         };
         // The GGL steps have their own unknowns and solver; the index-3 workspace still serves
@@ -385,7 +392,6 @@ impl<'a> Simulation<'a> {
                 let weights = ErrorWeights {
                     time_scale: length / speed,
                     atol_q: control.atol,
-                    atol_v: control.atol * speed / length,
                     rtol: control.rtol,
                 };
                 Controller::Adaptive(Box::new(ErrorControl::new(
@@ -394,7 +400,6 @@ impl<'a> Simulation<'a> {
                     control,
                     weights,
                     options.dt,
-                    t0,
                     &acc,
                     ws.layout.unknowns(),
                 )))
@@ -786,11 +791,11 @@ impl Simulation<'_> {
                 let judged = control.judge(
                     system,
                     ws,
-                    self.stabilized.is_some(),
-                    c.step,
+                    self.stabilized.as_mut(),
+                    &self.newton,
+                    &s.rule_saved,
                     (c.t, h),
                     (&c.q, &c.v, &c.acc),
-                    &s.acc_new,
                 );
                 match judged {
                     Ok(true) => match end {

@@ -47,43 +47,35 @@
 //! For Newmark schemes this is the estimate of Zienkiewicz and Xie, e_q = (beta - 1/6) h^2
 //! (a_{n+1} - a_n): here A, A' and A'' come from the history of accelerations instead.
 //!
-//! **Where A, A', A'' come from.** Each accepted step leaves one raw acceleration sample at a
-//! known time tau: the trapezoidal rules the mean acceleration (v_{n+1} - v_n)/h = a(q_a, v_a, t_a),
-//! which is A(t_n + alpha h) + O(h^2); generalised-alpha the true acceleration qdd_{n+1} at
-//! t_n + h; the run starts with the consistent accelerations at t_0.
+//! **Where A, A', A'' come from: the step-end positions.** The positions of a run of a scheme
+//! of order p lie, to O(h^p), on a smooth curve (the solution of the scheme's modified
+//! equation), whose derivatives are the exact motion's plus O(h^p). The estimate takes them
+//! from the polynomial through the positions at the last five step ends, the new one included
+//! (a Newton divided-difference table over their times, any step sizes): its second, third and
+//! fourth derivatives at t_n are A, A' and A'' to O(h). Positions are the one state every
+//! scheme and formulation computes directly and holds on the constraints at every step end:
+//! they carry neither the undamped parasitic solution of the index-3 trapezoidal rule (velocities
+//! off the velocity constraints by (-1)^n eps, which cancels from q_{n+1} - q_n = h (v_n +
+//! v_{n+1})/2) nor the ringing multipliers, and their round-off eps |q| enters A' h^3 as about
+//! 8 eps |q| (and A'' h^3 as 16 eps |q| / h: the velocities' own round-off in the index-3
+//! formulation, where they are differences of positions; [`crate::step_control`] gives the
+//! velocities a tolerance floor of that size). Accelerations (what an estimate would otherwise
+//! difference) would carry both, amplified by 1/h^2.
 //!
-//! The raw samples are smoothed before they are differenced: each is averaged with the previous
-//! one, weighted by their steps, S = (h_n a_n + h_{n-1} a_{n-1})/(h_n + h_{n-1}) at the likewise
-//! weighted time (still A + O(h^2) there). The reason is the undamped parasitic solution of the
-//! index-3 trapezoidal rule (and of generalised-alpha at rho_inf = 1): velocities off by
-//! (-1)^n eps, which every change of step size excites and nothing damps, put (-1)^n 2 eps/h into
-//! the mean accelerations. Differenced twice it would give an h^3 A'' term of about eps whatever
-//! the step, and the controller would shrink the step without end. The average of two
-//! consecutive mean accelerations is (v_{n+1} - v_{n-1})/(h_n + h_{n-1}), from which the
-//! oscillation cancels exactly for any steps. (The oscillation does not grow; the estimate
-//! measures what each step adds.)
+//! The estimated errors are then cut to their part tangent to the constraints (the run loop
+//! does it with the step's factorised Newton matrix, `adaptive.rs`): the local error of the
+//! positions normal to the constraints is nil (they hold at every step end), and the normal
+//! part of the velocities' error is the drift off the velocity constraints, which the index-3
+//! formulation leaves to the scheme's accuracy by design.
 //!
-//! The samples are also cut to their part tangent to the constraints before they enter the
-//! history (the run loop does it with the step's factorised Newton matrix, one extra solve): the
-//! part normal to the constraints is what the multipliers impose, and in an index-3 solve it
-//! depends on the step itself (backward Euler's velocities are chords, off the velocity
-//! constraints by O(h); the trapezoidal multipliers ring), so it jumps whenever the step size
-//! changes and would make the estimate, and the step, collapse. The positions' local error normal
-//! to the constraints is nil anyway (they hold at every step end); the tangential part follows
-//! the motion along the constraints, which is what errors propagate in.
+//! The run starts with a history of virtual positions before t_0, on the parabola
+//! q_0 + s v_0 + s^2/2 a_0 of the consistent start (a jerk of zero): the first steps see only
+//! part of the jerk, which the run's small first step ([`crate::step_control`]) covers.
 //!
-//! With the new smoothed sample and the last two, divided differences give A'' (from three
-//! samples; 0 while only two exist) and A' at the midpoint tau_bar of the two newest, and Taylor
-//! steps move A' and A to t_n:
-//!
-//! ```text
-//! d1 = (S_new - S_1)/(tau_new - tau_1),    d2 = 2 (d1 - (S_1 - S_2)/(tau_1 - tau_2))/(tau_new - tau_2)
-//! A'(t_n) = d1 - (tau_bar - t_n) d2,         A(t_n) = S_new - s A'(t_n) - s^2/2 d2,  s = tau_new - t_n
-//! ```
-//!
-//! Limits: a law whose third derivative jumps (the end of a C2 ramp) shows up in the samples only
-//! as the step that crosses it is taken, and a long step across it can be accepted with too
-//! small an estimate; h_max bounds that. The velocity part uses the linear-force h^3 constant.
+//! Limits: a law whose third derivative jumps (the end of a C2 ramp) shows up in the positions
+//! only as the step that crosses it is taken, and a long step across it can be accepted with
+//! too small an estimate; h_max bounds that. The velocity part uses the linear-force h^3
+//! constant.
 
 use super::Scheme;
 use crate::math::Vec3;
@@ -108,98 +100,111 @@ impl ErrorConstants {
     }
 }
 
-/// Where, after t_n, a step of size `h` of `scheme` leaves its acceleration sample: t_n + alpha h
-/// for the trapezoidal rules (the mean acceleration), t_n + h for generalised-alpha
-/// ([`super::TimeRule::sample_offset`]).
-pub fn sample_offset(scheme: &Scheme, h: f64) -> f64 {
-    scheme.sample_offset(h)
-}
+/// How many past step ends the estimate uses besides the new one.
+pub const HISTORY: usize = 3;
 
-/// The acceleration samples of the accepted steps, smoothed (module documentation).
+/// The positions and velocities at the last [`HISTORY`] accepted step ends, newest first
+/// (module documentation).
 #[derive(Debug, Clone)]
-pub struct AccelerationHistory {
-    /// The last accepted raw sample: time, values and weight (its step; 0 for the start).
-    pub(crate) raw: (f64, Vec<Vec3>, f64),
-    /// The last two smoothed samples (time, values), newest first.
-    pub(crate) newest: (f64, Vec<Vec3>),
-    pub(crate) older: Option<(f64, Vec<Vec3>)>,
+pub struct StateHistory {
+    /// (time, positions, velocities) of the step ends, newest first.
+    pub(crate) nodes: Vec<(f64, Vec<Vec3>, Vec<Vec3>)>,
 }
 
-impl AccelerationHistory {
-    /// A history holding one sample: the accelerations `a` at time `tau` (the consistent
-    /// accelerations of the initial state, which need no smoothing).
-    pub fn new(tau: f64, a: &[Vec3]) -> AccelerationHistory {
-        AccelerationHistory {
-            raw: (tau, a.to_vec(), 0.0),
-            newest: (tau, a.to_vec()),
-            older: None,
-        }
+impl StateHistory {
+    /// The history at the start of a run at `t0` from (q, v) with the consistent accelerations
+    /// `a`: the step end t0 and virtual ones at t0 - k `h` on the parabola through the start
+    /// (module documentation).
+    pub fn new(t0: f64, h: f64, q: &[Vec3], v: &[Vec3], a: &[Vec3]) -> StateHistory {
+        let nodes = (0..HISTORY)
+            .map(|k| {
+                let s = -(k as f64) * h;
+                let mut p = q.to_vec();
+                let mut u = v.to_vec();
+                for i in 0..q.len() {
+                    for c in 0..3 {
+                        p[i][c] += s * v[i][c] + 0.5 * s * s * a[i][c];
+                        u[i][c] += s * a[i][c];
+                    }
+                }
+                (t0 + s, p, u)
+            })
+            .collect();
+        StateHistory { nodes }
     }
 
-    /// The smoothed sample's time and the weights of the new raw sample (of a step `h`) and of
-    /// the last one.
-    fn smoothing(&self, tau: f64, h: f64) -> (f64, f64, f64) {
-        let w_raw = self.raw.2;
-        let (w_new, w_old) = (h / (h + w_raw), w_raw / (h + w_raw));
-        (w_new * tau + w_old * self.raw.0, w_new, w_old)
+    /// Adds the state (`q`, `v`) of the accepted step end at `t` (dropping the oldest).
+    pub fn push(&mut self, t: f64, q: &[Vec3], v: &[Vec3]) {
+        let mut oldest = self.nodes.pop().expect("a full history");
+        oldest.0 = t;
+        oldest.1.copy_from_slice(q);
+        oldest.2.copy_from_slice(v);
+        self.nodes.insert(0, oldest);
     }
 
-    /// Adds the raw sample `a` at `tau` of an accepted step of size `h` (after the newest).
-    pub fn push(&mut self, tau: f64, a: &[Vec3], h: f64) {
-        let (tau_s, w_new, w_old) = self.smoothing(tau, h);
-        let mut buffer = match self.older.take() {
-            Some((_, buffer)) => buffer,
-            None => vec![[0.0; 3]; a.len()],
-        };
-        for (b, (a, r)) in buffer.iter_mut().zip(a.iter().zip(&self.raw.1)) {
-            for k in 0..3 {
-                b[k] = w_new * a[k] + w_old * r[k];
-            }
-        }
-        let previous = std::mem::replace(&mut self.newest, (tau_s, buffer));
-        self.older = Some(previous);
-        self.raw.0 = tau;
-        self.raw.1.copy_from_slice(a);
-        self.raw.2 = h;
-    }
-
-    /// Writes the estimated local errors of positions and velocities of a step of size `h` from
-    /// `t_n` whose raw acceleration sample is `a_new` at `tau_new` (module documentation).
-    #[allow(clippy::too_many_arguments)]
+    /// Writes the estimated local errors of positions and velocities of the step of size `h`
+    /// from `t_n` (the newest step end of the history) to the state (`q_new`, `v_new`) (module
+    /// documentation).
     pub fn estimate(
         &self,
         constants: &ErrorConstants,
-        t_n: f64,
-        h: f64,
-        tau_new: f64,
-        a_new: &[Vec3],
+        (t_n, h): (f64, f64),
+        (q_new, v_new): (&[Vec3], &[Vec3]),
         e_q: &mut [Vec3],
         e_v: &mut [Vec3],
     ) {
-        let (tau_s, w_new, w_old) = self.smoothing(tau_new, h);
-        let (tau_1, a_1) = (&self.newest.0, &self.newest.1);
-        let span = tau_s - tau_1;
-        let tau_bar = 0.5 * (tau_s + tau_1);
-        let s = tau_s - t_n;
+        // Nodes x_0 = t_n + h (the new end), x_1 = t_n, ... (newest first).
+        let mut x = [0.0; HISTORY + 1];
+        x[0] = t_n + h;
+        for (j, node) in self.nodes.iter().enumerate() {
+            x[j + 1] = node.0;
+        }
+        // Derivatives 1 to 3 at t_n of the Newton basis w_m(t) = prod_{j<m} (t - x_j).
+        let basis = newton_basis_derivatives(&x, t_n);
+        let derivatives = |new: f64, past: &dyn Fn(usize) -> f64| {
+            let mut table = [0.0; HISTORY + 1];
+            table[0] = new;
+            for (j, value) in table.iter_mut().enumerate().skip(1) {
+                *value = past(j - 1);
+            }
+            // In-place divided differences: table[m] = f[x_0, ..., x_m].
+            for level in 1..=HISTORY {
+                for m in (level..=HISTORY).rev() {
+                    table[m] = (table[m] - table[m - 1]) / (x[m] - x[m - level]);
+                }
+            }
+            let mut out = [0.0; 3];
+            for (d, value) in out.iter_mut().enumerate() {
+                *value = (0..=HISTORY).map(|m| table[m] * basis[m][d]).sum();
+            }
+            out
+        };
         let (h2, h3) = (h * h, h * h * h);
-        for i in 0..a_new.len() {
+        for i in 0..q_new.len() {
             for k in 0..3 {
-                let a_s = w_new * a_new[i][k] + w_old * self.raw.1[i][k];
-                let d1 = (a_s - a_1[i][k]) / span;
-                let d2 = match &self.older {
-                    Some((tau_2, a_2)) => {
-                        let d1_old = (a_1[i][k] - a_2[i][k]) / (tau_1 - tau_2);
-                        2.0 * (d1 - d1_old) / (tau_s - tau_2)
-                    }
-                    None => 0.0,
-                };
-                let jerk = d1 - (tau_bar - t_n) * d2;
-                let acceleration = a_s - s * jerk - 0.5 * s * s * d2;
+                let [_, acceleration, jerk] = derivatives(q_new[i][k], &|j| self.nodes[j].1[i][k]);
                 e_q[i][k] = constants.q2 * h2 * acceleration + constants.q3 * h3 * jerk;
-                e_v[i][k] = constants.v2 * h2 * jerk + constants.v3 * h3 * d2;
+                let [_, jerk_v, snap] = derivatives(v_new[i][k], &|j| self.nodes[j].2[i][k]);
+                e_v[i][k] = constants.v2 * h2 * jerk_v + constants.v3 * h3 * snap;
             }
         }
     }
+}
+
+/// The first, second and third derivatives at `t` of the Newton basis polynomials
+/// w_m(t) = prod_{j<m} (t - x_j), m = 0..=HISTORY (Leibniz's rule on each new linear factor).
+fn newton_basis_derivatives(x: &[f64; HISTORY + 1], t: f64) -> [[f64; 3]; HISTORY + 1] {
+    // Value and derivatives 0..=3 of w_m at t.
+    let mut w = [1.0, 0.0, 0.0, 0.0];
+    let mut out = [[0.0; 3]; HISTORY + 1];
+    for (m, row) in out.iter_mut().enumerate() {
+        *row = [w[1], w[2], w[3]];
+        let g = t - x[m];
+        for d in (0..4).rev() {
+            w[d] = w[d] * g + if d > 0 { d as f64 * w[d - 1] } else { 0.0 };
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -251,65 +256,81 @@ mod tests {
         vec![[0.0; 3], [x, 0.0, 0.0]]
     }
 
-    /// One step of size h from the exact state at t_n with an exact history: (true, estimated)
-    /// local errors of x and x'.
+    /// The exact motion at t_n + s through the state (x, x') at t_n (closed form): x and x'.
+    fn flow(x: f64, v: f64, s: f64) -> [f64; 2] {
+        let (c, sn) = ((W * s).cos(), (W * s).sin());
+        [
+            1.0 + (x - 1.0) * c + v / W * sn,
+            -(x - 1.0) * W * sn + v * c,
+        ]
+    }
+
+    /// A uniform run of `scheme` with steps h from the exact state at t_n - 4 h to t_n + h, its
+    /// history fed with the step ends as in a run: (true, estimated) local errors of x and x' of
+    /// the last step (true: against the exact motion through the run's state at t_n).
     fn one_step(scheme: Scheme, t_n: f64, h: f64) -> ([f64; 2], [f64; 2]) {
         let system = oscillator();
         let mut ws = StepWorkspace::new(&system, 48);
-        let e = exact(t_n);
-        let (q_n, v_n) = (state(e[0]), state(e[1]));
+        let t_0 = t_n - HISTORY as f64 * h;
+        let e = exact(t_0);
+        let (mut q, mut v) = (state(e[0]), state(e[1]));
         let newton = NewtonOptions {
             tolerance: 1e-15,
             ..Default::default()
         };
-        ws.state.q.copy_from_slice(&q_n);
-        ws.state.lambda.fill(0.0);
-        // The samples a uniform run of step h would have left, from the exact motion.
-        let offset = sample_offset(&scheme, h);
-        let tau_1 = t_n - h + offset;
-        let mut history =
-            AccelerationHistory::new(tau_1 - 3.0 * h, &state(exact(tau_1 - 3.0 * h)[2]));
-        for j in (0..3).rev() {
-            let tau = tau_1 - j as f64 * h;
-            history.push(tau, &state(exact(tau)[2]), h);
-        }
-        let start = StepStart::new(t_n, &q_n, &v_n, h);
-        let a_new = match scheme {
-            Scheme::GeneralizedTrapezoidal { alpha } => {
-                GeneralizedTrapezoidal { alpha }
-                    .step(&system, &mut ws, start, &newton)
-                    .unwrap();
-                state((ws.state.v[1][0] - v_n[1][0]) / h)
-            }
+        let mut history = StateHistory::new(t_0, h, &q, &v, &state(e[2]));
+        // Generalised-alpha's algorithmic acceleration of the exact motion (module
+        // documentation).
+        let mut alpha_state = match scheme {
             Scheme::GeneralizedAlpha { rho_inf } => {
-                let ga = GeneralizedAlpha { rho_inf };
-                let k = ga.coefficients();
+                let k = GeneralizedAlpha { rho_inf }.coefficients();
                 let delta = k.alpha_m - k.alpha_f;
                 let kappa = 0.5 * (1.0 - k.alpha_f) - (1.0 - k.alpha_m) * (0.5 + delta);
-                // The algorithmic acceleration of the exact motion (module documentation).
-                let a = e[2] + delta * h * e[3] + kappa * h * h * e[4];
-                let mut alpha_state = RuleState::new(&state(a));
-                alpha_state.acceleration = state(e[2]);
-                index3_step(ga, &system, &mut ws, start, &mut alpha_state, &newton).unwrap();
-                alpha_state.acceleration.clone()
+                let mut rule =
+                    RuleState::new(&state(e[2] + delta * h * e[3] + kappa * h * h * e[4]));
+                rule.acceleration = state(e[2]);
+                rule
             }
+            _ => RuleState::new(&state(e[2])),
         };
-        let exact_end = exact(t_n + h);
-        let truth = [
-            ws.state.q[1][0] - exact_end[0],
-            ws.state.v[1][0] - exact_end[1],
-        ];
         let (mut e_q, mut e_v) = (state(0.0), state(0.0));
-        history.estimate(
-            &ErrorConstants::of(&scheme),
-            t_n,
-            h,
-            t_n + offset,
-            &a_new,
-            &mut e_q,
-            &mut e_v,
-        );
-        (truth, [e_q[1][0], e_v[1][0]])
+        for n in 0..=HISTORY {
+            let t = t_0 + n as f64 * h;
+            ws.state.q.copy_from_slice(&q);
+            ws.state.lambda.fill(0.0);
+            let start = StepStart::new(t, &q, &v, h);
+            match scheme {
+                Scheme::GeneralizedTrapezoidal { alpha } => {
+                    GeneralizedTrapezoidal { alpha }
+                        .step(&system, &mut ws, start, &newton)
+                        .unwrap();
+                }
+                Scheme::GeneralizedAlpha { rho_inf } => {
+                    let ga = GeneralizedAlpha { rho_inf };
+                    index3_step(ga, &system, &mut ws, start, &mut alpha_state, &newton).unwrap();
+                }
+            }
+            if n == HISTORY {
+                let constants = ErrorConstants::of(&scheme);
+                history.estimate(
+                    &constants,
+                    (t, h),
+                    (&ws.state.q, &ws.state.v),
+                    &mut e_q,
+                    &mut e_v,
+                );
+                let exact_end = flow(q[1][0], v[1][0], h);
+                let truth = [
+                    ws.state.q[1][0] - exact_end[0],
+                    ws.state.v[1][0] - exact_end[1],
+                ];
+                return (truth, [e_q[1][0], e_v[1][0]]);
+            }
+            q.copy_from_slice(&ws.state.q);
+            v.copy_from_slice(&ws.state.v);
+            history.push(t + h, &q, &v);
+        }
+        unreachable!()
     }
 
     /// The estimate of one step from the exact state matches the true local error of positions
@@ -348,29 +369,38 @@ mod tests {
         }
     }
 
-    /// A history with one sample (the start) gives A' from two samples and no A'' term.
+    /// On a cubic motion the divided differences are exact: a history of x(t) = t^3 (and its
+    /// velocity 3 t^2... for the velocity table, v(t) = t^3 too) at uneven times gives
+    /// A, A' = 6 t, 6 at t_n from positions and A', A'' = 6 t, 6 from v = t^3 (by hand).
     #[test]
-    fn a_single_sample_gives_the_first_difference() {
-        let history = AccelerationHistory::new(0.0, &[[1.0, 2.0, 3.0]]);
-        let constants = ErrorConstants {
-            q2: 0.0,
-            q3: 1.0,
-            v2: 1.0,
-            v3: 1.0,
-        };
+    fn derivatives_of_a_cubic_are_exact() {
+        let x = |t: f64| [t.powi(3), 0.0, 0.0];
+        let mut history = StateHistory::new(-1.0, 0.1, &[x(-1.0)], &[x(-1.0)], &[[0.0; 3]]);
+        for t in [-0.4, -0.25, 0.1] {
+            history.push(t, &[x(t)], &[x(t)]);
+        }
+        let (t_n, h) = (0.1, 0.3);
+        let new = [x(t_n + h)];
         let (mut e_q, mut e_v) = ([[0.0; 3]], [[0.0; 3]]);
-        // A linear acceleration 1 + 2 t in x: A' = 2 exactly.
+        let only = |q2, q3, v2, v3| ErrorConstants { q2, q3, v2, v3 };
         history.estimate(
-            &constants,
-            0.0,
-            0.5,
-            0.5,
-            &[[2.0, 2.0, 3.0]],
+            &only(1.0, 0.0, 1.0, 0.0),
+            (t_n, h),
+            (&new, &new),
             &mut e_q,
             &mut e_v,
         );
-        assert!((e_q[0][0] - 2.0 * 0.125).abs() < 1e-15);
-        assert!((e_v[0][0] - 2.0 * 0.25).abs() < 1e-15);
+        assert!((e_q[0][0] / (h * h) - 6.0 * t_n).abs() < 1e-12);
+        assert!((e_v[0][0] / (h * h) - 6.0 * t_n).abs() < 1e-12);
+        history.estimate(
+            &only(0.0, 1.0, 0.0, 1.0),
+            (t_n, h),
+            (&new, &new),
+            &mut e_q,
+            &mut e_v,
+        );
+        assert!((e_q[0][0] / (h * h * h) - 6.0).abs() < 1e-10);
+        assert!((e_v[0][0] / (h * h * h) - 6.0).abs() < 1e-10);
         assert_eq!(e_q[0][1], 0.0);
     }
 }

@@ -236,11 +236,6 @@ impl TimeRule for GeneralizedAlpha {
         }
     }
 
-    /// t_n + h: the true acceleration of the step's end.
-    fn sample_offset(&self, h: f64) -> f64 {
-        h
-    }
-
     /// At t_{n+1}, rows scaled by 1/(c m_ref) (module documentation).
     fn point(&self, start: &StepStart, mass_ref: f64) -> StepPoint {
         let (k, h) = (self.coefficients(), start.h);

@@ -20,7 +20,7 @@ mod step_problem;
 mod trapezoidal;
 mod workspace;
 
-pub use error_estimate::{AccelerationHistory, ErrorConstants};
+pub use error_estimate::{ErrorConstants, StateHistory};
 pub use generalized_alpha::{AlphaCoefficients, AlphaStep, GeneralizedAlpha};
 
 pub use newton::{
@@ -102,11 +102,6 @@ impl Scheme {
     /// The constants of the local-error estimate.
     pub fn error_constants(&self) -> ErrorConstants {
         with_rule!(*self, rule => rule.error_constants())
-    }
-
-    /// Where, after t_n, a step of size `h` leaves its acceleration sample.
-    pub fn sample_offset(&self, h: f64) -> f64 {
-        with_rule!(*self, rule => rule.sample_offset(h))
     }
 
     /// The rule's state at the start of a run with the consistent accelerations `acc`.

@@ -170,9 +170,6 @@ pub trait TimeRule: Copy + Send + Sync {
     /// The constants of the local-error estimate (`integrators/error_estimate.rs`).
     fn error_constants(&self) -> ErrorConstants;
 
-    /// Where, after t_n, a step of size `h` leaves its acceleration sample.
-    fn sample_offset(&self, h: f64) -> f64;
-
     /// The state at the start of a run with the consistent accelerations `acc`
     /// ([`RuleState::new`]; rules that carry no accelerations may leave it empty).
     fn initial_state(&self, acc: &[Vec3]) -> RuleState {

@@ -77,11 +77,6 @@ impl TimeRule for GeneralizedTrapezoidal {
         }
     }
 
-    /// t_n + alpha h: the mean acceleration of the step.
-    fn sample_offset(&self, h: f64) -> f64 {
-        self.alpha * h
-    }
-
     /// At t_n + alpha h, rows scaled by alpha h^2 / m_ref.
     fn point(&self, start: &StepStart, mass_ref: f64) -> StepPoint {
         let (alpha, h) = (self.alpha, start.h);
