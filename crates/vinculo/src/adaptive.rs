@@ -53,6 +53,7 @@ pub(crate) struct ErrorControl {
     pub(crate) free: Vec<bool>,
     pub(crate) projection: Vec<f64>,
     pub(crate) e_q: Vec<Vec3>,
+    pub(crate) e_v: Vec<Vec3>,
     pub(crate) q_big: Vec<Vec3>,
     pub(crate) v_big: Vec<Vec3>,
     pub(crate) lambda_big: Vec<f64>,
@@ -85,6 +86,7 @@ impl ErrorControl {
             free: system.particles().iter().map(|p| !p.fixed).collect(),
             projection: vec![0.0; unknowns],
             e_q: acc.to_vec(),
+            e_v: acc.to_vec(),
             q_big: acc.to_vec(),
             v_big: acc.to_vec(),
             lambda_big: Vec::new(),
@@ -103,6 +105,7 @@ impl ErrorControl {
         self.projection.resize(unknowns, 0.0);
         for a in [
             &mut self.e_q,
+            &mut self.e_v,
             &mut self.q_big,
             &mut self.v_big,
             &mut self.q_mid,
@@ -198,6 +201,7 @@ impl ErrorControl {
             for i in 0..q.len() {
                 for c in 0..3 {
                     self.e_q[i][c] = factor * (self.q_big[i][c] - ws.state.q[i][c]);
+                    self.e_v[i][c] = factor * (self.v_big[i][c] - ws.state.v[i][c]);
                 }
             }
         }
@@ -215,7 +219,17 @@ impl ErrorControl {
             factor_saddle(system, ws, &self.q_big, t + h)?;
         }
         tangential(ws, &mut self.e_q, &mut self.projection);
-        self.err = self.weights.norm(h, &self.free, &self.e_q, q, &self.q_big);
+        // The velocities' difference holds twice the start's drift off the velocity constraints
+        // (index 3: v_{n+1} = 2 (q_{n+1} - q_n)/h - v_n carries -v_n's normal part, two half
+        // steps +v_n's), normal to the constraints at the start: projected there, what is left
+        // of it is O(h) times the drift.
+        factor_saddle(system, ws, q, t)?;
+        ws.matrix.invalidate();
+        tangential(ws, &mut self.e_v, &mut self.projection);
+        let ends = [(q, v), (&self.q_big[..], &self.v_big[..])];
+        self.err = self
+            .weights
+            .norm(h, &self.free, (&self.e_q, &self.e_v), ends);
         Ok(!self.err.is_nan() && self.err <= 1.0)
     }
 

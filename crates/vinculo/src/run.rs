@@ -392,6 +392,7 @@ impl<'a> Simulation<'a> {
                 let weights = ErrorWeights {
                     time_scale: length / speed,
                     atol_q: control.atol,
+                    atol_v: control.atol * speed / length,
                     rtol: control.rtol,
                 };
                 Controller::Adaptive(Box::new(ErrorControl::new(

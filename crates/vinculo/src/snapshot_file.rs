@@ -26,13 +26,13 @@
 //! |---|---|
 //! | scheme: tag (0: generalised trapezoidal, 1: generalised-alpha) and its parameter (alpha, rho_inf) | u8, f64 |
 //! | options: rtol, atol, h_min, h_max, hold | 5 x f64 |
-//! | error weights: time scale, atol, rtol | 3 x f64 |
+//! | error weights: time scale, atol_q, atol_v, rtol | 4 x f64 |
 //! | PI controller: order k, last error norm, last attempt rejected (0 or 1), hold | f64, f64, u8, f64 |
 //! | next step size h, error norm of the last judged step | 2 x f64 |
 //! | error-estimate constants q2, q3, v2, v3 | 4 x f64 |
 //!
 //! Version 1 is version 3 with fixed steps only (tag 0). Version 2 also kept an acceleration
-//! history (and a velocity tolerance) for the error estimate, which step doubling no longer
+//! history for the error estimate, which step doubling no longer
 //! needs; its files with fixed steps are still read, those of error-controlled runs refused.
 //! Snapshots of runs that stopped are not saved.
 
@@ -95,7 +95,7 @@ impl Writer {
         self.f64(parameter);
         let (c, w) = (&e.control, &e.weights);
         self.f64s(&[c.rtol, c.atol, c.h_min, c.h_max, c.hold]);
-        self.f64s(&[w.time_scale, w.atol_q, w.rtol]);
+        self.f64s(&[w.time_scale, w.atol_q, w.atol_v, w.rtol]);
         self.f64s(&[e.pi.k, e.pi.previous]);
         self.0.push(e.pi.rejected as u8);
         self.f64s(&[e.pi.hold, e.h, e.err]);
@@ -192,10 +192,11 @@ impl Reader<'_> {
             h_max,
             hold,
         };
-        let [time_scale, atol_q, rtol] = self.f64s()?;
+        let [time_scale, atol_q, atol_v, rtol] = self.f64s()?;
         let weights = ErrorWeights {
             time_scale,
             atol_q,
+            atol_v,
             rtol,
         };
         let [k, previous] = self.f64s()?;
@@ -220,6 +221,7 @@ impl Reader<'_> {
             free: Vec::new(),
             projection: Vec::new(),
             e_q: Vec::new(),
+            e_v: Vec::new(),
             q_big: Vec::new(),
             v_big: Vec::new(),
             lambda_big: Vec::new(),

@@ -171,29 +171,41 @@ pub struct ErrorWeights {
     pub time_scale: f64,
     /// Absolute tolerance of positions (m).
     pub atol_q: f64,
+    /// Absolute tolerance of velocities (m/s).
+    pub atol_v: f64,
     /// Relative tolerance.
     pub rtol: f64,
 }
 
 impl ErrorWeights {
-    /// The weighted RMS norm of the position errors `e_q` of a step of size `h` over the
-    /// particles marked `free`, per unit step (module documentation), with the positions at both
-    /// ends of the step.
-    pub fn norm(&self, h: f64, free: &[bool], e_q: &[Vec3], q_0: &[Vec3], q_1: &[Vec3]) -> f64 {
-        let mut sum = 0.0;
+    /// The error norm of a step of size `h` with the position and velocity errors `e` over the
+    /// particles marked `free`, with the states (q, v) at both ends of the step `ends`: the
+    /// larger of the positions' weighted RMS norm per unit step and the velocities' per step
+    /// (module documentation).
+    pub fn norm(
+        &self,
+        h: f64,
+        free: &[bool],
+        (e_q, e_v): (&[Vec3], &[Vec3]),
+        [(q_0, v_0), (q_1, v_1)]: [(&[Vec3], &[Vec3]); 2],
+    ) -> f64 {
+        let (mut sum_q, mut sum_v) = (0.0, 0.0);
         let mut count = 0usize;
         for i in (0..free.len()).filter(|&i| free[i]) {
             for k in 0..3 {
                 let w_q = self.atol_q + self.rtol * q_0[i][k].abs().max(q_1[i][k].abs());
-                sum += (e_q[i][k] / w_q).powi(2);
+                let w_v = self.atol_v + self.rtol * v_0[i][k].abs().max(v_1[i][k].abs());
+                sum_q += (e_q[i][k] / w_q).powi(2);
+                sum_v += (e_v[i][k] / w_v).powi(2);
                 count += 1;
             }
         }
         if count == 0 {
-            0.0
-        } else {
-            (sum / count as f64).sqrt() * (self.time_scale / h).max(1.0)
+            return 0.0;
         }
+        let n = count as f64;
+        let positions = (sum_q / n).sqrt() * (self.time_scale / h).max(1.0);
+        positions.max((sum_v / n).sqrt())
     }
 }
 
@@ -304,23 +316,30 @@ mod tests {
     }
 
     /// The RMS norm of errors equal to their weights is 1 for steps longer than the time scale;
-    /// fixed particles do not count.
+    /// fixed particles do not count; positions count per unit step, velocities per step.
     #[test]
     fn weighted_norm() {
         let weights = ErrorWeights {
             time_scale: 0.5,
             atol_q: 1e-3,
+            atol_v: 1e-2,
             rtol: 0.1,
         };
         let q = [[1.0, 0.0, 0.0], [5.0, 5.0, 5.0]];
-        let q_1 = [[1.0, 2.0, 0.0], [5.0, 5.0, 5.0]];
-        // Weights of the free particle: 0.101, 0.201, 0.001.
-        let e_q = [[0.101, -0.201, 0.001], [9.0; 3]];
-        let err = weights.norm(1.0, &[true, false], &e_q, &q, &q_1);
+        let v = [[0.0, 2.0, 0.0], [0.0; 3]];
+        // Weights of the free particle: q: 0.101, 0.001, 0.001; v: 0.01, 0.21, 0.01.
+        let e_q = [[0.101, -0.001, 0.001], [9.0; 3]];
+        let e_v = [[0.01, 0.21, -0.01], [9.0; 3]];
+        let ends = [(&q[..], &v[..]), (&q[..], &v[..])];
+        let err = weights.norm(1.0, &[true, false], (&e_q, &e_v), ends);
         assert!((err - 1.0).abs() < 1e-12, "{err}");
-        // Per unit step: a step of a tenth of the time scale counts ten times.
-        let err = weights.norm(0.05, &[true, false], &e_q, &q, &q_1);
+        // Per unit step: a step of a tenth of the time scale counts the positions ten times.
+        let err = weights.norm(0.05, &[true, false], (&e_q, &e_v), ends);
         assert!((err - 10.0).abs() < 1e-11, "{err}");
+        // The velocities count per step: without position errors the norm stays 1.
+        let none = [[0.0; 3]; 2];
+        let err = weights.norm(0.05, &[true, false], (&none, &e_v), ends);
+        assert!((err - 1.0).abs() < 1e-12, "{err}");
     }
 
     /// Every bad option is refused with its name.
