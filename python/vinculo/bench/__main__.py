@@ -137,7 +137,13 @@ def compare(quick: bool = False, repeat: int = 3, out=print, full_newton: bool =
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Command line entry point."""
+    """Command line entry point (``work-precision`` as the first argument: the work-precision
+    table of :mod:`vinculo.bench.work_precision`)."""
+    argv = sys.argv[1:] if argv is None else argv
+    if argv[:1] == ["work-precision"]:
+        from vinculo.bench import work_precision
+
+        return work_precision.main(argv[1:])
     parser = argparse.ArgumentParser(prog="python -m vinculo.bench", description=__doc__)
     parser.add_argument("--quick", action="store_true", help="small models only (smoke run)")
     parser.add_argument("--no-scaling", action="store_true", help="skip the scaling run")
