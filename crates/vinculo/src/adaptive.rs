@@ -27,7 +27,8 @@ use crate::assembly::NONE;
 use crate::error::{Error, Result};
 use crate::initial::factor_saddle;
 use crate::integrators::{
-    ErrorConstants, NewtonOptions, RuleState, Scheme, StabilizedWorkspace, StepStart, StepWorkspace,
+    richardson_factor, NewtonOptions, RuleState, Scheme, StabilizedWorkspace, StepStart,
+    StepWorkspace,
 };
 use crate::math::Vec3;
 use crate::model::System;
@@ -45,7 +46,6 @@ pub(crate) struct ErrorControl {
     pub(crate) pi: PiController,
     /// The next step size.
     pub(crate) h: f64,
-    pub(crate) constants: ErrorConstants,
     /// The rule's state along the two half steps (a copy of the state before the step).
     pub(crate) rule_half: Option<RuleState>,
     /// Error norm of the step being judged.
@@ -80,7 +80,6 @@ impl ErrorControl {
             weights,
             pi: PiController::new(scheme.order(), control.hold),
             h: dt,
-            constants: scheme.error_constants(),
             rule_half: None,
             err: 0.0,
             free: system.particles().iter().map(|p| !p.fixed).collect(),
@@ -197,7 +196,7 @@ impl ErrorControl {
         if converged {
             // Richardson: the step's error C h^(p+1) exceeds that of the two halves by
             // (1 - 2^-p) C h^(p+1).
-            let factor = 1.0 / (1.0 - 0.5f64.powi(self.scheme.order() as i32));
+            let factor = richardson_factor(self.scheme.order());
             for i in 0..q.len() {
                 for c in 0..3 {
                     self.e_q[i][c] = factor * (self.q_big[i][c] - ws.state.q[i][c]);

@@ -29,7 +29,6 @@
 //! | error weights: time scale, atol_q, atol_v, rtol | 4 x f64 |
 //! | PI controller: order k, last error norm, last attempt rejected (0 or 1), hold | f64, f64, u8, f64 |
 //! | next step size h, error norm of the last judged step | 2 x f64 |
-//! | error-estimate constants q2, q3, v2, v3 | 4 x f64 |
 //!
 //! Version 1 is version 3 with fixed steps only (tag 0). Version 2 also kept an acceleration
 //! history for the error estimate, which step doubling no longer
@@ -40,7 +39,7 @@ use std::path::Path;
 
 use crate::adaptive::ErrorControl;
 use crate::error::{Error, Result};
-use crate::integrators::{ErrorConstants, RuleState, Scheme};
+use crate::integrators::{RuleState, Scheme};
 use crate::math::Vec3;
 use crate::run::{Carried, Controller, FixedSteps, Fnv, Snapshot};
 use crate::step_control::{AdaptiveOptions, ErrorWeights, PiController};
@@ -99,8 +98,6 @@ impl Writer {
         self.f64s(&[e.pi.k, e.pi.previous]);
         self.0.push(e.pi.rejected as u8);
         self.f64s(&[e.pi.hold, e.h, e.err]);
-        let k = &e.constants;
-        self.f64s(&[k.q2, k.q3, k.v2, k.v3]);
     }
 }
 
@@ -208,14 +205,12 @@ impl Reader<'_> {
             rejected,
             hold,
         };
-        let [q2, q3, v2, v3] = self.f64s()?;
         Ok(ErrorControl {
             scheme,
             control,
             weights,
             pi,
             h,
-            constants: ErrorConstants { q2, q3, v2, v3 },
             rule_half: None,
             err,
             free: Vec::new(),

@@ -342,6 +342,26 @@ mod tests {
         assert!((err - 1.0).abs() < 1e-12, "{err}");
     }
 
+    /// Newton's tolerance is the run's unless a hundredth of the error tolerance (relative to
+    /// the length scale) is smaller, and never below the floor.
+    #[test]
+    fn newton_tolerance_follows_the_error_tolerance() {
+        let tight = |rtol: f64, atol: f64| AdaptiveOptions {
+            rtol,
+            atol,
+            ..AdaptiveOptions::default()
+        };
+        assert_eq!(tight(1e-3, 1e-3).newton_tolerance(1e-10, 1.0), 1e-10);
+        assert!((tight(1e-8, 1e-8).newton_tolerance(1e-10, 1.0) - 1e-10).abs() < 1e-25);
+        assert!((tight(1e-9, 1e-6).newton_tolerance(1e-10, 1.0) - 1e-11).abs() < 1e-26);
+        // atol is a length: 1e-9 m on a 10 m model is 1e-10 of it.
+        assert!((tight(1e-6, 1e-9).newton_tolerance(1e-10, 10.0) - 1e-12).abs() < 1e-27);
+        assert_eq!(
+            tight(1e-14, 1e-14).newton_tolerance(1e-10, 1.0),
+            NEWTON_FLOOR
+        );
+    }
+
     /// Every bad option is refused with its name.
     #[test]
     fn bad_options_are_named() {
