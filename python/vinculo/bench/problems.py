@@ -98,7 +98,8 @@ class Problem:
         return np.concatenate([np.asarray(self.theta0, dtype=float), np.zeros(len(self.masses))])
 
     def cartesian(self, t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The bobs' positions and velocities, shape (len(t), n, 3), from y of shape (len(t), 2n)."""
+        """The bobs' positions and velocities, shape (len(t), n, 3), from y of shape
+        (len(t), 2n)."""
         n = len(self.masses)
         th, om = y[:, :n], y[:, n:]
         ell = np.asarray(self.links)
@@ -140,7 +141,7 @@ class Problem:
             system.add_plane(prev, (0.0, 0.0, 1.0), (0.0, 0.0, 0.0))
             law = vinculo.sine(self.amplitude, self.frequency)
             system.add_plane(prev, (1.0, 0.0, 0.0), (law, 0.0, 0.0))
-        for i, (mass, link) in enumerate(zip(self.masses, self.links)):
+        for i, (mass, link) in enumerate(zip(self.masses, self.links, strict=True)):
             bob = system.add_particle(mass, q0[0, i], velocity=v0[0, i])
             if i > 0 or self.slider:
                 system.add_distance(prev, bob, link)

@@ -152,7 +152,8 @@ def table(points: list[Point], out=print) -> None:
     methods = list(dict.fromkeys(p.method for p in points))
     header = f"{'problem':<13} {'tol':>6} " + " ".join(f"{m:>34}" for m in methods)
     out(header)
-    out(f"{'':<13} {'':>6} " + " ".join(f"{'error (m)  err/tol  CPU ms  steps':>34}" for _ in methods))
+    columns = f"{'error (m)  err/tol  CPU ms  steps':>34}"
+    out(f"{'':<13} {'':>6} " + " ".join(columns for _ in methods))
     rows: dict[tuple[str, float], dict[str, Point]] = {}
     for p in points:
         rows.setdefault((p.problem, p.tol), {})[p.method] = p
@@ -181,7 +182,7 @@ def plot(points: list[Point], path: str) -> None:
     problems = list(dict.fromkeys(p.problem for p in points))
     methods = list(dict.fromkeys(p.method for p in points))
     fig, axes = plt.subplots(1, len(problems), figsize=(4.5 * len(problems), 4), squeeze=False)
-    for ax, key in zip(axes[0], problems):
+    for ax, key in zip(axes[0], problems, strict=True):
         for m in methods:
             mine = [p for p in points if p.problem == key and p.method == m and p.error > 0]
             ax.loglog([p.cpu for p in mine], [p.error for p in mine], "o-", label=m)
