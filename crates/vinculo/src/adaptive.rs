@@ -2,8 +2,10 @@
 //! the step controller that the run loop (`run.rs`) consults when its steps are error-controlled
 //! (`docs/theory/adaptive.md`).
 //!
-//! Each converged step's local error is estimated ([`crate::integrators::error_estimate`]) and
-//! weighed ([`crate::step_control`]): a step with err <= 1 is accepted, one above is rejected and
+//! Each converged step's local error is estimated by step doubling (two half steps from the same
+//! start, [`crate::integrators::error_estimate`]; the step's own answer is kept) and weighed
+//! ([`crate::step_control`]): Newton's tolerance follows rtol and atol
+//! ([`crate::step_control::AdaptiveOptions::newton_tolerance`]); a step with err <= 1 is accepted, one above is rejected and
 //! retried with the PI controller's smaller step, one whose Newton iterations fail is retried with
 //! a quarter of its size (after one retry with a fresh matrix in modified Newton, as with fixed
 //! steps). A step the controller would make smaller than h_min ends the run with
@@ -21,7 +23,8 @@
 //! so a new step size h shifts that point by (alpha_m - alpha_f)(h - h_old), an O(h^2 |h - h_old|)
 //! position error, of the order of the local error itself as long as the step changes gradually
 //! (which the controller's growth limit ensures). The second order survives (checked by
-//! `tests/test_adaptive.py`, where the error falls with the tolerance like a second-order scheme's).
+//! `tests/test_adaptive.py` and `tests/test_adaptive_accuracy.py`, where the error falls with the
+//! tolerance like a second-order scheme's).
 
 use crate::assembly::NONE;
 use crate::error::{Error, Result};

@@ -1,30 +1,33 @@
 //! How step sizes are chosen: fixed, or by a PI controller on a weighted norm of the local error.
 //!
-//! **Error norm.** The local errors e_q (m) of a step's positions
-//! ([`crate::integrators::error_estimate`], step doubling) are weighed component by component,
-//! over the free particles' coordinates, with a root mean square:
+//! **Error norm.** The local errors e_q (m) and e_v (m/s) of a step
+//! ([`crate::integrators::error_estimate`], step doubling, cut to their parts tangent to the
+//! constraints) are weighed component by component, over the free particles' coordinates, with
+//! root mean squares:
 //!
 //! ```text
-//! err = sqrt( (1/N) sum_i (e_q,i / w_q,i)^2 ),   w_q,i = atol + rtol max(|q_n,i|, |q_{n+1},i|)
+//! err_q = sqrt( (1/N) sum_i (e_q,i / w_q,i)^2 ),   w_q,i = atol + rtol max(|q_n,i|, |q_{n+1},i|)
+//! err_v = sqrt( (1/N) sum_i (e_v,i / w_v,i)^2 ),   w_v,i = atol_v + rtol max(|v_n,i|, |v_{n+1},i|)
+//! err = max(err_q max(T / h, 1), err_v)
 //! ```
 //!
-//! atol is a length (m). Positions alone: an index-3 run's velocities carry a drift off the
-//! velocity constraints that every change of step size excites and that no step size removes
-//! (for the trapezoidal rule it is not even damped), so their step-doubling difference measures
-//! the drift, not the step; the tangential velocity errors show in the positions one step later
-//! and are controlled through them. The velocities' error is measured against references in
-//! `tests/test_adaptive_accuracy.py` and stated in `docs/theory/adaptive.md`.
+//! atol is a length (m); atol_v = atol U / L, with the length scale L of the model
+//! ([`crate::model::System::length_scale`]) and the speed scale U the run already uses for its
+//! initial velocity check (the largest initial speed, or sqrt(|g| L)). Positions count per unit
+//! step (below), velocities per step: an index-3 run's velocities carry a drift off the velocity
+//! constraints, set by earlier steps, of which the velocity estimate keeps O(h) times
+//! (`integrators/error_estimate.rs`); per unit step no retry could bring that below the
+//! tolerance, per step a smaller step does.
 //!
-//! **Error per unit step.** A step of size h is accepted when err T / h <= 1 (err <= 1 for steps
-//! longer than T): the error a step adds is measured against the tolerance per time T, not per
-//! step. The errors of the N = (t_end - t_start)/h steps of a run add up; with the error per step
+//! **Error per unit step.** The positions count err_q T / h (err_q for steps longer than T =
+//! L / U): the error a step adds is measured against the tolerance per time T, not per step. The errors of the N = (t_end - t_start)/h steps of a run add up; with the error per step
 //! at the tolerance the run's error would be about N times it, and grow as the tolerance shrinks
 //! (N grows as tol^(-1/(p+1)) for a scheme of order p). Per unit step, the run's error is about
 //! (t_end - t_start)/T times the tolerance (before the motion's own amplification of errors),
 //! proportional to the tolerance: halving the tolerance halves the error.
 //!
-//! **Controller.** The scaled error err T / h of a scheme of order p shrinks as h^k, k = p (the
-//! local error as h^(p+1)). After an accepted step the next one is
+//! **Controller.** The scaled error err_q T / h of a scheme of order p shrinks as h^k, k = p (the
+//! local error as h^(p+1); err_v faster). After an accepted step the next one is
 //!
 //! ```text
 //! h_new = h * clamp( (rho / err_n)^(0.7/k) * (err_{n-1} / rho)^(0.4/k), 1/5, 5 ),  rho = safety^k

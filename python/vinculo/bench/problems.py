@@ -35,6 +35,7 @@ from scipy.integrate import solve_ivp
 
 import vinculo
 
+#: Gravity, m/s^2 (along -z).
 GRAVITY = 9.81
 
 

@@ -31,6 +31,7 @@ SCHEMES = {
 }
 #: The peer's column label.
 RADAU = "scipy Radau (ODE)"
+#: Output times of every run (evenly spaced over the run, ends included).
 OUTPUTS = 201
 
 
