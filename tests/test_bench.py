@@ -1,5 +1,7 @@
 """Smoke run of the benchmark command (the full comparison is not part of the test suite)."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -70,3 +72,23 @@ def test_hanging_chain_stays_at_rest_and_scaling_reports_memory():
     figures = scaling.one(1_000)
     assert figures["solver"] == "tree elimination"
     assert figures["peak_mb"] > 0 and figures["seconds"] > 0
+
+
+def test_agreement_tolerance_is_a_share_of_the_schemes_own_error():
+    # The tolerance of the side-by-side table is AGREEMENT_SHARE (1/100) of the distance between
+    # vinculo's answers at dt and dt/2 (the scheme's own error: 3/4 of it at dt for a second-order
+    # scheme), never below AGREEMENT_FLOOR of the model's length. On the pendulum after 10 s it
+    # sees what the fixed 1e-3 m of before could not: modified Newton's stopping rule leaves its
+    # answer more than the tolerance away from full Newton's (measured 1.1e-4 m against a
+    # tolerance of 9.2e-7 m; full Newton agrees with Exudyn to 4e-8 m).
+    pendulum = bench.comparison_models(quick=True)[0]
+    assert pendulum.name.startswith("pendulum")
+    full = run_vinculo(pendulum, COMPARISON)
+    half = run_vinculo(dataclasses.replace(pendulum, dt=pendulum.dt / 2), COMPARISON)
+    error = float(np.linalg.norm(full.tip - half.tip))
+    tolerance = bench.agreement_tolerance(error, 1.0)
+    assert tolerance == pytest.approx(bench.AGREEMENT_SHARE * error, rel=1e-12)
+    assert bench.agreement_tolerance(0.0, 2.0) == pytest.approx(2.0 * bench.AGREEMENT_FLOOR)
+    modified = run_vinculo(pendulum, dataclasses.replace(COMPARISON, jacobian_reuse=True))
+    assert np.linalg.norm(modified.tip - full.tip) > 10.0 * tolerance
+    assert not COMPARISON.jacobian_reuse  # the headline runs vinculo's default, full Newton

@@ -122,9 +122,9 @@ class Simulation:
     def save_snapshot(self, path: str | os.PathLike[str]) -> None:
         """Save a snapshot of the current state to a file (a small binary format, floats bit-exact).
 
-        With ``adaptive=True`` the file also holds the error control's state (the next step size,
-        the step-size controller's memory, the acceleration history of the error estimate), so a
-        run loaded from it takes the same steps as the saved run would.
+        With ``adaptive=True`` the file also holds the error control's state (the next step size
+        and the step-size controller's memory), so a run loaded from it takes the same steps as
+        the saved run would.
 
         Arguments:
             path: the file to write.

@@ -2,8 +2,10 @@
 //! the step controller that the run loop (`run.rs`) consults when its steps are error-controlled
 //! (`docs/theory/adaptive.md`).
 //!
-//! Each converged step's local error is estimated ([`crate::integrators::error_estimate`]) and
-//! weighed ([`crate::step_control`]): a step with err <= 1 is accepted, one above is rejected and
+//! Each converged step's local error is estimated by step doubling (two half steps from the same
+//! start, [`crate::integrators::error_estimate`]; the step's own answer is kept) and weighed
+//! ([`crate::step_control`]): Newton's tolerance follows rtol and atol
+//! ([`crate::step_control::AdaptiveOptions::newton_tolerance`]); a step with err <= 1 is accepted, one above is rejected and
 //! retried with the PI controller's smaller step, one whose Newton iterations fail is retried with
 //! a quarter of its size (after one retry with a fresh matrix in modified Newton, as with fixed
 //! steps). A step the controller would make smaller than h_min ends the run with
@@ -21,12 +23,16 @@
 //! so a new step size h shifts that point by (alpha_m - alpha_f)(h - h_old), an O(h^2 |h - h_old|)
 //! position error, of the order of the local error itself as long as the step changes gradually
 //! (which the controller's growth limit ensures). The second order survives (checked by
-//! `tests/test_adaptive.py`, where the error falls with the tolerance like a second-order scheme's).
+//! `tests/test_adaptive.py` and `tests/test_adaptive_accuracy.py`, where the error falls with the
+//! tolerance like a second-order scheme's).
 
 use crate::assembly::NONE;
 use crate::error::{Error, Result};
 use crate::initial::factor_saddle;
-use crate::integrators::{AccelerationHistory, ErrorConstants, Scheme, StepWorkspace};
+use crate::integrators::{
+    richardson_factor, NewtonOptions, RuleState, Scheme, StabilizedWorkspace, StepStart,
+    StepWorkspace,
+};
 use crate::math::Vec3;
 use crate::model::System;
 use crate::step_control::{AdaptiveOptions, ErrorWeights, PiController};
@@ -43,22 +49,23 @@ pub(crate) struct ErrorControl {
     pub(crate) pi: PiController,
     /// The next step size.
     pub(crate) h: f64,
-    pub(crate) constants: ErrorConstants,
-    /// Built at the first attempt, once a factorisation can project the initial accelerations.
-    pub(crate) history: AccelerationHistory,
+    /// The rule's state along the two half steps (a copy of the state before the step).
+    pub(crate) rule_half: Option<RuleState>,
     /// Error norm of the step being judged.
     pub(crate) err: f64,
     pub(crate) free: Vec<bool>,
     pub(crate) projection: Vec<f64>,
-    pub(crate) initial: Vec<Vec3>,
-    pub(crate) a_sample: Vec<Vec3>,
     pub(crate) e_q: Vec<Vec3>,
     pub(crate) e_v: Vec<Vec3>,
-    pub(crate) q_end: Vec<Vec3>,
+    pub(crate) q_big: Vec<Vec3>,
+    pub(crate) v_big: Vec<Vec3>,
+    pub(crate) lambda_big: Vec<f64>,
+    pub(crate) q_mid: Vec<Vec3>,
+    pub(crate) v_mid: Vec<Vec3>,
 }
 
 impl ErrorControl {
-    /// The control of a run of `scheme` from `t0` with the consistent accelerations `acc`, first
+    /// The control of a run of `scheme` (`acc`: the start's accelerations, for the sizes), first
     /// step `dt`, on an index-3 system of `unknowns` unknowns.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn new(
@@ -67,7 +74,6 @@ impl ErrorControl {
         control: AdaptiveOptions,
         weights: ErrorWeights,
         dt: f64,
-        t0: f64,
         acc: &[Vec3],
         unknowns: usize,
     ) -> ErrorControl {
@@ -77,16 +83,17 @@ impl ErrorControl {
             weights,
             pi: PiController::new(scheme.order(), control.hold),
             h: dt,
-            constants: scheme.error_constants(),
-            history: AccelerationHistory::new(t0, acc),
+            rule_half: None,
             err: 0.0,
             free: system.particles().iter().map(|p| !p.fixed).collect(),
             projection: vec![0.0; unknowns],
-            initial: acc.to_vec(),
-            a_sample: acc.to_vec(),
             e_q: acc.to_vec(),
             e_v: acc.to_vec(),
-            q_end: vec![[0.0; 3]; acc.len()],
+            q_big: acc.to_vec(),
+            v_big: acc.to_vec(),
+            lambda_big: Vec::new(),
+            q_mid: acc.to_vec(),
+            v_mid: acc.to_vec(),
         }
     }
 
@@ -99,11 +106,12 @@ impl ErrorControl {
         }
         self.projection.resize(unknowns, 0.0);
         for a in [
-            &mut self.initial,
-            &mut self.a_sample,
             &mut self.e_q,
             &mut self.e_v,
-            &mut self.q_end,
+            &mut self.q_big,
+            &mut self.v_big,
+            &mut self.q_mid,
+            &mut self.v_mid,
         ] {
             a.resize(n, [0.0; 3]);
         }
@@ -132,48 +140,99 @@ impl ErrorControl {
         }
     }
 
-    /// Judges a converged step of size `h` from (t, q, v) with end acceleration `acc_new` (the
-    /// end state in `ws.state`): `Ok(true)` when its weighted error is at most 1 (the history then
-    /// takes its sample), `Ok(false)` when it must be retried. `step` counts the accepted steps
-    /// before it; `stabilized` says the step was a GGL step (whose matrix is not the index-3 one
-    /// the projection needs).
+    /// Judges a converged step of size `h` from (t, q, v) (the end state in `ws.state`) by
+    /// step doubling ([`crate::integrators::error_estimate`]): two steps of h/2 from the same
+    /// start with the rule's state before the step `rule`, whose difference from the step gives
+    /// its local error. `Ok(true)` when the weighted error is at most 1, `Ok(false)` when the
+    /// step must be retried; `ws.state` holds the step's own end state again on return.
+    /// `stabilized`: the GGL workspace of a GGL run (whose matrix is not the index-3 one the
+    /// projection needs).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn judge(
         &mut self,
         system: &System,
         ws: &mut StepWorkspace,
-        stabilized: bool,
-        step: usize,
+        mut stabilized: Option<&mut StabilizedWorkspace>,
+        newton: &NewtonOptions,
+        rule: &RuleState,
         (t, h): (f64, f64),
         (q, v, acc): (&[Vec3], &[Vec3], &[Vec3]),
-        acc_new: &[Vec3],
     ) -> Result<bool> {
-        self.a_sample.copy_from_slice(acc_new);
-        if stabilized {
-            // The GGL step factorised its own matrix: the projection needs the index-3
-            // workspace's [M/m_ref, -s G^T; s G, 0] at the step's end.
-            self.q_end.copy_from_slice(&ws.state.q);
-            factor_saddle(system, ws, &self.q_end, t + h)?;
+        self.q_big.copy_from_slice(&ws.state.q);
+        self.v_big.copy_from_slice(&ws.state.v);
+        self.lambda_big.clear();
+        self.lambda_big.extend_from_slice(&ws.state.lambda);
+        match &mut self.rule_half {
+            Some(r) if r.acceleration.len() == rule.acceleration.len() => r.copy_from(rule),
+            other => *other = Some(rule.clone()),
         }
-        tangential(ws, &mut self.a_sample, &mut self.projection);
-        if step == 0 {
-            self.initial.copy_from_slice(acc);
-            tangential(ws, &mut self.initial, &mut self.projection);
-            self.history = AccelerationHistory::new(t, &self.initial);
+        let rule_half = self.rule_half.as_mut().expect("set above");
+        let half = 0.5 * h;
+        let mut converged = true;
+        for k in 0..2 {
+            let t_k = t + k as f64 * half;
+            if k == 1 {
+                self.q_mid.copy_from_slice(&ws.state.q);
+                self.v_mid.copy_from_slice(&ws.state.v);
+            }
+            let (q_k, v_k): (&[Vec3], &[Vec3]) = if k == 0 {
+                (q, v)
+            } else {
+                (&self.q_mid, &self.v_mid)
+            };
+            for i in 0..q_k.len() {
+                for c in 0..3 {
+                    ws.state.q[i][c] = q_k[i][c] + half * v_k[i][c] + 0.5 * half * half * acc[i][c];
+                }
+            }
+            let start = StepStart::new(t_k, q_k, v_k, half);
+            let stab = stabilized.as_deref_mut();
+            if self
+                .scheme
+                .step(system, ws, stab, start, rule_half, newton)
+                .is_err()
+            {
+                converged = false;
+                break;
+            }
         }
-        let tau = t + self.scheme.sample_offset(h);
-        let (e_q, e_v) = (&mut self.e_q, &mut self.e_v);
-        self.history
-            .estimate(&self.constants, t, h, tau, &self.a_sample, e_q, e_v);
-        let (q_new, v_new) = (&ws.state.q, &ws.state.v);
-        self.err = self
-            .weights
-            .norm(h, &self.free, &self.e_q, &self.e_v, q, q_new, v, v_new);
-        if self.err.is_nan() || self.err > 1.0 {
+        if converged {
+            // Richardson: the step's error C h^(p+1) exceeds that of the two halves by
+            // (1 - 2^-p) C h^(p+1).
+            let factor = richardson_factor(self.scheme.order());
+            for i in 0..q.len() {
+                for c in 0..3 {
+                    self.e_q[i][c] = factor * (self.q_big[i][c] - ws.state.q[i][c]);
+                    self.e_v[i][c] = factor * (self.v_big[i][c] - ws.state.v[i][c]);
+                }
+            }
+        }
+        // The step's own end state back in place.
+        ws.state.q.copy_from_slice(&self.q_big);
+        ws.state.v.copy_from_slice(&self.v_big);
+        ws.state.lambda.copy_from_slice(&self.lambda_big);
+        if !converged {
+            self.err = f64::INFINITY;
             return Ok(false);
         }
-        self.history.push(tau, &self.a_sample, h);
-        Ok(true)
+        if stabilized.is_some() {
+            // The GGL steps factorised their own matrix: the projection needs the index-3
+            // workspace's [M/m_ref, -s G^T; s G, 0] at the step's end.
+            factor_saddle(system, ws, &self.q_big, t + h)?;
+        }
+        tangential(ws, &mut self.e_q, &mut self.projection);
+        // The velocities' difference holds twice the start's drift off the velocity constraints
+        // (index 3: v_{n+1} = 2 (q_{n+1} - q_n)/h - v_n carries -v_n's normal part, two half
+        // steps +v_n's), normal to the constraints at the start: projected there, what is left
+        // of it is O(h) times the drift.
+        factor_saddle(system, ws, q, t)?;
+        ws.matrix.invalidate();
+        tangential(ws, &mut self.e_v, &mut self.projection);
+        let ends = [(q, v), (&self.q_big[..], &self.v_big[..])];
+        self.err = self
+            .weights
+            .norm(h, &self.free, (&self.e_q, &self.e_v), ends);
+        Ok(!self.err.is_nan() && self.err <= 1.0)
     }
 
     /// After a step of size `h` from `t` failed the error test: `Ok` with a smaller next step,
@@ -202,7 +261,7 @@ impl ErrorControl {
     }
 }
 
-/// Replaces the accelerations `a` by their part tangent to the constraints, with the
+/// Replaces the vectors `a` (one per particle) by their part tangent to the constraints, with the
 /// factorisation of the step's last Newton matrix `[M/m_ref + K, -s G^T; s G, 0]` (K = O(h^2)):
 /// solving it with the right-hand side `[M a / m_ref; 0]` gives x with G x = 0 and
 /// (M/m_ref + K) x = M a / m_ref + s G^T mu, the M-orthogonal projection of a onto the tangent

@@ -393,8 +393,15 @@ impl<'a> Simulation<'a> {
 
         let mut ws = StepWorkspace::with_solver(system, options.dense_limit, options.sparse_solver);
         ws.assemble_in_parallel_from(system, options.parallel_from);
+        // Error-controlled steps tie Newton's tolerance to theirs (`step_control.rs`).
+        let relative = match options.step_control {
+            StepControl::Adaptive(control) => {
+                control.newton_tolerance(options.newton.tolerance, length)
+            }
+            StepControl::Fixed => options.newton.tolerance,
+        };
         let newton = NewtonOptions {
-            tolerance: options.newton.tolerance * length,
+            tolerance: relative * length,
             ..options.newton
         };
         // The GGL steps have their own unknowns and solver; the index-3 workspace still serves
@@ -464,7 +471,6 @@ impl<'a> Simulation<'a> {
                     control,
                     weights,
                     options.dt,
-                    t0,
                     &acc,
                     ws.layout.unknowns(),
                 )))
@@ -871,11 +877,11 @@ impl Simulation<'_> {
                 let judged = control.judge(
                     system,
                     ws,
-                    self.stabilized.is_some(),
-                    c.step,
+                    self.stabilized.as_mut(),
+                    &self.newton,
+                    &s.rule_saved,
                     (c.t, h),
                     (&c.q, &c.v, &c.acc),
-                    &s.acc_new,
                 );
                 match judged {
                     Ok(true) => match end {

@@ -1,6 +1,6 @@
 //! Snapshot files: a [`Snapshot`] saved to and loaded from a small binary file.
 //!
-//! # Format (version 2)
+//! # Format (version 3)
 //!
 //! Little-endian throughout; every float is stored as its IEEE-754 bits, so a loaded snapshot
 //! is bit for bit the saved one.
@@ -8,7 +8,7 @@
 //! | field | type |
 //! |---|---|
 //! | magic `VNCLSNAP` | 8 bytes |
-//! | version (2) | u32 |
+//! | version (3) | u32 |
 //! | model fingerprint ([`crate::run::fingerprint`]), particles n, constraint equations m | 3 x u64 |
 //! | time | f64 |
 //! | positions, velocities, accelerations | 3 x (n x 3 f64) |
@@ -29,25 +29,23 @@
 //! | error weights: time scale, atol_q, atol_v, rtol | 4 x f64 |
 //! | PI controller: order k, last error norm, last attempt rejected (0 or 1), hold | f64, f64, u8, f64 |
 //! | next step size h, error norm of the last judged step | 2 x f64 |
-//! | error-estimate constants q2, q3, v2, v3 | 4 x f64 |
-//! | acceleration history: raw sample (time f64, accelerations, weight f64), newest smoothed sample (time f64, accelerations), older sample present (0 or 1) and, if so, the same | |
 //!
-//! where each accelerations array is a u64 length then length x 3 f64.
-//!
-//! Version 1 is version 2 with fixed steps only (tag 0); files of version 1 are still read.
+//! Version 1 is version 3 with fixed steps only (tag 0). Version 2 also kept an acceleration
+//! history for the error estimate, which step doubling no longer
+//! needs; its files with fixed steps are still read, those of error-controlled runs refused.
 //! Snapshots of runs that stopped are not saved.
 
 use std::path::Path;
 
 use crate::adaptive::ErrorControl;
 use crate::error::{Error, Result};
-use crate::integrators::{AccelerationHistory, ErrorConstants, RuleState, Scheme};
+use crate::integrators::{RuleState, Scheme};
 use crate::math::Vec3;
 use crate::run::{Carried, Controller, FixedSteps, Fnv, Snapshot};
 use crate::step_control::{AdaptiveOptions, ErrorWeights, PiController};
 
 const MAGIC: &[u8; 8] = b"VNCLSNAP";
-const VERSION: u32 = 2;
+const VERSION: u32 = 3;
 /// The oldest format version still read.
 const OLDEST: u32 = 1;
 
@@ -85,10 +83,6 @@ impl Writer {
             self.f64(x);
         }
     }
-    fn sample(&mut self, (t, a): (f64, &[Vec3])) {
-        self.f64(t);
-        self.sized_vecs(a);
-    }
 
     /// The state of the error control (module documentation).
     fn error_control(&mut self, e: &ErrorControl) {
@@ -104,19 +98,6 @@ impl Writer {
         self.f64s(&[e.pi.k, e.pi.previous]);
         self.0.push(e.pi.rejected as u8);
         self.f64s(&[e.pi.hold, e.h, e.err]);
-        let k = &e.constants;
-        self.f64s(&[k.q2, k.q3, k.v2, k.v3]);
-        let history = &e.history;
-        self.sample((history.raw.0, &history.raw.1));
-        self.f64(history.raw.2);
-        self.sample((history.newest.0, &history.newest.1));
-        match &history.older {
-            Some((t, a)) => {
-                self.0.push(1);
-                self.sample((*t, a));
-            }
-            None => self.0.push(0),
-        }
     }
 }
 
@@ -190,9 +171,6 @@ impl Reader<'_> {
             )),
         }
     }
-    fn sample(&mut self) -> Result<(f64, Vec<Vec3>)> {
-        Ok((self.f64()?, self.sized_vecs()?))
-    }
 
     /// The state of the error control (module documentation), its scratch arrays empty.
     fn error_control(&mut self) -> Result<ErrorControl> {
@@ -227,30 +205,23 @@ impl Reader<'_> {
             rejected,
             hold,
         };
-        let [q2, q3, v2, v3] = self.f64s()?;
-        let raw = self.sample()?;
-        let raw = (raw.0, raw.1, self.f64()?);
-        let newest = self.sample()?;
-        let older = match self.flag("the older-sample flag")? {
-            true => Some(self.sample()?),
-            false => None,
-        };
         Ok(ErrorControl {
             scheme,
             control,
             weights,
             pi,
             h,
-            constants: ErrorConstants { q2, q3, v2, v3 },
-            history: AccelerationHistory { raw, newest, older },
+            rule_half: None,
             err,
             free: Vec::new(),
             projection: Vec::new(),
-            initial: Vec::new(),
-            a_sample: Vec::new(),
             e_q: Vec::new(),
             e_v: Vec::new(),
-            q_end: Vec::new(),
+            q_big: Vec::new(),
+            v_big: Vec::new(),
+            lambda_big: Vec::new(),
+            q_mid: Vec::new(),
+            v_mid: Vec::new(),
         })
     }
 }
@@ -323,7 +294,7 @@ impl Snapshot {
     ///
     /// # Errors
     /// [`Error::Snapshot`] when the file cannot be read, is not a snapshot file, is of a format
-    /// version this vinculo does not read (1 and 2 are), or is truncated or corrupt (its
+    /// version this vinculo does not read (1 to 3 are; of 2 only fixed steps), or is truncated or corrupt (its
     /// checksum does not match).
     pub fn load(path: impl AsRef<Path>) -> Result<Snapshot> {
         let path = path.as_ref();
@@ -386,7 +357,14 @@ impl Snapshot {
                 level: r.u32()?,
                 t_grid: r.f64()?,
             }),
-            1 if version >= 2 => Controller::Adaptive(Box::new(r.error_control()?)),
+            1 if version >= 3 => Controller::Adaptive(Box::new(r.error_control()?)),
+            1 if version == 2 => {
+                return Err(file_error(
+                    path,
+                    "an error-controlled run saved in format version 2, whose error estimate \
+                     this vinculo no longer has: rerun it from its start",
+                ))
+            }
             _ => {
                 return Err(file_error(
                     path,

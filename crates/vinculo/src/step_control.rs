@@ -1,30 +1,33 @@
 //! How step sizes are chosen: fixed, or by a PI controller on a weighted norm of the local error.
 //!
 //! **Error norm.** The local errors e_q (m) and e_v (m/s) of a step
-//! ([`crate::integrators::error_estimate`]) are weighed component by component, over the free
-//! particles' coordinates, with a root mean square:
+//! ([`crate::integrators::error_estimate`], step doubling, cut to their parts tangent to the
+//! constraints) are weighed component by component, over the free particles' coordinates, with
+//! root mean squares:
 //!
 //! ```text
-//! err = sqrt( (1/N) sum_i [ (e_q,i / w_q,i)^2 + (e_v,i / w_v,i)^2 ] )
-//! w_q,i = atol + rtol max(|q_n,i|, |q_{n+1},i|),   w_v,i = atol_v + rtol max(|v_n,i|, |v_{n+1},i|)
+//! err_q = sqrt( (1/N) sum_i (e_q,i / w_q,i)^2 ),   w_q,i = atol + rtol max(|q_n,i|, |q_{n+1},i|)
+//! err_v = sqrt( (1/N) sum_i (e_v,i / w_v,i)^2 ),   w_v,i = atol_v + rtol max(|v_n,i|, |v_{n+1},i|)
+//! err = max(err_q max(T / h, 1), err_v)
 //! ```
 //!
-//! atol is a length (m). The velocities' absolute tolerance is atol over the run's time scale,
-//! atol_v = atol U / L, with the length scale L of the model ([`crate::model::System::length_scale`])
-//! and the speed scale U the run already uses for its initial velocity check (the largest initial
-//! speed, or sqrt(|g| L)): an error of atol in positions and one of atol_v in velocities displace
-//! the motion by the same amount over the time T = L/U it takes to cross the model.
+//! atol is a length (m); atol_v = atol U / L, with the length scale L of the model
+//! ([`crate::model::System::length_scale`]) and the speed scale U the run already uses for its
+//! initial velocity check (the largest initial speed, or sqrt(|g| L)). Positions count per unit
+//! step (below), velocities per step: an index-3 run's velocities carry a drift off the velocity
+//! constraints, set by earlier steps, of which the velocity estimate keeps O(h) times
+//! (`integrators/error_estimate.rs`); per unit step no retry could bring that below the
+//! tolerance, per step a smaller step does.
 //!
-//! **Error per unit step.** A step of size h is accepted when err T / h <= 1 (err <= 1 for steps
-//! longer than T): the error a step adds is measured against the tolerance per time T, not per
-//! step. The errors of the N = (t_end - t_start)/h steps of a run add up; with the error per step
+//! **Error per unit step.** The positions count err_q T / h (err_q for steps longer than T =
+//! L / U): the error a step adds is measured against the tolerance per time T, not per step. The errors of the N = (t_end - t_start)/h steps of a run add up; with the error per step
 //! at the tolerance the run's error would be about N times it, and grow as the tolerance shrinks
 //! (N grows as tol^(-1/(p+1)) for a scheme of order p). Per unit step, the run's error is about
 //! (t_end - t_start)/T times the tolerance (before the motion's own amplification of errors),
 //! proportional to the tolerance: halving the tolerance halves the error.
 //!
-//! **Controller.** The scaled error err T / h of a scheme of order p shrinks as h^k, k = p (the
-//! local error as h^(p+1)). After an accepted step the next one is
+//! **Controller.** The scaled error err_q T / h of a scheme of order p shrinks as h^k, k = p (the
+//! local error as h^(p+1); err_v faster). After an accepted step the next one is
 //!
 //! ```text
 //! h_new = h * clamp( (rho / err_n)^(0.7/k) * (err_{n-1} / rho)^(0.4/k), 1/5, 5 ),  rho = safety^k
@@ -59,8 +62,7 @@ pub enum StepControl {
 pub struct AdaptiveOptions {
     /// Relative tolerance (> 0).
     pub rtol: f64,
-    /// Absolute tolerance of the positions, m (> 0); the velocities get atol U / L (module
-    /// documentation).
+    /// Absolute tolerance of the positions, m (> 0).
     pub atol: f64,
     /// Smallest step, s: a run that would need a smaller one stops with
     /// [`Error::StepSizeTooSmall`].
@@ -102,7 +104,22 @@ pub const MIN_SHRINK: f64 = 0.2;
 /// Reduction of the step after a Newton failure.
 pub const NEWTON_SHRINK: f64 = 0.25;
 
+/// Share of the tolerance left to Newton's iteration error (error-controlled steps).
+pub const NEWTON_SHARE: f64 = 0.01;
+/// Smallest Newton tolerance chosen for error-controlled steps, relative to the length scale
+/// (a few hundred times the round-off of a position of the size of the model).
+pub const NEWTON_FLOOR: f64 = 1e-13;
+
 impl AdaptiveOptions {
+    /// Newton's tolerance relative to the length scale `length` for these tolerances: the run's
+    /// `tolerance`, lowered to [`NEWTON_SHARE`] of min(rtol, atol / length) (not below
+    /// [`NEWTON_FLOOR`]), so that the iteration error stays below the local error the
+    /// controller allows.
+    pub fn newton_tolerance(&self, tolerance: f64, length: f64) -> f64 {
+        let tied = NEWTON_SHARE * self.rtol.min(self.atol / length);
+        tolerance.min(tied.max(NEWTON_FLOOR))
+    }
+
     /// Checks every option and the first step `dt` against them.
     pub fn check(&self, dt: f64) -> Result<()> {
         let bad = |name: &str, value: f64, expected: String| {
@@ -149,8 +166,8 @@ impl AdaptiveOptions {
     }
 }
 
-/// The weights of the error norm: absolute tolerances of positions and velocities, rtol, and
-/// the time scale of the error per unit step.
+/// The weights of the error norm: the absolute tolerance of positions, rtol, and the time
+/// scale of the error per unit step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ErrorWeights {
     /// Time scale T = L/U (s): the error of a step of size h < T counts T/h times.
@@ -164,35 +181,34 @@ pub struct ErrorWeights {
 }
 
 impl ErrorWeights {
-    /// The weighted RMS norm of (e_q, e_v) of a step of size `h` over the particles marked
-    /// `free`, per unit step (module documentation), with the states at both ends of the step.
-    #[allow(clippy::too_many_arguments)]
+    /// The error norm of a step of size `h` with the position and velocity errors `e` over the
+    /// particles marked `free`, with the states (q, v) at both ends of the step `ends`: the
+    /// larger of the positions' weighted RMS norm per unit step and the velocities' per step
+    /// (module documentation).
     pub fn norm(
         &self,
         h: f64,
         free: &[bool],
-        e_q: &[Vec3],
-        e_v: &[Vec3],
-        q_0: &[Vec3],
-        q_1: &[Vec3],
-        v_0: &[Vec3],
-        v_1: &[Vec3],
+        (e_q, e_v): (&[Vec3], &[Vec3]),
+        [(q_0, v_0), (q_1, v_1)]: [(&[Vec3], &[Vec3]); 2],
     ) -> f64 {
-        let mut sum = 0.0;
+        let (mut sum_q, mut sum_v) = (0.0, 0.0);
         let mut count = 0usize;
         for i in (0..free.len()).filter(|&i| free[i]) {
             for k in 0..3 {
                 let w_q = self.atol_q + self.rtol * q_0[i][k].abs().max(q_1[i][k].abs());
                 let w_v = self.atol_v + self.rtol * v_0[i][k].abs().max(v_1[i][k].abs());
-                sum += (e_q[i][k] / w_q).powi(2) + (e_v[i][k] / w_v).powi(2);
-                count += 2;
+                sum_q += (e_q[i][k] / w_q).powi(2);
+                sum_v += (e_v[i][k] / w_v).powi(2);
+                count += 1;
             }
         }
         if count == 0 {
-            0.0
-        } else {
-            (sum / count as f64).sqrt() * (self.time_scale / h).max(1.0)
+            return 0.0;
         }
+        let n = count as f64;
+        let positions = (sum_q / n).sqrt() * (self.time_scale / h).max(1.0);
+        positions.max((sum_v / n).sqrt())
     }
 }
 
@@ -303,7 +319,7 @@ mod tests {
     }
 
     /// The RMS norm of errors equal to their weights is 1 for steps longer than the time scale;
-    /// fixed particles do not count.
+    /// fixed particles do not count; positions count per unit step, velocities per step.
     #[test]
     fn weighted_norm() {
         let weights = ErrorWeights {
@@ -317,11 +333,36 @@ mod tests {
         // Weights of the free particle: q: 0.101, 0.001, 0.001; v: 0.01, 0.21, 0.01.
         let e_q = [[0.101, -0.001, 0.001], [9.0; 3]];
         let e_v = [[0.01, 0.21, -0.01], [9.0; 3]];
-        let err = weights.norm(1.0, &[true, false], &e_q, &e_v, &q, &q, &v, &v);
+        let ends = [(&q[..], &v[..]), (&q[..], &v[..])];
+        let err = weights.norm(1.0, &[true, false], (&e_q, &e_v), ends);
         assert!((err - 1.0).abs() < 1e-12, "{err}");
-        // Per unit step: a step of a tenth of the time scale counts ten times.
-        let err = weights.norm(0.05, &[true, false], &e_q, &e_v, &q, &q, &v, &v);
+        // Per unit step: a step of a tenth of the time scale counts the positions ten times.
+        let err = weights.norm(0.05, &[true, false], (&e_q, &e_v), ends);
         assert!((err - 10.0).abs() < 1e-11, "{err}");
+        // The velocities count per step: without position errors the norm stays 1.
+        let none = [[0.0; 3]; 2];
+        let err = weights.norm(0.05, &[true, false], (&none, &e_v), ends);
+        assert!((err - 1.0).abs() < 1e-12, "{err}");
+    }
+
+    /// Newton's tolerance is the run's unless a hundredth of the error tolerance (relative to
+    /// the length scale) is smaller, and never below the floor.
+    #[test]
+    fn newton_tolerance_follows_the_error_tolerance() {
+        let tight = |rtol: f64, atol: f64| AdaptiveOptions {
+            rtol,
+            atol,
+            ..AdaptiveOptions::default()
+        };
+        assert_eq!(tight(1e-3, 1e-3).newton_tolerance(1e-10, 1.0), 1e-10);
+        assert!((tight(1e-8, 1e-8).newton_tolerance(1e-10, 1.0) - 1e-10).abs() < 1e-25);
+        assert!((tight(1e-9, 1e-6).newton_tolerance(1e-10, 1.0) - 1e-11).abs() < 1e-26);
+        // atol is a length: 1e-9 m on a 10 m model is 1e-10 of it.
+        assert!((tight(1e-6, 1e-9).newton_tolerance(1e-10, 10.0) - 1e-12).abs() < 1e-27);
+        assert_eq!(
+            tight(1e-14, 1e-14).newton_tolerance(1e-10, 1.0),
+            NEWTON_FLOOR
+        );
     }
 
     /// Every bad option is refused with its name.

@@ -279,12 +279,13 @@ fn with_checksum(mut body: Vec<u8>) -> Vec<u8> {
     body
 }
 
-/// A version 2 file of an error-controlled run that is truncated, or whose error-control part
+/// A version 3 file of an error-controlled run that is truncated, or whose error-control part
 /// is cut short or carries an unknown time rule under a valid checksum, or that claims to be of
-/// version 1 (which has fixed steps only), is refused with the snapshot error, and so is the
+/// version 1 (which has fixed steps only) or 2 (whose error control kept an acceleration
+/// history), is refused with the snapshot error, and so is the
 /// snapshot restored into a fixed-step run or a run of another time rule; a fixed-step
 /// file written as version 1 (the two versions agree there) is still read, to the same
-/// snapshot (saved again, the version 2 file).
+/// snapshot (saved again, the version 3 file).
 #[test]
 fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     let system = chain();
@@ -300,7 +301,7 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     run.step_to(0.05).clone().unwrap();
     run.snapshot().save(&path).unwrap();
     let good = std::fs::read(&path).unwrap();
-    assert_eq!(&good[8..12], &2u32.to_le_bytes());
+    assert_eq!(&good[8..12], &3u32.to_le_bytes());
     let refused = |bytes: &[u8], expected: &str| {
         let damaged = dir.join("damaged.snap");
         std::fs::write(&damaged, bytes).unwrap();
@@ -313,7 +314,7 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     };
     // Truncated: the checksum no longer matches.
     refused(&good[..good.len() - 20], "checksum");
-    // Cut short inside the acceleration history, with a checksum of what is left.
+    // Cut short inside the error control's state, with a checksum of what is left.
     let body = &good[..good.len() - 8];
     refused(
         &with_checksum(body[..body.len() - 60].to_vec()),
@@ -333,6 +334,10 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     let mut as_v1 = body.to_vec();
     as_v1[8..12].copy_from_slice(&1u32.to_le_bytes());
     refused(&with_checksum(as_v1), "unknown step controller 1");
+    // Version 2's error control is not read.
+    let mut as_v2 = body.to_vec();
+    as_v2[8..12].copy_from_slice(&2u32.to_le_bytes());
+    refused(&with_checksum(as_v2), "format version 2");
 
     // A snapshot restored into a run of another kind: fixed steps, or another time rule.
     let loaded = vinculo::Snapshot::load(&path).unwrap();

@@ -66,7 +66,6 @@
 //! c = (alpha_m a_n - alpha_f qdd_n - (1 - alpha_m)(v_n + h (1 - gamma) a_n)/(gamma h))/(1 - alpha_f),
 //! w = 1 (everything at t_{n+1}).
 
-use super::error_estimate::ErrorConstants;
 use super::rule::{
     GglBase, GglCoefficients, Index3Rule, RuleState, StepPoint, StepStart, TimeRule,
 };
@@ -222,23 +221,6 @@ impl TimeRule for GeneralizedAlpha {
 
     fn matrix_key(&self, h: f64) -> [f64; 2] {
         [h, self.rho_inf]
-    }
-
-    fn error_constants(&self) -> ErrorConstants {
-        let k = self.coefficients();
-        let delta = k.alpha_m - k.alpha_f;
-        let kappa = 0.5 * (1.0 - k.alpha_f) - (1.0 - k.alpha_m) * (0.5 + delta);
-        ErrorConstants {
-            q2: 0.0,
-            q3: k.beta + 0.5 * delta - 1.0 / 6.0,
-            v2: 0.0,
-            v3: kappa + k.gamma * (0.5 + delta) - 1.0 / 6.0,
-        }
-    }
-
-    /// t_n + h: the true acceleration of the step's end.
-    fn sample_offset(&self, h: f64) -> f64 {
-        h
     }
 
     /// At t_{n+1}, rows scaled by 1/(c m_ref) (module documentation).

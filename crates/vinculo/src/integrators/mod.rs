@@ -21,7 +21,7 @@ mod step_problem;
 mod trapezoidal;
 mod workspace;
 
-pub use error_estimate::{AccelerationHistory, ErrorConstants};
+pub use error_estimate::richardson_factor;
 pub use generalized_alpha::{AlphaCoefficients, AlphaStep, GeneralizedAlpha};
 
 pub use newton::{
@@ -98,16 +98,6 @@ impl Scheme {
     /// What identifies the iteration matrix of a step of size `h` (for its reuse).
     pub fn matrix_key(&self, h: f64) -> [f64; 2] {
         with_rule!(*self, rule => rule.matrix_key(h))
-    }
-
-    /// The constants of the local-error estimate.
-    pub fn error_constants(&self) -> ErrorConstants {
-        with_rule!(*self, rule => rule.error_constants())
-    }
-
-    /// Where, after t_n, a step of size `h` leaves its acceleration sample.
-    pub fn sample_offset(&self, h: f64) -> f64 {
-        with_rule!(*self, rule => rule.sample_offset(h))
     }
 
     /// The rule's state at the start of a run with the consistent accelerations `acc`.

@@ -20,15 +20,14 @@
 //!   (`stabilized.rs`), the one GGL step problem;
 //! - [`TimeRule::advance`] and [`TimeRule::advance_ggl`] update the rule's state after a
 //!   converged step, and [`TimeRule::end_acceleration`] gives the acceleration that the run
-//!   loop's predictor and error estimate use;
-//! - order, the key of the iteration matrix (for modified Newton) and the error-estimate
-//!   constants complete the contract.
+//!   loop's predictor uses;
+//! - order (which the error control's step doubling needs) and the key of the iteration matrix
+//!   (for modified Newton) complete the contract.
 //!
 //! The equations each rule discretises are derived in `docs/theory/time-rules.md` (the index-3
 //! form in `docs/theory/formulation.md`, the stabilised form in `docs/theory/ggl.md`); the
 //! module documentation of each rule's file repeats the formulas it implements.
 
-use super::error_estimate::ErrorConstants;
 use crate::math::Vec3;
 
 /// The state a rule carries from step to step besides (q, v): generalised-alpha's true and
@@ -167,12 +166,6 @@ pub trait TimeRule: Copy + Send + Sync {
     /// What identifies the iteration matrix of a step of size `h` (for its reuse).
     fn matrix_key(&self, h: f64) -> [f64; 2];
 
-    /// The constants of the local-error estimate (`integrators/error_estimate.rs`).
-    fn error_constants(&self) -> ErrorConstants;
-
-    /// Where, after t_n, a step of size `h` leaves its acceleration sample.
-    fn sample_offset(&self, h: f64) -> f64;
-
     /// The state at the start of a run with the consistent accelerations `acc`
     /// ([`RuleState::new`]; rules that carry no accelerations may leave it empty).
     fn initial_state(&self, acc: &[Vec3]) -> RuleState {
@@ -199,7 +192,6 @@ pub trait TimeRule: Copy + Send + Sync {
     fn advance_ggl(&self, state: &mut RuleState, h: f64, v_n: &[Vec3], v: &[Vec3]);
 
     /// The acceleration of a converged step from `start` to v_{n+1} = `v` (with the state
-    /// already advanced), into `out`: what the run loop's predictor extrapolates with and its
-    /// error estimate samples.
+    /// already advanced), into `out`: what the run loop's predictor extrapolates with.
     fn end_acceleration(&self, state: &RuleState, start: StepStart, v: &[Vec3], out: &mut [Vec3]);
 }

@@ -28,7 +28,6 @@
 //! In the GGL form (`docs/theory/ggl.md`): kappa = alpha h, b = q_n + (1 - alpha) h v_n,
 //! c_v = 1/h, c = -v_n/h, w = alpha.
 
-use super::error_estimate::ErrorConstants;
 use super::rule::{
     GglBase, GglCoefficients, Index3Rule, RuleState, StepPoint, StepStart, TimeRule,
 };
@@ -65,21 +64,6 @@ impl TimeRule for GeneralizedTrapezoidal {
 
     fn matrix_key(&self, h: f64) -> [f64; 2] {
         [h, self.alpha]
-    }
-
-    fn error_constants(&self) -> ErrorConstants {
-        let alpha = self.alpha;
-        ErrorConstants {
-            q2: alpha - 0.5,
-            q3: alpha * alpha - 1.0 / 6.0,
-            v2: alpha - 0.5,
-            v3: alpha * alpha - 1.0 / 6.0,
-        }
-    }
-
-    /// t_n + alpha h: the mean acceleration of the step.
-    fn sample_offset(&self, h: f64) -> f64 {
-        self.alpha * h
     }
 
     /// At t_n + alpha h, rows scaled by alpha h^2 / m_ref.
