@@ -437,6 +437,7 @@ class System:
         axial_friction: float | None = None,
         friction_damping: float = 200.0,
         static_dynamic_scale: float = 1.0,
+        damping_ramp: float = 0.0,
     ) -> ForceId:
         """Contact of a line node with a flat seabed at ``z = -depth``, MoorDyn's model
         (docs/theory/seabed-and-line-loads.md).
@@ -466,6 +467,9 @@ class System:
                 FricDamp.
             static_dynamic_scale: ratio of static to kinetic friction (>= 1), MoorDyn's
                 StatDynFricScale.
+            damping_ramp: penetration (m, >= 0) over which the damping grows linearly from zero
+                to ``cbot``, which smooths the contact for Newton's iteration; 0: MoorDyn's law,
+                full damping from the first touch.
 
         Returns:
             The force's handle.

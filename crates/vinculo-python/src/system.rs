@@ -470,7 +470,7 @@ impl PySystem {
     }
 
     /// Seabed contact and friction of a line node (MoorDyn's kBot, cBot, friction model).
-    #[pyo3(signature = (node, *, depth, diameter, length, kbot=3.0e6, cbot=3.0e5, tangent=None, friction=0.0, axial_friction=None, friction_damping=200.0, static_dynamic_scale=1.0))]
+    #[pyo3(signature = (node, *, depth, diameter, length, kbot=3.0e6, cbot=3.0e5, tangent=None, friction=0.0, axial_friction=None, friction_damping=200.0, static_dynamic_scale=1.0, damping_ramp=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn add_seabed_contact(
         &mut self,
@@ -485,6 +485,7 @@ impl PySystem {
         axial_friction: Option<f64>,
         friction_damping: f64,
         static_dynamic_scale: f64,
+        damping_ramp: f64,
     ) -> PyResult<PyForceId> {
         let n = self.particle(node)?;
         let tangent = self.tangent(tangent)?;
@@ -494,6 +495,7 @@ impl PySystem {
             length,
             stiffness: kbot,
             damping: cbot,
+            damping_ramp,
             friction: SeabedFriction {
                 transverse: friction,
                 axial: axial_friction.unwrap_or(friction * AXIAL_FRICTION_RATIO),

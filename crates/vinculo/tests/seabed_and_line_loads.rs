@@ -54,6 +54,7 @@ fn seabed(friction: SeabedFriction) -> SeabedSpec {
         length: L,
         stiffness: 3.0e6,
         damping: 3.0e5,
+        damping_ramp: 0.0,
         friction,
     }
 }

@@ -77,6 +77,9 @@ pub struct SeabedContact {
     pub stiffness: f64,
     /// cBot (Pa s/m).
     pub damping: f64,
+    /// Penetration over which the damping ramps up linearly from zero (m); 0: MoorDyn's
+    /// damping, full as soon as the node touches.
+    pub damping_ramp: f64,
     /// Friction parameters.
     pub friction: SeabedFriction,
 }
@@ -98,10 +101,21 @@ impl SeabedContact {
         self.node.particles()
     }
 
-    /// Normal force N (N, along +z), 0 out of contact; and whether the node is in contact.
-    fn normal(&self, q: Vec3, v: Vec3) -> Option<f64> {
+    /// Normal force N (N, along +z) with dN/dz and dN/dv_z; None out of contact.
+    fn normal(&self, q: Vec3, v: Vec3) -> Option<(f64, f64, f64)> {
         let p = self.seabed_z - q[2];
-        (p > 0.0).then(|| self.area * (self.stiffness * p - self.damping * v[2]))
+        if p <= 0.0 {
+            return None;
+        }
+        let a = self.area;
+        let (ramp, dramp_dz) = if p < self.damping_ramp {
+            (p / self.damping_ramp, -1.0 / self.damping_ramp)
+        } else {
+            (1.0, 0.0)
+        };
+        let n = a * (self.stiffness * p - self.damping * ramp * v[2]);
+        let dn_dz = -a * self.stiffness - a * self.damping * dramp_dz * v[2];
+        Some((n, dn_dz, -a * self.damping * ramp))
     }
 
     /// The friction parts (transverse, axial) at velocity v and tangent t.
@@ -157,7 +171,7 @@ impl SeabedContact {
     /// The contact force on the node (normal and friction) at its position and velocity.
     pub(crate) fn node_force(&self, q: &[Vec3], v: &[Vec3]) -> Vec3 {
         let i = self.node.node();
-        let Some(n) = self.normal(q[i], v[i]) else {
+        let Some((n, _, _)) = self.normal(q[i], v[i]) else {
             return [0.0; 3];
         };
         let mut f = [0.0, 0.0, n];
@@ -183,10 +197,9 @@ impl SeabedContact {
         dv: &mut Jacobian,
     ) {
         let i = self.node.node();
-        let Some(n) = self.normal(q[i], v[i]) else {
+        let Some((n, dn_dz, dn_dvz)) = self.normal(q[i], v[i]) else {
             return;
         };
-        let (dn_dz, dn_dvz) = (-self.area * self.stiffness, -self.area * self.damping);
         dq[0][0][2][2] += dn_dz;
         dv[0][0][2][2] += dn_dvz;
         if self.friction.transverse == 0.0 && self.friction.axial == 0.0 {
@@ -233,6 +246,7 @@ mod tests {
             area: 0.08 * 1.7,
             stiffness: 3.0e6,
             damping: 3.0e5,
+            damping_ramp: 0.0,
             friction,
         }
     }
@@ -272,7 +286,7 @@ mod tests {
         ] {
             v[1] = vel;
             let c = contact(None, friction(1.0));
-            let n = c.normal(q[1], vel).unwrap();
+            let n = c.normal(q[1], vel).unwrap().0;
             let part = c.parts(vel, None)[0].take().unwrap();
             assert_eq!(c.friction_of(&part, n).1, kinetic, "branch at {vel:?}");
             for tangent in [Some([0, 2]), None, Some([1, 0]), Some([2, 1])] {
@@ -281,6 +295,13 @@ mod tests {
                     fd::check(&f, &q, &v, 0.0);
                 }
             }
+        }
+        // Inside the damping ramp (p = 2 mm < 5 mm), moving down and up.
+        for vz in [-0.3, 0.2] {
+            v[1] = [0.2, 0.1, vz];
+            let mut c = contact(Some([0, 2]), friction(1.0));
+            c.damping_ramp = 0.005;
+            fd::check(&Force::SeabedContact(Box::new(c)), &q, &v, 0.0);
         }
         let mut above = q.clone();
         above[1][2] = -49.9;

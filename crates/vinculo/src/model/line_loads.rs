@@ -20,6 +20,8 @@ pub struct SeabedSpec {
     pub stiffness: f64,
     /// cBot (Pa s/m, >= 0), MoorDyn's default 3e5.
     pub damping: f64,
+    /// Penetration over which the damping ramps up from zero (m, >= 0); 0: MoorDyn's law.
+    pub damping_ramp: f64,
     /// Friction (coefficients >= 0, FricDamp > 0, StatDynFricScale >= 1).
     pub friction: SeabedFriction,
 }
@@ -102,6 +104,7 @@ impl System {
                 * positive(field("node length"), spec.length)?,
             stiffness: non_negative(field("seabed stiffness kBot"), spec.stiffness)?,
             damping: non_negative(field("seabed damping cBot"), spec.damping)?,
+            damping_ramp: non_negative(field("damping ramp"), spec.damping_ramp)?,
             friction: SeabedFriction {
                 transverse: non_negative(field("friction coefficient"), fr.transverse)?,
                 axial: non_negative(field("axial friction coefficient"), fr.axial)?,
