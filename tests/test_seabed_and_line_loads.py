@@ -1,6 +1,7 @@
 """Seabed contact, friction and line hydrodynamics from Python, against closed forms
 (MoorDyn's conventions, docs/theory/seabed-and-line-loads.md), and their typed errors."""
 
+import itertools
 import math
 
 import numpy as np
@@ -27,14 +28,16 @@ def chain_on_seabed(segments: int, friction: float):
         z = -DEPTH - 0.3 if end else -DEPTH + 0.2
         node_length = 0.5 * length if end else length
         nodes.append(system.add_particle(w * node_length, (xk, 0.0, z), fixed=end))
-    for a, b in zip(nodes, nodes[1:]):
+    for a, b in itertools.pairwise(nodes):
         system.add_distance(a, b, None)
     for k in range(1, segments):
         tangent = (nodes[k - 1], nodes[k + 1])
-        system.add_line_hydrodynamics(nodes[k], diameter=d, length=length, cd=1.2, cdax=0.05,
-                                      ca=1.0, tangent=tangent)
-        system.add_seabed_contact(nodes[k], depth=DEPTH, diameter=d, length=length,
-                                  tangent=tangent, friction=friction)
+        system.add_line_hydrodynamics(
+            nodes[k], diameter=d, length=length, cd=1.2, cdax=0.05, ca=1.0, tangent=tangent
+        )
+        system.add_seabed_contact(
+            nodes[k], depth=DEPTH, diameter=d, length=length, tangent=tangent, friction=friction
+        )
     return system, nodes, (w - RHO * math.pi * d * d / 4) * G
 
 
@@ -64,8 +67,9 @@ def test_tangent_defaults_and_bad_values_raise_typed_errors():
     with pytest.raises(InvalidInputError, match="kBot"):
         system.add_seabed_contact(n, depth=DEPTH, diameter=0.1, length=1.0, kbot=-1.0)
     with pytest.raises(InvalidInputError, match="static/dynamic"):
-        system.add_seabed_contact(n, depth=DEPTH, diameter=0.1, length=1.0, friction=0.3,
-                                  static_dynamic_scale=0.5)
+        system.add_seabed_contact(
+            n, depth=DEPTH, diameter=0.1, length=1.0, friction=0.3, static_dynamic_scale=0.5
+        )
     with pytest.raises(InvalidInputError, match="tangent"):
         system.add_seabed_contact(n, depth=DEPTH, diameter=0.1, length=1.0, tangent=(a, a))
     with pytest.raises(InvalidInputError, match="tangent"):

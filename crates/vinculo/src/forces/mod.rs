@@ -102,6 +102,8 @@ impl Force {
 
     /// Applied force on each touched particle, on the stack for the built-in kinds.
     #[inline(always)]
+    // The line elements hand over `Rows` already (their size depends on the node's tangent).
+    #[allow(clippy::useless_conversion)]
     pub fn force_rows(&self, q: &[Vec3], v: &[Vec3], t: f64) -> Rows {
         dispatch!(self, f => f.force(q, v, t).into())
     }
