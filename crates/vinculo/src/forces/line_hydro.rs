@@ -114,6 +114,11 @@ impl LineHydro {
         add(buoyancy, drag)
     }
 
+    /// Potential of the buoyancy, rho V g . q (the drag dissipates).
+    pub(crate) fn potential(&self, q: &[Vec3]) -> f64 {
+        self.density * self.volume() * dot(self.gravity, q[self.node.node()])
+    }
+
     pub(crate) fn force(&self, q: &[Vec3], v: &[Vec3], _t: f64) -> Rows {
         self.node.rows(self.node_force(q, v))
     }
@@ -197,6 +202,10 @@ mod tests {
         let b = 1025.0 * 9.80665 * vol;
         let f = e.node_force(&q, &rest);
         assert!((f[2] - b).abs() < 1e-12 * b && f[0] == 0.0 && f[1] == 0.0);
+        // The buoyancy is minus the gradient of its potential rho V g . q.
+        let mut up = q.clone();
+        up[1][2] += 1.0;
+        assert!((e.potential(&q) - e.potential(&up) - b).abs() < 1e-9 * b);
         let u = 0.7;
         let mut v = rest.clone();
         v[1] = [0.0, u, 0.0];

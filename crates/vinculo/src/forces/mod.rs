@@ -134,11 +134,13 @@ impl Force {
         dispatch!(self, f => f.add_jacobian(q, v, t, dq, dv))
     }
 
-    /// Potential energy (0 for non-conservative elements).
+    /// Potential energy of the conservative part (0 for non-conservative elements).
     pub fn potential(&self, q: &[Vec3]) -> f64 {
         match self {
             Force::SpringDamper(f) => f.potential(q),
             Force::Bending(f) => f.potential(q),
+            Force::SeabedContact(f) => f.potential(q),
+            Force::LineHydro(f) => f.potential(q),
             _ => 0.0,
         }
     }

@@ -184,6 +184,13 @@ impl SeabedContact {
         f
     }
 
+    /// Energy of the seabed's spring, A kBot p^2 / 2 while the node penetrates (the damping
+    /// and the friction dissipate).
+    pub(crate) fn potential(&self, q: &[Vec3]) -> f64 {
+        let p = (self.seabed_z - q[self.node.node()][2]).max(0.0);
+        0.5 * self.area * self.stiffness * p * p
+    }
+
     pub(crate) fn force(&self, q: &[Vec3], v: &[Vec3], _t: f64) -> Rows {
         self.node.rows(self.node_force(q, v))
     }
@@ -307,6 +314,21 @@ mod tests {
         above[1][2] = -49.9;
         let f = Force::SeabedContact(Box::new(contact(Some([0, 2]), friction(1.0))));
         fd::check(&f, &above, &v, 0.0);
+    }
+
+    /// At rest without friction the force is minus the gradient of the spring's energy.
+    #[test]
+    fn force_at_rest_is_minus_the_gradient_of_the_potential() {
+        let c = contact(None, SeabedFriction::NONE);
+        let (q, _) = state();
+        let rest = vec![[0.0; 3]; 3];
+        let f = c.node_force(&q, &rest);
+        let h = 1e-7;
+        let (mut qp, mut qm) = (q.clone(), q.clone());
+        qp[1][2] += h;
+        qm[1][2] -= h;
+        let grad = (c.potential(&qp) - c.potential(&qm)) / (2.0 * h);
+        assert!((f[2] + grad).abs() < 1e-6 * f[2], "{} vs {}", f[2], -grad);
     }
 
     /// Out of contact the force is zero; in contact at rest it is A kBot p upwards, the closed
