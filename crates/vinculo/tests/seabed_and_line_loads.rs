@@ -197,3 +197,44 @@ fn added_mass_lengthens_the_heave_period() {
         "period {measured} s against {period} s"
     );
 }
+
+/// A node held by a spring k in a uniform current U settles where the spring carries the drag
+/// of the current: k x = 1/2 rho Cd d l U^2 across the line, 1/2 rho CdAx pi d l U^2 along it
+/// (no gravity, so only the drag and the spring act; the drag damps the motion with
+/// c = rho C A U, a damping ratio of about 0.7, so it has settled to round-off in 20 s).
+#[test]
+fn node_in_a_current_settles_where_the_spring_carries_the_drag() {
+    let (cd, cdax, k, u) = (1.2, 0.4, 500.0, 0.8);
+    for (direction, area_coefficient) in [(1, cd * D * L), (0, cdax * std::f64::consts::PI * D * L)]
+    {
+        let mut s = System::new([0.0; 3]);
+        let a = s.add_particle(1.0, [-L, 0.0, 0.0], [0.0; 3], true).unwrap();
+        let b = s.add_particle(1.0, [L, 0.0, 0.0], [0.0; 3], true).unwrap();
+        let n = s.add_particle(MASS, [0.0; 3], [0.0; 3], false).unwrap();
+        let mut anchor_at = [0.0; 3];
+        anchor_at[direction] = -1.0;
+        let anchor = s.add_particle(1.0, anchor_at, [0.0; 3], true).unwrap();
+        s.add_spring_damper(anchor, n, k, 0.0, Some(1.0)).unwrap();
+        let mut current = [0.0; 3];
+        current[direction] = u;
+        let hydro = LineHydroSpec {
+            density: RHO,
+            diameter: D,
+            length: L,
+            cd,
+            cdax,
+            ca: 0.0,
+            caax: 0.0,
+            current,
+        };
+        s.add_line_hydrodynamics(n, Some((a, b)), &hydro).unwrap();
+        let sol = run(&s, 20.0, 1e-2);
+        let x = sol.position(sol.len() - 1, 2)[direction];
+        // The drag on the node at rest in the current U: 1/2 rho C A U^2.
+        let expected = 0.5 * RHO * area_coefficient * u * u / k;
+        assert!(
+            ((x - expected) / expected).abs() < 1e-6,
+            "direction {direction}: displacement {x} m against {expected} m"
+        );
+    }
+}
