@@ -24,6 +24,17 @@ use crate::model::System;
 /// alone: the multiplier (the tension) follows from the stretch, `c lambda = -Phi`, and puts
 /// no condition on the accelerations or on the positions.
 fn fill_saddle(system: &System, ws: &mut StepWorkspace, q: &[Vec3], t: f64) {
+    fill_saddle_rows(system, ws, (q, t), true)
+}
+
+/// [`fill_saddle`], with the compliant constraints' rows as exact ones when `compliant` is
+/// false.
+fn fill_saddle_rows(
+    system: &System,
+    ws: &mut StepWorkspace,
+    (q, t): (&[Vec3], f64),
+    compliant: bool,
+) {
     let layout = &ws.layout;
     let values = &mut ws.values;
     values.fill(0.0);
@@ -35,7 +46,7 @@ fn fill_saddle(system: &System, ws: &mut StepWorkspace, q: &[Vec3], t: f64) {
         // The saddle matrix has no Hessian term: no blocks.
         let values: &mut [f64] = values;
         let s = ws.scales[c];
-        if con.is_compliant() {
+        if compliant && con.is_compliant() {
             // The row is the unknown lambda / (s m_ref) itself (1 on the diagonal, whatever
             // the compliance: well conditioned as EA grows); its right-hand side says what
             // the multiplier is.
@@ -103,14 +114,47 @@ fn add_free(layout: &Layout, x: &[f64], out: &mut [Vec3]) {
     }
 }
 
-/// Accelerations and multipliers consistent with (q, v) at time t.
-pub fn consistent_accelerations(
+/// The multipliers of the system at rest at (q, t) with every constraint held exact (elastic
+/// segments as inextensible ones): a first iterate of the static equilibrium.
+pub(crate) fn rigid_multipliers(
+    system: &System,
+    ws: &mut StepWorkspace,
+    q: &[Vec3],
+    t: f64,
+) -> Result<Vec<f64>> {
+    let v = vec![[0.0; 3]; q.len()];
+    rest_right_hand_side(system, ws, q, &v, t, false);
+    ws.matrix.invalidate();
+    fill_saddle_rows(system, ws, (q, t), false);
+    ws.solver
+        .factor(&ws.values)
+        .map_err(|s| singular_error(system, &ws.layout, t, s))?;
+    ws.solver.solve_in_place(&mut ws.r);
+    let m3 = 3 * ws.layout.free;
+    let lambda: Vec<f64> = (0..system.constraints().len())
+        .map(|c| ws.r[m3 + c] * ws.scales[c] * ws.mass_ref)
+        .collect();
+    if lambda.iter().all(|x| x.is_finite()) {
+        Ok(lambda)
+    } else {
+        Err(Error::SingularMatrix {
+            t,
+            equation: "an unidentified equation".into(),
+            detail: "the solution is not finite".into(),
+        })
+    }
+}
+
+/// The right-hand side [M g + f; -gamma] / m_ref of the consistent start into `ws.r`; a
+/// compliant constraint's row gets its multiplier from the stretch when `compliant`.
+fn rest_right_hand_side(
     system: &System,
     ws: &mut StepWorkspace,
     q: &[Vec3],
     v: &[Vec3],
     t: f64,
-) -> Result<(Vec<Vec3>, Vec<f64>)> {
+    compliant: bool,
+) {
     let g = system.gravity();
     let m3 = 3 * ws.layout.free;
     ws.r.fill(0.0);
@@ -134,12 +178,24 @@ pub fn consistent_accelerations(
         }
     }
     for (c, con) in system.constraints().iter().enumerate() {
-        ws.r[m3 + c] = if con.is_compliant() {
+        ws.r[m3 + c] = if compliant && con.is_compliant() {
             -con.residual(q, t) / (con.compliance(t) * ws.scales[c] * ws.mass_ref)
         } else {
             -ws.scales[c] * con.gamma(q, v, t)
         };
     }
+}
+
+/// Accelerations and multipliers consistent with (q, v) at time t.
+pub fn consistent_accelerations(
+    system: &System,
+    ws: &mut StepWorkspace,
+    q: &[Vec3],
+    v: &[Vec3],
+    t: f64,
+) -> Result<(Vec<Vec3>, Vec<f64>)> {
+    let m3 = 3 * ws.layout.free;
+    rest_right_hand_side(system, ws, q, v, t, true);
     solve_saddle(system, ws, q, t)?;
     let mut a = vec![[0.0; 3]; q.len()];
     add_free(&ws.layout, &ws.r, &mut a);

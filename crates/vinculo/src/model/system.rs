@@ -409,6 +409,12 @@ impl System {
         self.constraints[c].tension(lambda)
     }
 
+    /// Fixes or frees particle `i` (an index of this system): how the linearised stiffness at a
+    /// point frees that point.
+    pub(crate) fn set_fixed(&mut self, i: usize, fixed: bool) {
+        self.particles[i].fixed = fixed;
+    }
+
     /// Inertia of each particle's translation: its mass plus the added mass of fluid elements.
     pub fn inertia(&self) -> Vec<f64> {
         let mut m: Vec<f64> = self.particles.iter().map(|p| p.mass).collect();
