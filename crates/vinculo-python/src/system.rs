@@ -203,6 +203,25 @@ impl PySystem {
         Ok(PyConstraintId { index: id.0 })
     }
 
+    /// Elastic segment: |q_a - q_b| = L(t) + (L(t)/EA) T, its multiplier the tension T (N).
+    /// `length` is a number or a law of time (a winch); `ea` in N, `math.inf`: inextensible.
+    #[pyo3(signature = (a, b, length, ea))]
+    fn add_elastic_distance(
+        &mut self,
+        a: &Bound<'_, PyAny>,
+        b: &Bound<'_, PyAny>,
+        length: &Bound<'_, PyAny>,
+        ea: f64,
+    ) -> PyResult<PyConstraintId> {
+        let (a, b) = (self.particle(a)?, self.particle(b)?);
+        let length = scalar(length, "unstretched length")?;
+        let id = self
+            .inner
+            .add_elastic_distance(a, b, length, ea)
+            .map_err(to_py)?;
+        Ok(PyConstraintId { index: id.0 })
+    }
+
     /// Fixed distance from a particle to a prescribed point p(t), Phi = L^2 - |q - p(t)|^2.
     #[pyo3(signature = (particle, point, length=None))]
     fn add_distance_to_point(
