@@ -33,7 +33,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from vinculo.errors import InvalidInputError
 
@@ -250,6 +249,8 @@ def solve_catenary(horizontal_span: float, vertical_span: float, length: float, 
                 f"solve_catenary: {name} = {value!r} is out of its domain (spans in m with "
                 f"the fairlead above the anchor, length > 0, weight in water >= 0 in N/m, "
                 f"EA > 0 in N)", name=name, value=value)
+    from scipy.optimize import brentq
+
     x_target, z_target = float(horizontal_span), float(vertical_span)
     chord = math.hypot(x_target, z_target)
     if weight == 0.0:
