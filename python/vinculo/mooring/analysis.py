@@ -235,9 +235,12 @@ def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_en
             cover the run, or a bad step or end time.
         ConvergenceError: when a step or the initial equilibrium fails.
     """
-    from vinculo.mooring.model import build_model
+    from vinculo.mooring.model import _check_motion, build_model
+    from vinculo.mooring.moordyn_file import read_moordyn
     from vinculo.simulate import simulate
 
+    if not isinstance(path, MoorDynFile):
+        path = read_moordyn(path)
     if isinstance(motion, (str, Path)):
         motion = Motion.from_csv(motion)
     if not (math.isfinite(t_end) and t_end > 0.0):
@@ -250,6 +253,7 @@ def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_en
                 f"{motion.source} covers t = {start:g} to {end:g} s; the run needs 0 to "
                 f"{t_end:g} s: give a shorter --t-end or a longer record", name="t_end",
                 value=t_end)
+    _check_motion(path, motion)
     built = build_model(path, motion)
     started = time.process_time()
     solution = simulate(built.system, t_end, dt, progress=progress, **options)
