@@ -332,8 +332,8 @@ def _stiffness(path: str, line: _Line, field_name: str, text: str, what: str) ->
         float(text)
     except ValueError:
         raise _error(path, line.number, field_name,
-                     f"{text!r}: {what} from a table file (non-linear stiffness) is not "
-                     f"supported yet; give one number", text) from None
+                     f"{text!r} is not a number (a file name here, {what} from a table of a "
+                     f"non-linear line, is not supported yet)", text) from None
     return _number(path, line, field_name, text)
 
 
