@@ -255,6 +255,10 @@ def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_en
                 value=t_end)
     _check_motion(path, motion)
     built = build_model(path, motion)
+    if motion is not None and np.any(motion.velocities(0.0) != 0.0):
+        # The coupled points start moving: the velocities of the lines' nodes are made
+        # consistent with theirs (the least mass-weighted change).
+        built.system.project_initial_state()
     started = time.process_time()
     solution = simulate(built.system, t_end, dt, progress=progress, **options)
     cpu = time.process_time() - started
