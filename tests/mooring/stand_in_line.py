@@ -13,6 +13,7 @@ use those instead.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -123,7 +124,7 @@ def add_line(system, end_a, end_b, line_type, unstretched_length, segments, wate
         nodes.append(particle.index)
     nodes.append(end_b)
     links = [system.add_distance(handles[i] if i < len(handles) else system.particles()[i],
-                                 system.particles()[j]) for i, j in zip(nodes, nodes[1:])]
+                                 system.particles()[j]) for i, j in itertools.pairwise(nodes)]
     return Line(nodes, links, cat, heading, -water.depth)
 
 

@@ -56,7 +56,7 @@ def test_run_api_returns_the_end_forces(line_api, tmp_path):
 
     if line_api != "real":
         pytest.skip("the stand-in's chain of exact distances is not in equilibrium at t = 0")
-    motion, path = _motion_file(tmp_path)
+    _motion, path = _motion_file(tmp_path)
     result = mooring.run(HANGING, path, 1.0, dt=0.01)
     assert result.end_forces.shape == (result.times.size, 1, 2, 3)
     statics = mooring.statics(HANGING)
