@@ -7,8 +7,8 @@ import pytest
 
 pytest.importorskip("moordyn")
 
-from vinculo.mooring.bench import CASES, motion_for  # noqa: E402
-from vinculo.mooring.peer import run_moordyn  # noqa: E402
+from vinculo.mooring.bench import CASES, motion_for
+from vinculo.mooring.peer import run_moordyn
 
 
 def _on(times, values, grid):
