@@ -183,3 +183,25 @@ def test_comments_are_ignored():
         "80.0          WtrDpth", "80.0          WtrDpth  # the depth at the site")
     assert parse_moordyn(text).options.depth == 80.0
     assert math.isclose(parse_moordyn(text).line_types["rope"].ea, 1e7)
+
+
+def test_moordyn_reads_the_written_options(tmp_path):
+    # The options are written under names MoorDyn-C 2.7 knows (it ignores, with a warning, a
+    # name it does not, such as rhoW): a density of 900 kg/m^3 written back changes MoorDyn's
+    # fairlead force exactly as the original file's does.
+    pytest.importorskip("moordyn")
+    from vinculo.mooring.peer import run_moordyn
+
+    base = tmp_path / "base.txt"
+    base.write_text((DATA / "taut_line.txt").read_text()
+                    .replace("100.0         TmaxIC", "2.0           TmaxIC"))
+    source = tmp_path / "light.txt"
+    source.write_text(base.read_text()
+                      .replace("80.0          WtrDpth", "80.0 WtrDpth\n900.0 rho\n9.81 g"))
+    model = read_moordyn(source)
+    assert (model.options.density, model.options.gravity) == (900.0, 9.81)
+    original = run_moordyn(source, None, 0.1)
+    rewritten = run_moordyn(model, None, 0.1)
+    default = run_moordyn(base, None, 0.1)
+    np.testing.assert_allclose(rewritten.end_forces, original.end_forces, rtol=1e-12, atol=1e-9)
+    assert abs(original.end_forces[0, 0, 1, 2] - default.end_forces[0, 0, 1, 2]) > 100.0

@@ -487,7 +487,7 @@ _MODEL_OPTIONS = {
 _SETTINGS = {
     "writelog", "tscheme", "cfl", "dtout", "dtic", "tmaxic", "cdscaleic", "threshic",
     "icdfac", "icthresh", "ictmax", "icgendynamic", "disableoutput", "disableouttime",
-    "writeunits", "echo", "outswitch", "inertialf", "inertialf_rampt",
+    "writeunits", "echo", "outswitch", "inertialf", "inertialf_rampt", "fileic",
 }
 
 # Options of features not supported yet: key -> what it asks for. A zero (or empty) value
@@ -732,7 +732,7 @@ def format_moordyn(model: MoorDynFile) -> str:
     named = [
         ("time_step", "dtM", "time step (s)"),
         ("gravity", "g", "gravitational acceleration (m/s^2)"),
-        ("density", "rhoW", "water density (kg/m^3)"),
+        ("density", "WtrDnsty", "water density (kg/m^3)"),
         ("depth", "WtrDpth", "water depth (m)"),
         ("kbot", "kBot", "seabed stiffness (Pa/m)"),
         ("cbot", "cBot", "seabed damping (Pa-s/m)"),
