@@ -17,12 +17,9 @@ file's OPTIONS), and the initial state is the static equilibrium
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 from vinculo._core import ParticleId, System
 from vinculo.errors import InvalidInputError
@@ -204,30 +201,3 @@ def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, 
 
         built.statics = solve_statics(system, **statics_options)
     return built
-
-
-def end_positions(built: MooringModel, positions: np.ndarray) -> np.ndarray:
-    """The positions of every line's two ends.
-
-    Arguments:
-        built: the model.
-        positions: ``(particles, 3)`` or ``(times, particles, 3)`` positions.
-
-    Returns:
-        ``(lines, 2, 3)`` or ``(times, lines, 2, 3)``.
-    """
-    index = np.array([built.line_ends(k) for k in range(len(built.lines))], dtype=int)
-    return np.asarray(positions)[..., index, :]
-
-
-def horizontal_distance(a: np.ndarray, b: np.ndarray) -> float:
-    """The horizontal distance between two points.
-
-    Arguments:
-        a: (x, y, z).
-        b: (x, y, z).
-
-    Returns:
-        ``sqrt((b_x - a_x)^2 + (b_y - a_y)^2)``.
-    """
-    return math.hypot(b[0] - a[0], b[1] - a[1])
