@@ -7,7 +7,8 @@ Each POINTS row becomes a particle:
   a :class:`~vinculo.mooring.motion.Motion` (fixed-coordinate constraints; the file's position
   when no motion is given), so that the constraint multipliers carry the force that holds it;
 - ``Free``: a free particle with the point's mass, and, for a point with a volume, its buoyancy,
-  added mass (``Ca``) and drag (``CdA``) as a Morison element in still water.
+  added mass (``Ca``) and drag (``CdA``) as a Morison element in still water (a point with no
+  volume, its drag ``1/2 rho CdA |v| v`` alone).
 
 Each LINES row becomes a line of lumped masses between its two points
 (:func:`vinculo.mooring.line.add_line`, with the line type, the water and the seabed of the
@@ -187,6 +188,8 @@ def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, 
             system.add_morison(particle, volume=point.volume, area=point.cda,
                                drag_coefficient=1.0 if point.cda > 0.0 else 0.0,
                                added_mass_coefficient=point.ca, density=options.density)
+        elif point.cda > 0.0:  # drag alone: 1/2 rho CdA |v| v against the motion
+            system.add_quadratic_drag(particle, 0.5 * options.density * point.cda)
         points.append(particle)
     lines = []
     for row in model.lines:
