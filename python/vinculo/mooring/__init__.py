@@ -18,9 +18,14 @@ Example:
     >>> result.to_csv("statics.csv")  # doctest: +SKIP
 """
 
-import contextlib
+import importlib
+import types
+from typing import Any
 
+from vinculo.mooring.analysis import MooringRun, MooringStatics, run
+from vinculo.mooring.analysis import statics as _statics
 from vinculo.mooring.catenary import CatenarySolution, solve_catenary, weight_in_water
+from vinculo.mooring.model import MooringModel, build_model
 from vinculo.mooring.moordyn_file import (
     FileLine,
     FileLineType,
@@ -34,13 +39,23 @@ from vinculo.mooring.moordyn_file import (
 )
 from vinculo.mooring.motion import Motion
 
-# The submodule vinculo.mooring.statics (the equilibrium solver) is imported before the function
-# statics() is bound below: a later import of the submodule then finds it loaded and leaves the
-# package's attribute `statics` the function.
-with contextlib.suppress(ImportError):
-    import vinculo.mooring.statics  # noqa: F401
-from vinculo.mooring.analysis import MooringRun, MooringStatics, run, statics
-from vinculo.mooring.model import MooringModel, build_model
+
+class _CallableModule(types.ModuleType):
+    """The module vinculo.mooring.statics (the equilibrium solver), callable as the analysis
+    :func:`vinculo.mooring.analysis.statics`: ``vinculo.mooring.statics(path)`` and
+    ``vinculo.mooring.statics.solve_statics(system)`` both work."""
+
+    def __call__(self, *args: Any, **kwargs: Any) -> MooringStatics:
+        return _statics(*args, **kwargs)
+
+
+try:
+    statics = importlib.import_module("vinculo.mooring.statics")
+    statics.__class__ = _CallableModule
+except ModuleNotFoundError as missing:  # the equilibrium solver is not in this tree
+    if missing.name != "vinculo.mooring.statics":
+        raise
+    statics = _statics
 
 __all__ = [
     "CatenarySolution",
