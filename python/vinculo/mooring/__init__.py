@@ -49,13 +49,22 @@ class _CallableModule(types.ModuleType):
         return _statics(*args, **kwargs)
 
 
-try:
-    statics = importlib.import_module("vinculo.mooring.statics")
-    statics.__class__ = _CallableModule
-except ModuleNotFoundError as missing:  # the equilibrium solver is not in this tree
-    if missing.name != "vinculo.mooring.statics":
-        raise
-    statics = _statics
+def _statics_entry() -> Any:
+    """The solver module made callable, or the analysis function alone without the module."""
+    try:
+        module = importlib.import_module("vinculo.mooring.statics")
+    except ModuleNotFoundError as missing:  # the equilibrium solver is not in this tree
+        if missing.name != "vinculo.mooring.statics":
+            raise
+        return _statics
+    module.__class__ = _CallableModule
+    return module
+
+
+statics = _statics_entry()
+"""The static equilibrium of a MoorDyn file: ``statics(path)`` is
+:func:`vinculo.mooring.analysis.statics` (end forces, tensions and laid lengths); the same name is
+the module of the equilibrium solver (``vinculo.mooring.statics.solve_statics``)."""
 
 __all__ = [
     "CatenarySolution",
