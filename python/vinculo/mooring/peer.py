@@ -254,42 +254,57 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
 
 
 def largest_stable_step(source: str | Path | MoorDynFile, motion: Motion | None, t_end: float,
-                        reference: PeerRun, *, low: float, high: float,
+                        reference: PeerRun | None = None, *, low: float, high: float,
                         tolerance: float = 0.05, ratio: float = 1.1,
                         dt_output: float = 0.1) -> tuple[float, int]:
     """MoorDyn's largest stable time step on a case, by bisection on dtM.
 
-    A step is stable when the run reaches ``t_end`` with finite forces whose end tensions stay
-    within ``tolerance`` (relative to the largest reference tension) of ``reference``, a run
-    at a small step.
+    With a ``reference`` (a run at a small step with the same ``dt_output``), a step is stable
+    when the run reaches ``t_end`` with end tensions within ``tolerance`` (relative to the
+    largest reference tension) of the reference's. Without one, when the run reaches ``t_end``
+    with finite forces whose tensions never exceed ten times their largest value at t = 0 (no
+    blow-up).
 
     Arguments:
         source: the MoorDyn input file or model.
         motion: the coupled points' motion.
         t_end: the end time (s).
-        reference: a run at a step known to be stable and accurate, with the same
-            ``dt_output``.
-        low: a step known to be stable (s).
-        high: a step above the stable range (s); checked, and doubled until unstable.
+        reference: a run at a step known to be stable and accurate (None: the blow-up test).
+        low: a step thought to be stable (s); halved until it is.
+        high: a step thought to be above the stable range (s); doubled until it is.
         tolerance: the largest relative difference in end tension accepted.
         ratio: stop when ``high / low`` is below this.
         dt_output: the output interval (s), the same as the reference's.
 
     Returns:
         ``(step, runs)``: the largest stable step found (s) and the number of MoorDyn runs.
+
+    Raises:
+        PeerError: when no step down to a millionth of ``low`` is stable.
     """
-    scale = float(np.nanmax(reference.end_tensions))
+    scale = float(np.nanmax(reference.end_tensions)) if reference is not None else math.nan
     runs = 0
 
     def stable(dt: float) -> bool:
         nonlocal runs
         runs += 1
         run = run_moordyn(source, motion, t_end, dt_output=dt_output, time_step=dt)
-        if run.error is not None or run.times.size != reference.times.size:
+        if run.error is not None or run.times.size < round(t_end / dt_output) + 1:
             return False
-        diff = np.abs(run.end_tensions - reference.end_tensions)
-        return bool(np.all(np.isfinite(diff)) and diff.max() <= tolerance * scale)
+        tensions = run.end_tensions
+        if not np.all(np.isfinite(tensions)):
+            return False
+        if reference is None:
+            return bool(tensions.max() <= 10.0 * max(tensions[0].max(), 1e-300))
+        if run.times.size != reference.times.size:
+            return False
+        return bool(np.abs(tensions - reference.end_tensions).max() <= tolerance * scale)
 
+    floor = low * 1e-6
+    while not stable(low):
+        high, low = low, low / 2.0
+        if low < floor:
+            raise PeerError(f"MoorDyn found no stable step down to {floor:g} s")
     for _ in range(20):
         if not stable(high):
             break
