@@ -423,6 +423,106 @@ class System:
             InvalidInputError: a value outside its domain.
             UnknownHandleError: a handle of another system.
         """
+    def add_seabed_contact(
+        self,
+        node: ParticleId,
+        *,
+        depth: float,
+        diameter: float,
+        length: float,
+        kbot: float = 3.0e6,
+        cbot: float = 3.0e5,
+        tangent: tuple[ParticleId, ParticleId] | None = None,
+        friction: float = 0.0,
+        axial_friction: float | None = None,
+        friction_damping: float = 200.0,
+        static_dynamic_scale: float = 1.0,
+        damping_ramp: float = 0.0,
+    ) -> ForceId:
+        """Contact of a line node with a flat seabed at ``z = -depth``, MoorDyn's model
+        (docs/theory/seabed-and-line-loads.md).
+
+        While the node penetrates (``p = -depth - z > 0``) the seabed pushes it up with
+        ``N = d l (kbot p - cbot v_z)``, and friction opposes its sliding velocity, separately
+        along the line (``axial_friction``) and across it (``friction``): ``-mu friction_damping w``
+        for slow sliding, ``-mu |N| w / |w|`` (Coulomb) once ``friction_damping |w| >
+        static_dynamic_scale |N|``.
+
+        Arguments:
+            node: the line node.
+            depth: water depth (m); the seabed is the plane z = -depth.
+            diameter: the line's volume-equivalent diameter d (m, > 0).
+            length: the length of line l the node stands for (m, > 0): half a segment on each
+                side.
+            kbot: seabed stiffness per unit area (Pa/m, >= 0), MoorDyn's kBot.
+            cbot: seabed damping per unit area (Pa s/m, >= 0), MoorDyn's cBot.
+            tangent: (a, b): the line's direction at the node points from particle a to b (the
+                node's neighbours, or the node and its one neighbour at an end of the line);
+                None: friction with ``friction`` in every direction.
+            friction: transverse kinetic friction coefficient (>= 0), MoorDyn's
+                FrictionCoefficient.
+            axial_friction: axial kinetic friction coefficient (>= 0); None: equal to
+                ``friction`` (MoorDyn-C's single coefficient).
+            friction_damping: slope of the friction at small speeds (N s/m, > 0), MoorDyn's
+                FricDamp.
+            static_dynamic_scale: ratio of static to kinetic friction (>= 1), MoorDyn's
+                StatDynFricScale.
+            damping_ramp: penetration (m, >= 0) over which the damping grows linearly from zero
+                to ``cbot``, which smooths the contact for Newton's iteration; 0: MoorDyn's law,
+                full damping from the first touch.
+
+        Returns:
+            The force's handle.
+
+        Raises:
+            InvalidInputError: a value outside its domain, or a tangent that is not two
+                different particles.
+            UnknownHandleError: a handle of another system.
+        """
+    def add_line_hydrodynamics(
+        self,
+        node: ParticleId,
+        *,
+        diameter: float,
+        length: float,
+        cd: float = 0.0,
+        cdax: float = 0.0,
+        ca: float = 0.0,
+        caax: float = 0.0,
+        density: float = 1025.0,
+        tangent: tuple[ParticleId, ParticleId] | None = None,
+        current: Vector | None = None,
+    ) -> ForceId:
+        """Buoyancy, drag and added mass of a line node in water, MoorDyn's model in the line's
+        local frame (docs/theory/seabed-and-line-loads.md).
+
+        With the volume ``V = pi d^2 / 4 l`` and the velocity relative to the current
+        ``r = current - v`` split into its parts along (``r_a``) and across (``r_n``) the line:
+        buoyancy ``rho V g`` upwards, normal drag ``1/2 rho cd d l |r_n| r_n``, axial drag
+        ``1/2 rho cdax pi d l |r_a| r_a``. The added mass ``ca rho V`` joins the node's inertia
+        in every direction (the axial coefficient ``caax`` is not yet applied separately).
+
+        Arguments:
+            node: the line node.
+            diameter: the line's volume-equivalent diameter d (m, > 0).
+            length: the length of line l the node stands for (m, > 0).
+            cd: normal drag coefficient (>= 0).
+            cdax: axial drag coefficient (>= 0).
+            ca: normal added-mass coefficient (>= 0).
+            caax: axial added-mass coefficient (>= 0).
+            density: water density rho (kg/m^3, > 0).
+            tangent: (a, b): the line's direction at the node, from particle a to b, as for
+                ``add_seabed_contact``; None: drag with ``cd`` in every direction.
+            current: a uniform current (m/s, 3 numbers); None: still water.
+
+        Returns:
+            The force's handle.
+
+        Raises:
+            InvalidInputError: a value outside its domain, or a tangent that is not two
+                different particles.
+            UnknownHandleError: a handle of another system.
+        """
     def set_tension_only(self, constraint: ConstraintId) -> None:
         """Declare a distance constraint a string: runs stop with NegativeTensionError when it
         would have to push.

@@ -6,8 +6,8 @@ use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use vinculo::forces::MorisonSpec;
-use vinculo::model::{ParticleId, RigidBodySpec, System};
+use vinculo::forces::{MorisonSpec, SeabedFriction};
+use vinculo::model::{LineHydroSpec, ParticleId, RigidBodySpec, SeabedSpec, System};
 
 /// Handle to a particle of one System.
 #[pyclass(name = "ParticleId", module = "vinculo._core", frozen, eq, hash)]
@@ -87,7 +87,36 @@ fn vec3(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<[f64; 3]> {
     Ok([v[0], v[1], v[2]])
 }
 
+/// mu_a / mu_t when the axial friction coefficient is not given: MoorDyn-C applies one
+/// coefficient to the whole sliding velocity.
+const AXIAL_FRICTION_RATIO: f64 = 1.0;
+
 impl PySystem {
+    /// A line tangent given as a pair (a, b) of particles, or None.
+    fn tangent(
+        &self,
+        tangent: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Option<(ParticleId, ParticleId)>> {
+        let Some(pair) = tangent else {
+            return Ok(None);
+        };
+        let items: Vec<Bound<'_, PyAny>> = pair.extract().map_err(|_| {
+            invalid(
+                "tangent",
+                pair.repr().map(|r| r.to_string()).unwrap_or_default(),
+                "expected a pair (a, b) of ParticleIds: the tangent points from a to b",
+            )
+        })?;
+        if items.len() != 2 {
+            return Err(invalid(
+                "tangent",
+                pair.repr().map(|r| r.to_string()).unwrap_or_default(),
+                "expected exactly two ParticleIds (a, b)",
+            ));
+        }
+        Ok(Some((self.particle(&items[0])?, self.particle(&items[1])?)))
+    }
+
     fn particle(&self, obj: &Bound<'_, PyAny>) -> PyResult<ParticleId> {
         let id = obj.cast::<PyParticleId>().map_err(|_| {
             Python::attach(|py| {
@@ -456,6 +485,85 @@ impl PySystem {
             fluid,
         };
         let id = self.inner.add_morison(p, spec).map_err(to_py)?;
+        Ok(PyForceId { index: id.0 })
+    }
+
+    /// Seabed contact and friction of a line node (MoorDyn's kBot, cBot, friction model).
+    #[pyo3(signature = (node, *, depth, diameter, length, kbot=3.0e6, cbot=3.0e5, tangent=None, friction=0.0, axial_friction=None, friction_damping=200.0, static_dynamic_scale=1.0, damping_ramp=0.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_seabed_contact(
+        &mut self,
+        node: &Bound<'_, PyAny>,
+        depth: f64,
+        diameter: f64,
+        length: f64,
+        kbot: f64,
+        cbot: f64,
+        tangent: Option<&Bound<'_, PyAny>>,
+        friction: f64,
+        axial_friction: Option<f64>,
+        friction_damping: f64,
+        static_dynamic_scale: f64,
+        damping_ramp: f64,
+    ) -> PyResult<PyForceId> {
+        let n = self.particle(node)?;
+        let tangent = self.tangent(tangent)?;
+        let spec = SeabedSpec {
+            depth,
+            diameter,
+            length,
+            stiffness: kbot,
+            damping: cbot,
+            damping_ramp,
+            friction: SeabedFriction {
+                transverse: friction,
+                axial: axial_friction.unwrap_or(friction * AXIAL_FRICTION_RATIO),
+                damping: friction_damping,
+                static_scale: static_dynamic_scale,
+            },
+        };
+        let id = self
+            .inner
+            .add_seabed_contact(n, tangent, &spec)
+            .map_err(to_py)?;
+        Ok(PyForceId { index: id.0 })
+    }
+
+    /// Buoyancy, drag and added mass of a line node in water (MoorDyn's Cd, CdAx, Ca, CaAx).
+    #[pyo3(signature = (node, *, diameter, length, cd=0.0, cdax=0.0, ca=0.0, caax=0.0, density=1025.0, tangent=None, current=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_line_hydrodynamics(
+        &mut self,
+        node: &Bound<'_, PyAny>,
+        diameter: f64,
+        length: f64,
+        cd: f64,
+        cdax: f64,
+        ca: f64,
+        caax: f64,
+        density: f64,
+        tangent: Option<&Bound<'_, PyAny>>,
+        current: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<PyForceId> {
+        let n = self.particle(node)?;
+        let tangent = self.tangent(tangent)?;
+        let spec = LineHydroSpec {
+            density,
+            diameter,
+            length,
+            cd,
+            cdax,
+            ca,
+            caax,
+            current: current
+                .map(|c| vec3(c, "current"))
+                .transpose()?
+                .unwrap_or([0.0; 3]),
+        };
+        let id = self
+            .inner
+            .add_line_hydrodynamics(n, tangent, &spec)
+            .map_err(to_py)?;
         Ok(PyForceId { index: id.0 })
     }
 

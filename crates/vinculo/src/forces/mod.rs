@@ -9,6 +9,9 @@
 //!
 //! - `added_mass()`: mass added to a particle's inertia (fluid elements only).
 //!
+//! Line elements ([`SeabedContact`], [`LineHydro`]) act on one node of a line and read its
+//! tangent from its neighbours ([`LineNode`]).
+//!
 //! The local values are [`crate::local`]'s, placed by the one assembler whatever n is.
 //!
 //! Uniform gravity acts on every particle and lives in the [`System`](crate::model::System) itself.
@@ -20,14 +23,20 @@
 mod applied;
 mod bending;
 mod drag;
+mod line_hydro;
+mod line_node;
 mod morison;
+mod seabed;
 mod spring_damper;
 pub mod user;
 
 pub use applied::AppliedForce;
 pub use bending::Bending;
 pub use drag::{LinearDrag, QuadraticDrag};
+pub use line_hydro::LineHydro;
+pub use line_node::LineNode;
 pub use morison::{Morison, MorisonSpec};
+pub use seabed::{SeabedContact, SeabedFriction};
 pub use spring_damper::SpringDamper;
 pub use user::{ForceGroup, UserForce, UserForces};
 
@@ -54,6 +63,10 @@ pub enum Force {
     Morison(Box<Morison>),
     /// Bending stiffness at the middle of three consecutive particles.
     Bending(Bending),
+    /// Seabed contact and friction on a line node.
+    SeabedContact(Box<SeabedContact>),
+    /// Buoyancy and drag on a line node, in the line's local frame.
+    LineHydro(Box<LineHydro>),
     /// One element of a group computed by a user function.
     User(UserForce),
 }
@@ -67,6 +80,8 @@ macro_rules! dispatch {
             Force::QuadraticDrag($f) => $e,
             Force::Morison($f) => $e,
             Force::Bending($f) => $e,
+            Force::SeabedContact($f) => $e,
+            Force::LineHydro($f) => $e,
             Force::User($f) => $e,
         }
     };
@@ -87,6 +102,8 @@ impl Force {
 
     /// Applied force on each touched particle, on the stack for the built-in kinds.
     #[inline(always)]
+    // The line elements hand over `Rows` already (their size depends on the node's tangent).
+    #[allow(clippy::useless_conversion)]
     pub fn force_rows(&self, q: &[Vec3], v: &[Vec3], t: f64) -> Rows {
         dispatch!(self, f => f.force(q, v, t).into())
     }
@@ -117,11 +134,13 @@ impl Force {
         dispatch!(self, f => f.add_jacobian(q, v, t, dq, dv))
     }
 
-    /// Potential energy (0 for non-conservative elements).
+    /// Potential energy of the conservative part (0 for non-conservative elements).
     pub fn potential(&self, q: &[Vec3]) -> f64 {
         match self {
             Force::SpringDamper(f) => f.potential(q),
             Force::Bending(f) => f.potential(q),
+            Force::SeabedContact(f) => f.potential(q),
+            Force::LineHydro(f) => f.potential(q),
             _ => 0.0,
         }
     }
@@ -136,6 +155,7 @@ impl Force {
     pub fn added_mass(&self) -> Option<(usize, f64)> {
         match self {
             Force::Morison(f) => Some((f.particles[0], f.added_mass())),
+            Force::LineHydro(f) => Some((f.node.node(), f.added_mass())),
             _ => None,
         }
     }
@@ -161,6 +181,8 @@ impl Force {
             Force::QuadraticDrag(_) => format!("quadratic drag #{index} (particle {})", p[0]),
             Force::Morison(_) => format!("fluid forces #{index} (particle {})", p[0]),
             Force::Bending(_) => format!("bending #{index} (particles {p:?})"),
+            Force::SeabedContact(_) => format!("seabed contact #{index} (node {})", p[0]),
+            Force::LineHydro(_) => format!("line hydrodynamics #{index} (node {})", p[0]),
             Force::User(f) => format!(
                 "user force '{}' element {} #{index} (particles {p:?})",
                 f.group.name, f.element

@@ -1,11 +1,13 @@
 //! The model: particles and the system that owns them with their constraints and forces, and
 //! rigid bodies built from particles.
 
+mod line_loads;
 mod particle;
 mod rigid_body;
 mod system;
 pub mod user_groups;
 
+pub use line_loads::{LineHydroSpec, SeabedSpec};
 pub use particle::{ConstraintId, ForceId, Particle, ParticleId};
 pub use rigid_body::{RigidBody, RigidBodySpec};
 pub use system::System;

@@ -1,0 +1,133 @@
+//! A node of a lumped-mass line and its unit tangent, the local frame of the node's seabed
+//! friction and hydrodynamic loads.
+//!
+//! MoorDyn's convention (MoorDyn-F `MoorDyn_Line.f90`, `Line_GetStateDeriv`; MoorDyn-C
+//! `Line.cpp`, `getStateDeriv`): at an interior node i the tangent is the direction of the
+//! chord between its neighbours, t_i = (q_{i+1} - q_{i-1}) / |q_{i+1} - q_{i-1}|; at an end
+//! node, the direction of its one segment (t_0 = (q_1 - q_0)/|.|, t_N = (q_N - q_{N-1})/|.|).
+//! Here a tangent is the direction from a particle a to a particle b, t = d / |d| with
+//! d = q_b - q_a, and its derivatives are
+//!
+//! ```text
+//! dt/dq_b = (I - t t^T) / |d| = P / |d|,        dt/dq_a = -P / |d|
+//! ```
+//!
+//! A node without neighbours (a lone particle) has no tangent: its loads are then isotropic.
+//!
+//! The elements built on a node act on the node alone (the force on its neighbours is zero),
+//! but depend on the neighbours' positions through t: their Jacobian has the blocks
+//! df_node/dq_neighbour.
+
+use crate::math::{diag, norm, outer, scale, sub, Mat3, Vec3};
+
+/// A line node: the particle that carries the loads, and the particles that give its tangent.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LineNode {
+    /// Touched particles: the node first, then the tangent's particles that are not the node.
+    pub particles: [usize; 3],
+    /// Number of touched particles (1, 2 or 3).
+    pub count: usize,
+    /// Local indices (into `particles`) of the tangent's particles (a, b): t = unit(q_b - q_a);
+    /// `None` for a node without a tangent.
+    pub tangent: Option<[usize; 2]>,
+}
+
+/// A node's tangent at a configuration: t, and the projector P / |d| of its derivative.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Tangent {
+    /// Unit tangent t.
+    pub t: Vec3,
+    /// dt/dq_b = (I - t t^T) / |d| (and dt/dq_a = minus it).
+    pub dt_db: Mat3,
+    /// Local indices (a, b) of the particles the tangent depends on.
+    pub ends: [usize; 2],
+}
+
+impl LineNode {
+    /// A node whose tangent runs from particle `a` to particle `b` (either may be the node
+    /// itself, as at the ends of a line), or a node without a tangent (`None`).
+    /// The caller checks that a != b.
+    pub fn new(node: usize, tangent: Option<[usize; 2]>) -> LineNode {
+        let mut particles = [node; 3];
+        let mut count = 1;
+        let mut local = |p: usize| -> usize {
+            if let Some(k) = particles[..count].iter().position(|&x| x == p) {
+                k
+            } else {
+                particles[count] = p;
+                count += 1;
+                count - 1
+            }
+        };
+        let tangent = tangent.map(|[a, b]| [local(a), local(b)]);
+        LineNode {
+            particles,
+            count,
+            tangent,
+        }
+    }
+
+    /// The touched particles, the node first.
+    #[inline]
+    pub fn particles(&self) -> &[usize] {
+        &self.particles[..self.count]
+    }
+
+    /// The node's particle.
+    #[inline]
+    pub fn node(&self) -> usize {
+        self.particles[0]
+    }
+
+    /// The unit tangent at positions `q` (None without a tangent, or where its two particles
+    /// coincide).
+    pub(crate) fn tangent(&self, q: &[Vec3]) -> Option<Tangent> {
+        let [a, b] = self.tangent?;
+        let d = sub(q[self.particles[b]], q[self.particles[a]]);
+        let len = norm(d);
+        if len == 0.0 {
+            return None;
+        }
+        let t = scale(1.0 / len, d);
+        let dt_db = outer(-1.0 / len, t, t);
+        let dt_db = crate::math::add_mat(diag(1.0 / len), dt_db);
+        Some(Tangent {
+            t,
+            dt_db,
+            ends: [a, b],
+        })
+    }
+
+    /// A node force, placed as the element's local rows (zero on the neighbours).
+    #[inline]
+    pub(crate) fn rows(&self, f: Vec3) -> crate::local::Rows {
+        match self.count {
+            1 => [f].into(),
+            2 => [f, [0.0; 3]].into(),
+            _ => [f, [0.0; 3], [0.0; 3]].into(),
+        }
+    }
+}
+
+/// The matrix product a b.
+#[inline]
+pub(crate) fn mul(a: Mat3, b: Mat3) -> Mat3 {
+    std::array::from_fn(|r| std::array::from_fn(|c| (0..3).map(|k| a[r][k] * b[k][c]).sum()))
+}
+
+impl Tangent {
+    /// Adds (df/dt) (dt/dq) into the node's row of `dq`, for a force f on the node whose
+    /// derivative with respect to the tangent is `df_dt`.
+    pub(crate) fn add_chain(&self, df_dt: Mat3, dq: &mut crate::local::Blocks) {
+        let j = mul(df_dt, self.dt_db);
+        let [a, b] = self.ends;
+        dq[0][b] = crate::math::add_mat(dq[0][b], j);
+        dq[0][a] = crate::math::add_mat(dq[0][a], crate::math::scale_mat(-1.0, j));
+    }
+}
+
+/// d(w)/dt for the axial part w = t (t . x) of a vector x: t x^T + (t . x) I.
+#[inline]
+pub(crate) fn axial_part_by_tangent(t: Vec3, x: Vec3) -> Mat3 {
+    crate::math::add_mat(outer(1.0, t, x), diag(crate::math::dot(t, x)))
+}

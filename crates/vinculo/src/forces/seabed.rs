@@ -1,0 +1,364 @@
+//! Contact of a line node with a flat seabed at z = z_b (= -depth), with Coulomb friction
+//! regularised as MoorDyn does (`docs/theory/seabed-and-line-loads.md`).
+//!
+//! Normal force (MoorDyn: kBot, cBot per unit area; the contact area is the node's projected
+//! area A = d l, d the line's diameter and l the node's length, half a segment each side):
+//!
+//! ```text
+//! p = z_b - z                       penetration (contact while p > 0)
+//! N = A (kBot p - cBot v_z)         f_n = N e_z
+//! ```
+//!
+//! As in MoorDyn the damping acts whenever the node penetrates, in either direction of v_z, so
+//! N may be negative (the seabed holds a node that leaves it fast); friction uses |N|.
+//!
+//! Friction (MoorDyn-F's transverse/axial model): the node's velocity along the seabed
+//! v_s = (v_x, v_y, 0) splits into the axial part v_a = t (t . v_s) along the line's tangent t
+//! ([`super::line_node`]) and the transverse part v_t = v_s - v_a. Each part w with kinetic
+//! coefficient mu (mu_t, mu_a) gets
+//!
+//! ```text
+//! f = -mu c_v w                     if c_v |w| <= m_c |N|     (linear, "static" branch)
+//! f = -mu |N| w / |w|               otherwise                 (kinetic Coulomb friction)
+//! ```
+//!
+//! with c_v = FricDamp (N s/m) and m_c = StatDynFricScale (>= 1). With m_c = 1 the friction is
+//! continuous (a kink where the branches meet); with m_c > 1 it drops from m_c mu |N| to mu |N|
+//! there. A node without a tangent gets the transverse coefficient in every direction.
+//!
+//! Smoothness: the normal force is continuous in q at p = 0 (a kink) but jumps by
+//! -A cBot v_z in v_z there, exactly as MoorDyn's; the Jacobian is the one of the branch the
+//! state is in (one-sided at the kinks). No regularisation beyond MoorDyn's own.
+//!
+//! Jacobian (contact, the node local 0): dN/dz = -A kBot, dN/dv_z = -A cBot; for each friction
+//! part, linear branch df/dw = -mu c_v I, kinetic branch df/dw = -mu |N| (I - u u^T)/|w| with
+//! u = w/|w|, df/dN = -mu sgn(N) u; dw/dv and dw/dt follow from w = t t^T S v or (I - t t^T) S v,
+//! S = diag(1, 1, 0), and dt/dq from [`super::line_node`].
+
+use super::line_node::{axial_part_by_tangent, mul, LineNode, Tangent};
+use super::Jacobian;
+use crate::local::Rows;
+use crate::math::{add, add_mat, diag, dot, norm, outer, scale, scale_mat, sub, Mat3, Vec3};
+
+/// MoorDyn's seabed friction parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeabedFriction {
+    /// Transverse kinetic coefficient mu_t (MoorDyn's FrictionCoefficient, MoorDyn-F's MuKT).
+    pub transverse: f64,
+    /// Axial kinetic coefficient mu_a (MoorDyn-F's MuKA).
+    pub axial: f64,
+    /// Slope c_v of the linear branch (N s/m, MoorDyn's FricDamp / MoorDyn-F's CV, default 200).
+    pub damping: f64,
+    /// Ratio m_c of static to kinetic friction (MoorDyn's StatDynFricScale / MoorDyn-F's MC,
+    /// default 1).
+    pub static_scale: f64,
+}
+
+impl SeabedFriction {
+    /// No friction.
+    pub const NONE: SeabedFriction = SeabedFriction {
+        transverse: 0.0,
+        axial: 0.0,
+        damping: 200.0,
+        static_scale: 1.0,
+    };
+}
+
+/// Seabed contact and friction on one line node.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeabedContact {
+    /// The node and the particles of its tangent.
+    pub node: LineNode,
+    /// Height of the seabed z_b (m; -depth).
+    pub seabed_z: f64,
+    /// Contact area A = d l (m^2).
+    pub area: f64,
+    /// kBot (Pa/m).
+    pub stiffness: f64,
+    /// cBot (Pa s/m).
+    pub damping: f64,
+    /// Penetration over which the damping ramps up linearly from zero (m); 0: MoorDyn's
+    /// damping, full as soon as the node touches.
+    pub damping_ramp: f64,
+    /// Friction parameters.
+    pub friction: SeabedFriction,
+}
+
+/// One friction part: its velocity w, how w depends on the node's velocity (dw/dv) and on the
+/// tangent (dw/dt, None when w does not depend on it).
+struct Part {
+    mu: f64,
+    w: Vec3,
+    dw_dv: Mat3,
+    dw_dt: Option<Mat3>,
+}
+
+/// S = diag(1, 1, 0): the velocity along a flat seabed.
+const ALONG: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.0]];
+
+impl SeabedContact {
+    pub(crate) fn particles(&self) -> &[usize] {
+        self.node.particles()
+    }
+
+    /// Normal force N (N, along +z) with dN/dz and dN/dv_z; None out of contact.
+    fn normal(&self, q: Vec3, v: Vec3) -> Option<(f64, f64, f64)> {
+        let p = self.seabed_z - q[2];
+        if p <= 0.0 {
+            return None;
+        }
+        let a = self.area;
+        let (ramp, dramp_dz) = if p < self.damping_ramp {
+            (p / self.damping_ramp, -1.0 / self.damping_ramp)
+        } else {
+            (1.0, 0.0)
+        };
+        let n = a * (self.stiffness * p - self.damping * ramp * v[2]);
+        let dn_dz = -a * self.stiffness - a * self.damping * dramp_dz * v[2];
+        Some((n, dn_dz, -a * self.damping * ramp))
+    }
+
+    /// The friction parts (transverse, axial) at velocity v and tangent t.
+    fn parts(&self, v: Vec3, tangent: Option<&Tangent>) -> [Option<Part>; 2] {
+        let fr = &self.friction;
+        let vs = [v[0], v[1], 0.0];
+        match tangent {
+            None => [
+                (fr.transverse > 0.0).then_some(Part {
+                    mu: fr.transverse,
+                    w: vs,
+                    dw_dv: ALONG,
+                    dw_dt: None,
+                }),
+                None,
+            ],
+            Some(tg) => {
+                let t = tg.t;
+                let tt = outer(1.0, t, t);
+                let va = scale(dot(t, vs), t);
+                let da_dt = axial_part_by_tangent(t, vs);
+                let da_dv = mul(tt, ALONG);
+                [
+                    (fr.transverse > 0.0).then(|| Part {
+                        mu: fr.transverse,
+                        w: sub(vs, va),
+                        dw_dv: add_mat(ALONG, scale_mat(-1.0, da_dv)),
+                        dw_dt: Some(scale_mat(-1.0, da_dt)),
+                    }),
+                    (fr.axial > 0.0).then_some(Part {
+                        mu: fr.axial,
+                        w: va,
+                        dw_dv: da_dv,
+                        dw_dt: Some(da_dt),
+                    }),
+                ]
+            }
+        }
+    }
+
+    /// The friction of one part under normal force `n`: f, and whether it is on the kinetic
+    /// branch.
+    fn friction_of(&self, part: &Part, n: f64) -> (Vec3, bool) {
+        let fr = &self.friction;
+        let s = norm(part.w);
+        if fr.damping * s > fr.static_scale * n.abs() {
+            (scale(-part.mu * n.abs() / s, part.w), true)
+        } else {
+            (scale(-part.mu * fr.damping, part.w), false)
+        }
+    }
+
+    /// The contact force on the node (normal and friction) at its position and velocity.
+    pub(crate) fn node_force(&self, q: &[Vec3], v: &[Vec3]) -> Vec3 {
+        let i = self.node.node();
+        let Some((n, _, _)) = self.normal(q[i], v[i]) else {
+            return [0.0; 3];
+        };
+        let mut f = [0.0, 0.0, n];
+        if self.friction.transverse > 0.0 || self.friction.axial > 0.0 {
+            let tangent = self.node.tangent(q);
+            for part in self.parts(v[i], tangent.as_ref()).iter().flatten() {
+                f = add(f, self.friction_of(part, n).0);
+            }
+        }
+        f
+    }
+
+    /// Energy of the seabed's spring, A kBot p^2 / 2 while the node penetrates (the damping
+    /// and the friction dissipate).
+    pub(crate) fn potential(&self, q: &[Vec3]) -> f64 {
+        let p = (self.seabed_z - q[self.node.node()][2]).max(0.0);
+        0.5 * self.area * self.stiffness * p * p
+    }
+
+    pub(crate) fn force(&self, q: &[Vec3], v: &[Vec3], _t: f64) -> Rows {
+        self.node.rows(self.node_force(q, v))
+    }
+
+    pub(crate) fn add_jacobian(
+        &self,
+        q: &[Vec3],
+        v: &[Vec3],
+        _t: f64,
+        dq: &mut Jacobian,
+        dv: &mut Jacobian,
+    ) {
+        let i = self.node.node();
+        let Some((n, dn_dz, dn_dvz)) = self.normal(q[i], v[i]) else {
+            return;
+        };
+        dq[0][0][2][2] += dn_dz;
+        dv[0][0][2][2] += dn_dvz;
+        if self.friction.transverse == 0.0 && self.friction.axial == 0.0 {
+            return;
+        }
+        let tangent = self.node.tangent(q);
+        let fr = &self.friction;
+        for part in self.parts(v[i], tangent.as_ref()).iter().flatten() {
+            let (f, kinetic) = self.friction_of(part, n);
+            // df/dw
+            let df_dw = if kinetic {
+                let s = norm(part.w);
+                let u = scale(1.0 / s, part.w);
+                let c = -part.mu * n.abs() / s;
+                // df/dN: f = -mu |N| u, so df/dN = f / N (N != 0 on this branch as |w| > 0).
+                if n != 0.0 {
+                    let df_dn = scale(1.0 / n, f);
+                    for r in 0..3 {
+                        dq[0][0][r][2] += df_dn[r] * dn_dz;
+                        dv[0][0][r][2] += df_dn[r] * dn_dvz;
+                    }
+                }
+                add_mat(diag(c), outer(-c, u, u))
+            } else {
+                diag(-part.mu * fr.damping)
+            };
+            dv[0][0] = add_mat(dv[0][0], mul(df_dw, part.dw_dv));
+            if let (Some(dw_dt), Some(tg)) = (part.dw_dt, tangent.as_ref()) {
+                tg.add_chain(mul(df_dw, dw_dt), dq);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{fd, Force};
+    use super::*;
+
+    fn contact(tangent: Option<[usize; 2]>, friction: SeabedFriction) -> SeabedContact {
+        SeabedContact {
+            node: LineNode::new(1, tangent),
+            seabed_z: -50.0,
+            area: 0.08 * 1.7,
+            stiffness: 3.0e6,
+            damping: 3.0e5,
+            damping_ramp: 0.0,
+            friction,
+        }
+    }
+
+    fn friction(mc: f64) -> SeabedFriction {
+        SeabedFriction {
+            transverse: 0.8,
+            axial: 0.45,
+            damping: 200.0,
+            static_scale: mc,
+        }
+    }
+
+    /// Positions of a node 2 mm into the seabed between two neighbours, and velocities.
+    fn state() -> (Vec<Vec3>, Vec<Vec3>) {
+        let q = vec![
+            [-1.6, 0.3, -49.95],
+            [0.05, 0.1, -50.002],
+            [1.7, -0.2, -50.01],
+        ];
+        let v = vec![[0.1, 0.0, 0.0], [0.0; 3], [0.0, 0.3, 0.0]];
+        (q, v)
+    }
+
+    /// The analytic Jacobian equals central differences of the force on every branch: the
+    /// linear friction branch (slow sliding), the kinetic branch (fast sliding) in both parts
+    /// or in one, static friction above the kinetic one (m_c > 1), a node without a tangent,
+    /// an end node whose tangent runs from or to itself, and a node out of contact.
+    #[test]
+    fn jacobian_matches_finite_differences() {
+        let (q, mut v) = state();
+        // |N| = 816 N here: with c_v = 200 N s/m the kinetic branch starts at 4 m/s.
+        for (vel, kinetic) in [
+            ([1e-4, -2e-4, 1e-5], false),
+            ([6.1, -8.2, 0.01], true),
+            ([0.3, 9.0, 0.002], true),
+        ] {
+            v[1] = vel;
+            let c = contact(None, friction(1.0));
+            let n = c.normal(q[1], vel).unwrap().0;
+            let part = c.parts(vel, None)[0].take().unwrap();
+            assert_eq!(c.friction_of(&part, n).1, kinetic, "branch at {vel:?}");
+            for tangent in [Some([0, 2]), None, Some([1, 0]), Some([2, 1])] {
+                for mc in [1.0, 1.5] {
+                    let f = Force::SeabedContact(Box::new(contact(tangent, friction(mc))));
+                    fd::check(&f, &q, &v, 0.0);
+                }
+            }
+        }
+        // Inside the damping ramp (p = 2 mm < 5 mm), moving down and up.
+        for vz in [-0.3, 0.2] {
+            v[1] = [0.2, 0.1, vz];
+            let mut c = contact(Some([0, 2]), friction(1.0));
+            c.damping_ramp = 0.005;
+            fd::check(&Force::SeabedContact(Box::new(c)), &q, &v, 0.0);
+        }
+        let mut above = q.clone();
+        above[1][2] = -49.9;
+        let f = Force::SeabedContact(Box::new(contact(Some([0, 2]), friction(1.0))));
+        fd::check(&f, &above, &v, 0.0);
+    }
+
+    /// At rest without friction the force is minus the gradient of the spring's energy.
+    #[test]
+    fn force_at_rest_is_minus_the_gradient_of_the_potential() {
+        let c = contact(None, SeabedFriction::NONE);
+        let (q, _) = state();
+        let rest = vec![[0.0; 3]; 3];
+        let f = c.node_force(&q, &rest);
+        let h = 1e-7;
+        let (mut qp, mut qm) = (q.clone(), q.clone());
+        qp[1][2] += h;
+        qm[1][2] -= h;
+        let grad = (c.potential(&qp) - c.potential(&qm)) / (2.0 * h);
+        assert!((f[2] + grad).abs() < 1e-6 * f[2], "{} vs {}", f[2], -grad);
+    }
+
+    /// Out of contact the force is zero; in contact at rest it is A kBot p upwards, the closed
+    /// form of MoorDyn's law.
+    #[test]
+    fn normal_force_is_the_spring_of_the_penetration() {
+        let c = contact(Some([0, 2]), friction(1.0));
+        let (mut q, v) = state();
+        let f = c.node_force(&q, &v);
+        let expected = 0.08 * 1.7 * 3.0e6 * 0.002;
+        assert!((f[2] - expected).abs() < 1e-9 * expected, "{f:?}");
+        assert_eq!([f[0], f[1]], [0.0, 0.0]);
+        q[1][2] = -49.999;
+        assert_eq!(c.node_force(&q, &v), [0.0; 3]);
+    }
+
+    /// Sliding fast along the tangent meets mu_a |N|, across it mu_t |N| (Coulomb's law on the
+    /// kinetic branch, past |N| / c_v = 2 m/s here), each opposing the motion.
+    #[test]
+    fn kinetic_friction_is_coulomb_with_axial_and_transverse_coefficients() {
+        let mut c = contact(Some([0, 2]), friction(1.0));
+        c.node = LineNode::new(1, Some([0, 2]));
+        let q = vec![[-1.0, 0.0, -50.0], [0.0, 0.0, -50.001], [1.0, 0.0, -50.0]];
+        let n = c.area * c.stiffness * 0.001;
+        let mut v = vec![[0.0; 3]; 3];
+        v[1] = [5.0, 0.0, 0.0];
+        let f = c.node_force(&q, &v);
+        assert!((f[0] + 0.45 * n).abs() < 1e-9 * n, "axial {f:?}");
+        v[1] = [0.0, -5.0, 0.0];
+        let f = c.node_force(&q, &v);
+        assert!((f[1] - 0.8 * n).abs() < 1e-9 * n, "transverse {f:?}");
+    }
+}
