@@ -443,10 +443,10 @@ class System:
         (docs/theory/seabed-and-line-loads.md).
 
         While the node penetrates (``p = -depth - z > 0``) the seabed pushes it up with
-        ``N = d l (kbot p - cbot v_z)``, and friction opposes its sliding velocity, separately
-        along the line (``axial_friction``) and across it (``friction``): ``-mu friction_damping w``
-        for slow sliding, ``-mu |N| w / |w|`` (Coulomb) once ``friction_damping |w| >
-        static_dynamic_scale |N|``.
+        ``N = d l (kbot p - cbot v_z)``, and friction opposes its sliding velocity ``w`` (or,
+        with ``axial_friction``, each of its parts along and across the line):
+        ``-mu friction_damping w`` for slow sliding, ``-mu |N| w / |w|`` (Coulomb) once
+        ``friction_damping |w| > static_dynamic_scale |N|``.
 
         Arguments:
             node: the line node.
@@ -458,11 +458,13 @@ class System:
             cbot: seabed damping per unit area (Pa s/m, >= 0), MoorDyn's cBot.
             tangent: (a, b): the line's direction at the node points from particle a to b (the
                 node's neighbours, or the node and its one neighbour at an end of the line);
-                None: friction with ``friction`` in every direction.
+                None: isotropic friction with ``friction``.
             friction: transverse kinetic friction coefficient (>= 0), MoorDyn's
                 FrictionCoefficient.
-            axial_friction: axial kinetic friction coefficient (>= 0); None: equal to
-                ``friction`` (MoorDyn-C's single coefficient).
+            axial_friction: axial kinetic friction coefficient (>= 0, MoorDyn-F's MuKA): the
+                sliding velocity splits along and across the line, each part with its own
+                coefficient; None: MoorDyn-C's single coefficient, ``friction`` on the whole
+                sliding velocity whatever the line's direction.
             friction_damping: slope of the friction at small speeds (N s/m, > 0), MoorDyn's
                 FricDamp.
             static_dynamic_scale: ratio of static to kinetic friction (>= 1), MoorDyn's

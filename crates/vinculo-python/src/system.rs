@@ -87,10 +87,6 @@ fn vec3(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<[f64; 3]> {
     Ok([v[0], v[1], v[2]])
 }
 
-/// mu_a / mu_t when the axial friction coefficient is not given: MoorDyn-C applies one
-/// coefficient to the whole sliding velocity.
-const AXIAL_FRICTION_RATIO: f64 = 1.0;
-
 impl PySystem {
     /// A line tangent given as a pair (a, b) of particles, or None.
     fn tangent(
@@ -517,7 +513,7 @@ impl PySystem {
             damping_ramp,
             friction: SeabedFriction {
                 transverse: friction,
-                axial: axial_friction.unwrap_or(friction * AXIAL_FRICTION_RATIO),
+                axial: axial_friction,
                 damping: friction_damping,
                 static_scale: static_dynamic_scale,
             },
