@@ -296,7 +296,8 @@ def add_line(system: Any, end_a: int, end_b: int, line_type: LineType,
     shape = _initial_shape(a, b, line_type, length0, segments, water, seabed)
     segment = length0 / segments
     mass = line_type.mass_per_length * segment
-    g = water.gravity
+    # The system's gravity (the water's is the same in a consistent model).
+    gravity = np.asarray(system.gravity, dtype=float)
     nodes = [end_a]
     for k in range(1, segments):
         particle = system.add_particle(mass, tuple(float(c) for c in shape[k]))
@@ -331,9 +332,9 @@ def add_line(system: Any, end_a: int, end_b: int, line_type: LineType,
                 axial_friction=seabed.axial_friction, friction_damping=seabed.friction_damping,
                 static_dynamic_scale=seabed.static_dynamic_scale)
         if end:
-            system.add_force(node, (0.0, 0.0, -0.5 * mass * g))
+            system.add_force(node, tuple(float(c) for c in 0.5 * mass * gravity))
     half = 0.5 * segment
-    buoyancy = water.density * math.pi * line_type.diameter**2 / 4.0 * half * g
-    load = np.array([0.0, 0.0, buoyancy - line_type.mass_per_length * half * g])
+    displaced = water.density * math.pi * line_type.diameter**2 / 4.0 * half
+    load = (line_type.mass_per_length * half - displaced) * gravity
     return Line(nodes=nodes, segments=links, line_type=line_type, unstretched_length=length0,
                 water=water, name=name, end_loads=(load, load.copy()))
