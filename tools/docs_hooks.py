@@ -201,8 +201,9 @@ def cli_reference(cli) -> str:
         "",
         "<!-- Generated at build time from the argparse parsers of python/vinculo/cli.py -->",
         "",
-        "The `vinculo` program (also `python -m vinculo`) has two commands, `demo` and `buoy`; "
-        "`buoy` has two more, `buoy sweep` and `buoy calibrate`. "
+        "The `vinculo` program (also `python -m vinculo`) has three commands, `demo`, `buoy` "
+        "and `mooring`; `buoy` has two more, `buoy sweep` and `buoy calibrate`, and `mooring` "
+        "has `mooring statics` and `mooring run`. "
         "This page is generated from the program's own parsers when the site is built, so it "
         "lists exactly the options the program accepts; `vinculo COMMAND --help` prints the same. "
         "Lengths are in metres, times in seconds, frequencies in hertz and angles in degrees "
@@ -216,6 +217,8 @@ def cli_reference(cli) -> str:
         if name == "buoy":
             lines += _parser_section("vinculo buoy sweep", cli._study_parser(), level=2)
             lines += _parser_section("vinculo buoy calibrate", cli._calibrate_parser(), level=2)
+        for action_name, action_parser in _subcommands(parser).items():
+            lines += _parser_section(f"vinculo {name} {action_name}", action_parser, level=2)
     lines += [
         "## From Python",
         "",

@@ -9,6 +9,8 @@ Usage::
                  [--output DIR] [--case FILE.toml] [--PARAMETER VALUE ...]
     vinculo buoy sweep --param NAME=VALUES [...] [--scheduler ADDRESS] [--output DIR]
     vinculo buoy calibrate --data FILE.csv [--fit NAMES] [--output DIR]
+    vinculo mooring statics FILE [--output DIR]
+    vinculo mooring run FILE [--motion FILE.csv] --t-end T [--dt DT] [--output DIR]
 
 ``demo`` runs the four demo models (pendulum, double pendulum, hanging chain, inclined plane),
 prints one line per model comparing the simulation with its reference value, and writes one PNG
@@ -21,6 +23,10 @@ sweep's duration at that frequency, ``(settle_periods + fit_periods) / FREQ``) a
 view of the run as an animation (default ``DIR/buoy_<FREQ>Hz.gif``). ``buoy sweep`` runs a
 parameter study (:mod:`vinculo.buoy.parameter_study`) and ``buoy calibrate`` fits the fluid
 coefficients to measurements (:mod:`vinculo.buoy.calibration`).
+
+``mooring statics`` solves the static equilibrium of a MoorDyn v2 input file and writes
+``statics.csv``; ``mooring run`` moves its coupled points by a recorded motion and writes the end
+tensions over time, a NetCDF file and plots (see :mod:`vinculo.mooring.cli`).
 
 Exit codes: 0 on success, 1 when a simulation fails, 2 on bad arguments (an option, a value or an
 input file), 130 after Ctrl-C (``vinculo buoy`` first writes the runs that finished).
@@ -148,6 +154,9 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     demo.set_defaults(handler=_demo)
     _add_buoy_parser(commands)
+    from vinculo.mooring.cli import add_mooring_parser
+
+    add_mooring_parser(commands)
     return parser
 
 

@@ -28,6 +28,7 @@ __all__ = [
     "InternalError",
     "Interrupted",
     "InvalidInputError",
+    "MooringFileError",
     "NegativeTensionError",
     "OutputTooLargeError",
     "RedundantConstraintsError",
@@ -127,6 +128,27 @@ class InvalidInputError(VinculoError, ValueError):
     a non-positive tolerance, a tabulated law with too few or unsorted samples, and so on.
     Details usually include ``name`` (the argument) and ``value`` (what was given).
     """
+
+
+class MooringFileError(InvalidInputError):
+    """A mooring input file (MoorDyn's format) is malformed or asks for what is not supported.
+
+    Raised by :func:`vinculo.mooring.read_moordyn` and everything that reads such a file (the
+    ``vinculo mooring`` commands): a value that is not a number, a missing column, a reference
+    to an unknown line type or point, or a feature vinculo does not model yet (rods, bodies,
+    wave kinematics, ...). The message starts with the file and the line, then the field.
+
+    Attributes:
+        file: the file's path (text).
+        line: the line number in the file (1-based; None when the problem is not on one line).
+        field: the column or option name.
+        value: the offending text or value.
+    """
+
+    file: str | None = None
+    line: int | None = None
+    field: str | None = None
+    value: Any = None
 
 
 class UnknownHandleError(VinculoError, LookupError):

@@ -6,6 +6,7 @@ mod laws;
 mod reentry;
 mod run;
 mod run_result;
+mod statics;
 mod stepping;
 mod system;
 mod user_physics;
@@ -25,5 +26,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<run::PyRunSettings>()?;
     m.add_class::<run_result::PyRunResult>()?;
     m.add_function(wrap_pyfunction!(run::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(statics::solve_statics, m)?)?;
+    m.add_function(wrap_pyfunction!(statics::point_stiffness, m)?)?;
+    m.add_function(wrap_pyfunction!(statics::point_force, m)?)?;
     Ok(())
 }

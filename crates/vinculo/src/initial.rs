@@ -19,8 +19,22 @@ use crate::linear::Singular;
 use crate::math::{dot, Vec3};
 use crate::model::System;
 
-/// Fills `[M/m_ref, -s G^T; s G, 0]` at positions q, time t.
+/// Fills `[M/m_ref, -s G^T; s G, 0]` at positions q, time t. The row of a compliant
+/// constraint (`docs/theory/moorings.md`) is instead its scaled multiplier lambda / (s m_ref)
+/// alone: the multiplier (the tension) follows from the stretch, `c lambda = -Phi`, and puts
+/// no condition on the accelerations or on the positions.
 fn fill_saddle(system: &System, ws: &mut StepWorkspace, q: &[Vec3], t: f64) {
+    fill_saddle_rows(system, ws, (q, t), true)
+}
+
+/// [`fill_saddle`], with the compliant constraints' rows as exact ones when `compliant` is
+/// false.
+fn fill_saddle_rows(
+    system: &System,
+    ws: &mut StepWorkspace,
+    (q, t): (&[Vec3], f64),
+    compliant: bool,
+) {
     let layout = &ws.layout;
     let values = &mut ws.values;
     values.fill(0.0);
@@ -31,7 +45,17 @@ fn fill_saddle(system: &System, ws: &mut StepWorkspace, q: &[Vec3], t: f64) {
         let g = con.gradient(q, t);
         // The saddle matrix has no Hessian term: no blocks.
         let values: &mut [f64] = values;
-        layout.add_constraint_blocks(values, (c, &[]), ws.scales[c], (&g, &g));
+        let s = ws.scales[c];
+        if compliant && con.is_compliant() {
+            // The row is the unknown lambda / (s m_ref) itself (1 on the diagonal, whatever
+            // the compliance: well conditioned as EA grows); its right-hand side says what
+            // the multiplier is.
+            let none = [[0.0; 3]; 2];
+            layout.add_constraint_blocks(values, (c, &[]), s, (&g, &none[..g.len()]));
+            crate::assembly::add(values, layout.constraint_diagonal[c], 1.0);
+        } else {
+            layout.add_constraint_blocks(values, (c, &[]), s, (&g, &g));
+        }
     }
 }
 
@@ -95,14 +119,47 @@ fn add_free(layout: &Layout, x: &[f64], out: &mut [Vec3]) {
     }
 }
 
-/// Accelerations and multipliers consistent with (q, v) at time t.
-pub fn consistent_accelerations(
+/// The multipliers of the system at rest at (q, t) with every constraint held exact (elastic
+/// segments as inextensible ones): a first iterate of the static equilibrium.
+pub(crate) fn rigid_multipliers(
+    system: &System,
+    ws: &mut StepWorkspace,
+    q: &[Vec3],
+    t: f64,
+) -> Result<Vec<f64>> {
+    let v = vec![[0.0; 3]; q.len()];
+    rest_right_hand_side(system, ws, q, &v, t, false);
+    ws.matrix.invalidate();
+    fill_saddle_rows(system, ws, (q, t), false);
+    ws.solver
+        .factor(&ws.values)
+        .map_err(|s| singular_error(system, &ws.layout, t, s))?;
+    ws.solver.solve_in_place(&mut ws.r);
+    let m3 = 3 * ws.layout.free;
+    let lambda: Vec<f64> = (0..system.constraints().len())
+        .map(|c| ws.r[m3 + c] * ws.scales[c] * ws.mass_ref)
+        .collect();
+    if lambda.iter().all(|x| x.is_finite()) {
+        Ok(lambda)
+    } else {
+        Err(Error::SingularMatrix {
+            t,
+            equation: "an unidentified equation".into(),
+            detail: "the solution is not finite".into(),
+        })
+    }
+}
+
+/// The right-hand side [M g + f; -gamma] / m_ref of the consistent start into `ws.r`; a
+/// compliant constraint's row gets its multiplier from the stretch when `compliant`.
+fn rest_right_hand_side(
     system: &System,
     ws: &mut StepWorkspace,
     q: &[Vec3],
     v: &[Vec3],
     t: f64,
-) -> Result<(Vec<Vec3>, Vec<f64>)> {
+    compliant: bool,
+) {
     let g = system.gravity();
     let m3 = 3 * ws.layout.free;
     ws.r.fill(0.0);
@@ -126,8 +183,24 @@ pub fn consistent_accelerations(
         }
     }
     for (c, con) in system.constraints().iter().enumerate() {
-        ws.r[m3 + c] = -ws.scales[c] * con.gamma(q, v, t);
+        ws.r[m3 + c] = if compliant && con.is_compliant() {
+            -con.residual(q, t) / (con.compliance(t) * ws.scales[c] * ws.mass_ref)
+        } else {
+            -ws.scales[c] * con.gamma(q, v, t)
+        };
     }
+}
+
+/// Accelerations and multipliers consistent with (q, v) at time t.
+pub fn consistent_accelerations(
+    system: &System,
+    ws: &mut StepWorkspace,
+    q: &[Vec3],
+    v: &[Vec3],
+    t: f64,
+) -> Result<(Vec<Vec3>, Vec<f64>)> {
+    let m3 = 3 * ws.layout.free;
+    rest_right_hand_side(system, ws, q, v, t, true);
     solve_saddle(system, ws, q, t)?;
     let mut a = vec![[0.0; 3]; q.len()];
     add_free(&ws.layout, &ws.r, &mut a);
@@ -172,24 +245,28 @@ pub fn velocity_residual(c: &Constraint, q: &[Vec3], v: &[Vec3], t: f64) -> f64 
     gv + c.phi_t(q, t)
 }
 
-/// Largest scaled constraint residual max_k |s_k Phi_k(q, t)| and its index.
+/// Largest scaled constraint residual max_k |s_k Phi_k(q, t)| and its index (compliant
+/// constraints, which any stretch satisfies with its tension, count as 0).
 pub fn scaled_violation(system: &System, q: &[Vec3], t: f64) -> (f64, usize) {
-    worst(
-        system
-            .constraints()
-            .iter()
-            .map(|c| c.scale() * c.residual(q, t)),
-    )
+    worst(system.constraints().iter().map(|c| {
+        if c.is_compliant() {
+            0.0
+        } else {
+            c.scale() * c.residual(q, t)
+        }
+    }))
 }
 
-/// Largest scaled velocity-constraint residual max_k |s_k (Phi_q v + Phi_t)| and its index.
+/// Largest scaled velocity-constraint residual max_k |s_k (Phi_q v + Phi_t)| and its index
+/// (compliant constraints count as 0).
 pub fn scaled_velocity_violation(system: &System, q: &[Vec3], v: &[Vec3], t: f64) -> (f64, usize) {
-    worst(
-        system
-            .constraints()
-            .iter()
-            .map(|c| c.scale() * velocity_residual(c, q, v, t)),
-    )
+    worst(system.constraints().iter().map(|c| {
+        if c.is_compliant() {
+            0.0
+        } else {
+            c.scale() * velocity_residual(c, q, v, t)
+        }
+    }))
 }
 
 /// Moves the system's initial positions and velocities onto Phi = 0 and G v + Phi_t = 0 at time t
@@ -222,7 +299,9 @@ pub fn project_initial_state(
         }
         ws.r.fill(0.0);
         for (c, con) in system.constraints().iter().enumerate() {
-            ws.r[m3 + c] = -ws.scales[c] * con.residual(&q, t);
+            if !con.is_compliant() {
+                ws.r[m3 + c] = -ws.scales[c] * con.residual(&q, t);
+            }
         }
         solve_saddle(system, &mut ws, &q, t)?;
         add_free(&ws.layout, &ws.r, &mut q);
@@ -230,7 +309,9 @@ pub fn project_initial_state(
     }
     ws.r.fill(0.0);
     for (c, con) in system.constraints().iter().enumerate() {
-        ws.r[m3 + c] = -ws.scales[c] * velocity_residual(con, &q, &v, t);
+        if !con.is_compliant() {
+            ws.r[m3 + c] = -ws.scales[c] * velocity_residual(con, &q, &v, t);
+        }
     }
     solve_saddle(system, &mut ws, &q, t)?;
     add_free(&ws.layout, &ws.r, &mut v);

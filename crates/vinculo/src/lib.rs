@@ -57,6 +57,7 @@ pub mod run;
 pub mod simulate;
 pub mod snapshot_file;
 pub mod solution;
+pub mod statics;
 pub mod step_control;
 pub mod user;
 

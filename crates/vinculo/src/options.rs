@@ -167,6 +167,20 @@ pub(crate) fn check_options(system: &System, o: &SimulationOptions) -> Result<()
     if let Some(times) = &o.output_times {
         check_output_times(o, times)?;
     }
+    if o.formulation == crate::integrators::Formulation::Ggl {
+        if let Some(k) = system.constraints().iter().position(|c| c.is_compliant()) {
+            return Err(Error::InvalidParameter {
+                name: format!(
+                    "formulation 'ggl' with the compliant {}",
+                    system.constraints()[k].name(k)
+                ),
+                value: f64::NAN,
+                expected: "elastic segments (finite EA) run on the index-3 formulation: use \
+                           formulation 'index3'"
+                    .into(),
+            });
+        }
+    }
     let constraints = system
         .constraints()
         .iter()

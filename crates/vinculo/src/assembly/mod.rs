@@ -50,6 +50,9 @@ pub struct Layout {
     pub constraint_column: Vec<[Slot; 3]>,
     /// Per constraint and particle a: slots of Phi_q (the constraint's row, columns of a).
     pub constraint_row: Vec<[Slot; 3]>,
+    /// Per constraint: the slot of its multiplier's diagonal entry, which holds the compliance
+    /// of a compliant constraint (NO_SLOT for an exact one).
+    pub constraint_diagonal: Vec<Slot>,
     /// Where each force's entries start in `force_block`.
     pub force_offsets: ElementOffsets,
     /// Per force and ordered pair (a, b) of its particles: the block of its Jacobian.
@@ -75,7 +78,7 @@ impl Layout {
             + system
                 .constraints()
                 .iter()
-                .map(|c| count(c.particles()) + 2 * 3 * c.particles().len())
+                .map(|c| count(c.particles()) + 2 * 3 * c.particles().len() + 1)
                 .sum::<usize>()
             + system
                 .forces()
@@ -117,6 +120,9 @@ impl Layout {
                     }
                 }
             }
+            if c.is_compliant() {
+                entries.push((lambda(k), lambda(k)));
+            }
         }
         for f in system.forces().iter().filter(|f| f.has_jacobian()) {
             for (a, b) in pairs(f.particles()) {
@@ -130,6 +136,15 @@ impl Layout {
         let mut constraint_hessian = Vec::with_capacity(constraint_offsets.pair_entries());
         let mut constraint_column = Vec::with_capacity(constraint_offsets.particle_entries());
         let mut constraint_row = Vec::with_capacity(constraint_offsets.particle_entries());
+        let constraint_diagonal = (0..m)
+            .map(|k| {
+                if system.constraints()[k].is_compliant() {
+                    pattern.slot32(lambda(k), lambda(k))
+                } else {
+                    NO_SLOT
+                }
+            })
+            .collect();
         for (k, c) in system.constraints().iter().enumerate() {
             let parts = c.particles();
             push_pair_blocks(&mut constraint_hessian, &pattern, parts, &dof, (0, 0));
@@ -162,6 +177,7 @@ impl Layout {
             constraint_hessian,
             constraint_column,
             constraint_row,
+            constraint_diagonal,
             force_offsets,
             force_block,
         }
@@ -232,14 +248,24 @@ impl Layout {
     ) {
         let s = at.scales[c];
         let w = at.hessian * at.lambda[c];
+        // A compliant row (`docs/theory/moorings.md`) weights Phi(q_end) by w = dq_e/dq, the
+        // Hessian term's weight over -sigma, and has its compliance in its own column,
+        // d(s c lambda)/d(lambda sigma / s).
+        let row = if con.is_compliant() {
+            let compliance = con.compliance(at.t_eval);
+            values.add(self.constraint_diagonal[c], s * s * compliance / at.sigma);
+            s * (-at.hessian / at.sigma)
+        } else {
+            s
+        };
         con.with_hessian_and_gradient((at.q_eval, at.t_eval), w, buffer, |hess, grad_eval| {
             if at.same_point() {
                 let grads = (grad_eval, grad_eval);
-                self.add_constraint_blocks(values, (c, hess), s, grads);
+                self.add_constraint_blocks_weighted(values, (c, hess), (s, row), grads);
             } else {
                 con.with_gradient(at.q_end, at.t_end, |grad_end| {
                     let grads = (grad_eval, grad_end);
-                    self.add_constraint_blocks(values, (c, hess), s, grads);
+                    self.add_constraint_blocks_weighted(values, (c, hess), (s, row), grads);
                 });
             }
         });
@@ -256,6 +282,19 @@ impl Layout {
         values: &mut V,
         (c, hess): (usize, &[crate::math::Mat3]),
         s: f64,
+        grads: (&[crate::math::Vec3], &[crate::math::Vec3]),
+    ) {
+        self.add_constraint_blocks_weighted(values, (c, hess), (s, s), grads)
+    }
+
+    /// [`Layout::add_constraint_blocks`] with the column's gradient weighted by `-s_column`
+    /// and the row's by `s_row`.
+    #[inline(always)]
+    pub fn add_constraint_blocks_weighted<V: Entries + ?Sized>(
+        &self,
+        values: &mut V,
+        (c, hess): (usize, &[crate::math::Mat3]),
+        s: (f64, f64),
         (grad_column, grad_row): (&[crate::math::Vec3], &[crate::math::Vec3]),
     ) {
         let blocks = &self.constraint_hessian[self.constraint_offsets.pairs(c)];
@@ -312,7 +351,7 @@ fn two_particles<'a>(
 fn place_constraint<V: Entries + ?Sized>(
     values: &mut V,
     (blocks, hess): (&[Block], &[crate::math::Mat3]),
-    s: f64,
+    (s_column, s_row): (f64, f64),
     (columns, rows): Strips<'_>,
     (grad_column, grad_row): Grads<'_>,
 ) {
@@ -321,8 +360,8 @@ fn place_constraint<V: Entries + ?Sized>(
     }
     for (x, (column, row)) in columns.iter().zip(rows).enumerate() {
         for k in 0..3 {
-            values.add(column[k], -s * grad_column[x][k]);
-            values.add(row[k], s * grad_row[x][k]);
+            values.add(column[k], -s_column * grad_column[x][k]);
+            values.add(row[k], s_row * grad_row[x][k]);
         }
     }
 }

@@ -84,6 +84,10 @@ pub struct ResidualTerms<'a> {
     pub lambda: &'a [f64],
     /// Scale of each constraint row.
     pub scales: &'a [f64],
+    /// w = dq_e/dq: the weight of the step's end in the evaluation point.
+    pub end_weight: f64,
+    /// Phi_k(q_n, t_n) of each compliant constraint at the step's start (0 for the others).
+    pub start_phi: &'a [f64],
 }
 
 /// Where and with which weights one step's Jacobian is evaluated (besides the mass block).
@@ -104,6 +108,8 @@ pub struct JacobianTerms<'a> {
     pub force_dv: f64,
     /// Weight of lambda_k d2Phi_k/dq2.
     pub hessian: f64,
+    /// Scale of the dynamics rows (the multipliers' unknowns are lambda sigma / s).
+    pub sigma: f64,
     /// Multipliers.
     pub lambda: &'a [f64],
     /// Scale of each constraint row.
@@ -111,6 +117,20 @@ pub struct JacobianTerms<'a> {
 }
 
 impl ResidualTerms<'_> {
+    /// The (unscaled) row of constraint `c` (`con`) whose residual at the step's end is `phi`:
+    /// `phi` for an exact constraint; for a compliant one (`docs/theory/moorings.md`)
+    /// w Phi(q_end, t_end) + (1 - w) Phi(q_n, t_n) + c(t_e) lambda, the stretch at the
+    /// evaluation point where its multiplier, the tension, acts.
+    #[inline(always)]
+    pub fn row(&self, con: &crate::constraints::Constraint, c: usize, phi: f64) -> f64 {
+        if con.is_compliant() {
+            let w = self.end_weight;
+            w * phi + (1.0 - w) * self.start_phi[c] + con.compliance(self.t_eval) * self.lambda[c]
+        } else {
+            phi
+        }
+    }
+
     /// True when the constraint rows are evaluated where the gradients are (the same positions
     /// and time), so that one evaluation serves both.
     pub fn same_point(&self) -> bool {
@@ -378,7 +398,7 @@ impl ParallelAssembly {
                         out[i..i + grad.len()].copy_from_slice(grad);
                         i += grad.len();
                     });
-                    *r = at.scales[c] * con.residual(at.q_end, at.t_end);
+                    *r = at.scales[c] * at.row(con, c, con.residual(at.q_end, at.t_end));
                 }
             });
         let sigma = at.sigma;

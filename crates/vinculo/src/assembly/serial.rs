@@ -14,7 +14,9 @@ impl Layout {
     /// Writes the scaled residual: `row.rows(i)` is the start of the three rows of free particle i
     /// (its inertia and gravity terms); then each force's local forces and each constraint's
     /// gradient term at the evaluation point are subtracted, and each constraint's row
-    /// s_k Phi_k(q_end, t_end) written.
+    /// s_k Phi_k(q_end, t_end) written (a compliant constraint's row is
+    /// s_k (w Phi_k(q_end, t_end) + (1 - w) Phi_k(q_n, t_n) + c_k lambda_k) instead, see
+    /// [`ResidualTerms::row`]).
     pub fn residual(
         &self,
         system: &System,
@@ -49,7 +51,7 @@ impl Layout {
                 });
                 con.residual(at.q_end, at.t_end)
             };
-            r[m3 + c] = at.scales[c] * phi;
+            r[m3 + c] = at.scales[c] * at.row(con, c, phi);
         }
     }
 

@@ -24,6 +24,7 @@
 //! its elements at once ([`user`]).
 
 mod distance;
+mod elastic_distance;
 mod fixed_coordinate;
 mod plane;
 mod point_distance;
@@ -31,6 +32,7 @@ mod redundancy;
 pub mod user;
 
 pub use distance::Distance;
+pub use elastic_distance::ElasticDistance;
 pub use fixed_coordinate::FixedCoordinate;
 pub use plane::Plane;
 pub use point_distance::PointDistance;
@@ -50,6 +52,8 @@ pub type Hessian = Blocks;
 pub enum Constraint {
     /// Fixed distance between two particles (paper eq. 17).
     Distance(Distance),
+    /// An elastic segment: a compliant distance whose multiplier is the tension.
+    ElasticDistance(Box<ElasticDistance>),
     /// Fixed distance from a particle to a point moving by a prescribed law.
     PointDistance(Box<PointDistance>),
     /// Particle on a plane whose normal and point may move (paper eq. 18).
@@ -64,6 +68,7 @@ macro_rules! dispatch {
     ($self:ident, $c:ident => $e:expr) => {
         match $self {
             Constraint::Distance($c) => $e,
+            Constraint::ElasticDistance($c) => $e,
             Constraint::PointDistance($c) => $e,
             Constraint::Plane($c) => $e,
             Constraint::FixedCoordinate($c) => $e,
@@ -117,6 +122,7 @@ impl Constraint {
     ) -> R {
         match self {
             Constraint::Distance(c) => use_it(&c.hessian(w), &c.gradient(q, t)),
+            Constraint::ElasticDistance(c) => use_it(&c.hessian(q, w), &c.gradient(q, t)),
             other => {
                 buffer.reset(other.particles().len());
                 other.add_hessian(q, t, w, buffer);
@@ -180,20 +186,53 @@ impl Constraint {
     pub fn length(&self) -> f64 {
         match self {
             Constraint::Distance(c) => c.length,
+            Constraint::ElasticDistance(c) => c.share * c.length.value(0.0),
             Constraint::PointDistance(c) => c.length,
             _ => 0.0,
         }
     }
 
-    /// True for the kinds that hold a distance (whose multiplier is a tension 2 lambda L).
+    /// True for the kinds that hold a distance (whose multiplier is a tension 2 lambda L, or the
+    /// tension itself for an elastic segment).
     pub fn is_distance(&self) -> bool {
-        matches!(self, Constraint::Distance(_) | Constraint::PointDistance(_))
+        matches!(
+            self,
+            Constraint::Distance(_) | Constraint::PointDistance(_) | Constraint::ElasticDistance(_)
+        )
+    }
+
+    /// The tension (N, > 0 pulling) that multiplier `lambda` means, for the distance kinds:
+    /// 2 lambda L for Phi = L^2 - |d|^2, lambda itself for an elastic segment.
+    pub fn tension(&self, lambda: f64) -> Option<f64> {
+        match self {
+            Constraint::ElasticDistance(_) => Some(lambda),
+            Constraint::Distance(_) | Constraint::PointDistance(_) => {
+                Some(2.0 * lambda * self.length())
+            }
+            _ => None,
+        }
+    }
+
+    /// The compliance c(t) of the equation Phi + c lambda = 0 (`docs/theory/moorings.md`): L/EA
+    /// for an elastic segment of finite EA, 0 (an exact constraint) for every other kind.
+    #[inline(always)]
+    pub fn compliance(&self, t: f64) -> f64 {
+        match self {
+            Constraint::ElasticDistance(c) => c.compliance(t),
+            _ => 0.0,
+        }
+    }
+
+    /// True when the constraint's equation has a compliance (its row gets a diagonal entry).
+    pub fn is_compliant(&self) -> bool {
+        matches!(self, Constraint::ElasticDistance(c) if c.ea.is_finite())
     }
 
     /// The time interval on which the constraint's laws are defined.
     pub fn domain(&self) -> (f64, f64) {
         match self {
             Constraint::Distance(_) => (f64::NEG_INFINITY, f64::INFINITY),
+            Constraint::ElasticDistance(c) => c.length.domain(),
             Constraint::PointDistance(c) => c.point.domain(),
             Constraint::Plane(c) => {
                 let (a, b) = c.normal.domain();
@@ -210,6 +249,9 @@ impl Constraint {
         let p = self.particles();
         match self {
             Constraint::Distance(_) => format!("distance #{index} (particles {}-{})", p[0], p[1]),
+            Constraint::ElasticDistance(_) => {
+                format!("elastic segment #{index} (particles {}-{})", p[0], p[1])
+            }
             Constraint::PointDistance(_) => {
                 format!("distance to a moving point #{index} (particle {})", p[0])
             }

@@ -51,9 +51,14 @@ impl<'a, R: Index3Rule> StepProblem<'a, R> {
     pub fn new(
         system: &'a System,
         ws: &'a mut StepWorkspace,
-        point: StepPoint,
+        (start, point): (&StepStart, StepPoint),
         rule: R,
     ) -> (Self, LinearWork<'a>) {
+        for (k, con) in system.constraints().iter().enumerate() {
+            if con.is_compliant() {
+                ws.state.start_phi[k] = con.residual(start.q_n, start.t_n);
+            }
+        }
         let problem = StepProblem {
             system,
             layout: &ws.layout,
@@ -131,6 +136,8 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
             sigma: point.sigma,
             lambda: &b.lambda,
             scales: self.scales,
+            end_weight: -rule.weights(point.sigma).2 / point.sigma,
+            start_phi: &b.start_phi,
         };
         let (system, layout, inertia) = (self.system, self.layout, self.inertia);
         let (particles, g) = (system.particles(), system.gravity());
@@ -164,6 +171,7 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
             force_dq,
             force_dv,
             hessian,
+            sigma: point.sigma,
             lambda: &b.lambda,
             scales: self.scales,
         };
@@ -221,7 +229,7 @@ pub fn index3_step<T: TimeRule>(
     let report = {
         let point = rule.point(&start, ws.mass_ref);
         let step = rule.index3(state, start);
-        let (mut problem, work) = StepProblem::new(system, ws, point, step);
+        let (mut problem, work) = StepProblem::new(system, ws, (&start, point), step);
         let report = newton::solve(&mut problem, work, rule.matrix_key(h), options)?;
         problem.kinematics();
         report
@@ -267,7 +275,7 @@ mod tests {
         start: StepStart<'a>,
     ) -> (StepProblem<'a, T::Step<'a>>, LinearWork<'a>) {
         let point = rule.point(&start, ws.mass_ref);
-        StepProblem::new(s, ws, point, rule.index3(state, start))
+        StepProblem::new(s, ws, (&start, point), rule.index3(state, start))
     }
 
     /// The step of size h = 0.01 from (t_n = 0.3, q_n, v_n).
@@ -321,6 +329,77 @@ mod tests {
                 assert_same_assembly(&run(false, trapezoidal), &run(true, trapezoidal));
             }
         }
+    }
+
+    /// An elastic chain: a fixed anchor, three free particles, segments of EA = 2e3 N (one
+    /// paid out by a winch law), and one inextensible elastic segment (EA = infinity).
+    fn elastic_chain() -> System {
+        use crate::laws::Law;
+        let mut s = System::new([0.1, -0.2, -9.81]);
+        let a = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
+        let b = s
+            .add_particle(0.7, [0.5, 0.1, -0.2], [0.3, 0.1, 0.0], false)
+            .unwrap();
+        let c = s
+            .add_particle(1.3, [0.9, -0.1, -0.4], [-0.2, 0.4, 0.1], false)
+            .unwrap();
+        let d = s
+            .add_particle(0.4, [1.2, 0.6, -0.1], [0.0, -0.3, 0.5], false)
+            .unwrap();
+        s.add_elastic_distance(a, b, (Law::Constant(0.5), 1.0), 2e3)
+            .unwrap();
+        let winch = Law::polynomial(vec![0.45, 0.1, -0.05]).unwrap();
+        s.add_elastic_distance(b, c, (winch, 1.0), 2e3).unwrap();
+        s.add_elastic_distance(c, d, (Law::Constant(0.8), 1.0), f64::INFINITY)
+            .unwrap();
+        s
+    }
+
+    /// The Jacobian with compliant rows (the compliance on the multipliers' diagonal, a winch's
+    /// time-dependent compliance) equals finite differences of the residual, for both rules, with
+    /// the sparse LU's layout, dense storage and the tree elimination's layout; and the parallel
+    /// assembly gives the serial one.
+    #[test]
+    fn elastic_segments_jacobian_matches_finite_differences() {
+        let s = elastic_chain();
+        let (q_n, v_n) = (s.initial_positions(), s.initial_velocities());
+        let solvers = [
+            (0, SparseSolver::SparseLu),
+            (1000, SparseSolver::SparseLu),
+            (0, SparseSolver::Auto),
+        ];
+        for (dense_limit, solver) in solvers {
+            let mut ws = StepWorkspace::with_solver(&s, dense_limit, solver);
+            perturbed_iterate(&mut ws, &q_n);
+            ws.state.lambda.truncate(3);
+            let layout = ws.layout.clone();
+            let mut state = RuleState::new(&q_n);
+            let rule = GeneralizedTrapezoidal { alpha: 0.6 };
+            let (mut problem, _) = problem_at(rule, &s, &mut ws, &mut state, start(&q_n, &v_n));
+            assert_jacobian_matches(&mut problem, &layout);
+            let mut ws = StepWorkspace::with_solver(&s, dense_limit, solver);
+            perturbed_iterate(&mut ws, &q_n);
+            ws.state.lambda.truncate(3);
+            let mut state = alpha_state(q_n.len());
+            let rule = GeneralizedAlpha { rho_inf: 0.6 };
+            let (mut problem, _) = problem_at(rule, &s, &mut ws, &mut state, start(&q_n, &v_n));
+            assert_jacobian_matches(&mut problem, &layout);
+        }
+        let run = |parallel: bool| {
+            let mut ws = StepWorkspace::new(&s, 48);
+            if parallel {
+                ws.assemble_in_parallel_from(&s, 0);
+            }
+            wiggled_iterate(&mut ws, &q_n);
+            let mut state = alpha_state(q_n.len());
+            assemble(
+                GeneralizedTrapezoidal { alpha: 0.6 },
+                &s,
+                &mut ws,
+                &mut state,
+            )
+        };
+        assert_same_assembly(&run(false), &run(true));
     }
 
     /// The assembled Jacobian equals finite differences of the assembled residual, for a system

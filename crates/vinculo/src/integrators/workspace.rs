@@ -47,6 +47,8 @@ pub struct StepBuffers {
     pub v: Vec<Vec3>,
     /// Multipliers.
     pub lambda: Vec<f64>,
+    /// Phi_k(q_n, t_n) of each compliant constraint at the step's start (0 for the others).
+    pub start_phi: Vec<f64>,
     /// Positions of the evaluation point of forces and constraint gradients (rules that
     /// evaluate them at the step's end leave it unused).
     pub q_eval: Vec<Vec3>,
@@ -103,6 +105,7 @@ impl StepWorkspace {
                 q: vec![[0.0; 3]; n],
                 v: vec![[0.0; 3]; n],
                 lambda: vec![0.0; layout.constraints],
+                start_phi: vec![0.0; layout.constraints],
                 q_eval: vec![[0.0; 3]; n],
                 v_eval: vec![[0.0; 3]; n],
             },

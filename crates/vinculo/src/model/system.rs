@@ -1,7 +1,9 @@
 //! The system: particles, constraints and forces in arenas, reached through typed handles.
 
 use super::particle::{ConstraintId, ForceId, Particle, ParticleId};
-use crate::constraints::{Constraint, Distance, FixedCoordinate, Plane, PointDistance};
+use crate::constraints::{
+    Constraint, Distance, ElasticDistance, FixedCoordinate, Plane, PointDistance,
+};
 use crate::error::{finite_vector, non_negative, positive, Error, Result};
 use crate::forces::{
     AppliedForce, Bending, Force, LinearDrag, Morison, MorisonSpec, QuadraticDrag, SpringDamper,
@@ -134,6 +136,55 @@ impl System {
             particles: [i, j],
             length,
         }))
+    }
+
+    /// An elastic segment between `a` and `b` of unstretched length `share length(t)` (m;
+    /// `length` a law of time for a winch, `share` the segment's share of it, 1 for a segment of
+    /// its own) and axial stiffness `ea` (N; `f64::INFINITY`: inextensible), whose multiplier is
+    /// its tension (`docs/theory/moorings.md`).
+    ///
+    /// # Errors
+    /// [`Error::SameParticle`] when `a` is `b`; [`Error::InvalidParameter`] when the length is
+    /// not > 0 at t = 0, `share` not in (0, 1] or `ea` not > 0.
+    pub fn add_elastic_distance(
+        &mut self,
+        a: ParticleId,
+        b: ParticleId,
+        (length, share): (Law, f64),
+        ea: f64,
+    ) -> Result<ConstraintId> {
+        let (i, j) = (self.check(a)?, self.check(b)?);
+        let index = self.constraints.len();
+        if i == j {
+            return Err(Error::SameParticle {
+                what: format!("elastic segment #{index}"),
+                particle: i,
+            });
+        }
+        positive(
+            format!("unstretched length of elastic segment #{index} (particles {i}-{j}) at t = 0"),
+            share * length.value(0.0),
+        )?;
+        if !(share > 0.0 && share <= 1.0) {
+            return Err(Error::InvalidParameter {
+                name: format!("share of the length law of elastic segment #{index}"),
+                value: share,
+                expected: "must be in (0, 1]".into(),
+            });
+        }
+        if ea.is_nan() || ea <= 0.0 {
+            return Err(Error::InvalidParameter {
+                name: format!("EA of elastic segment #{index} (particles {i}-{j})"),
+                value: ea,
+                expected: "must be > 0 (N; infinity for an inextensible segment)".into(),
+            });
+        }
+        self.push_constraint(Constraint::ElasticDistance(Box::new(ElasticDistance {
+            particles: [i, j],
+            length,
+            share,
+            ea,
+        })))
     }
 
     /// Fixed distance from `p` to a point moving by `point(t)`. `length = None`: the current distance.
@@ -361,10 +412,16 @@ impl System {
 
     /// Tension (N, > 0 pulling) of distance constraint `c` carrying multiplier `lambda`:
     /// with Phi = L^2 - |d|^2 the force on the first particle is -2 lambda d, so the tension is
-    /// 2 lambda L. `None` for constraints that are not distances.
+    /// 2 lambda L; an elastic segment's multiplier is its tension. `None` for constraints that
+    /// are not distances.
     pub fn tension(&self, c: usize, lambda: f64) -> Option<f64> {
-        let con = &self.constraints[c];
-        con.is_distance().then(|| 2.0 * lambda * con.length())
+        self.constraints[c].tension(lambda)
+    }
+
+    /// Fixes or frees particle `i` (an index of this system): how the linearised stiffness at a
+    /// point frees that point.
+    pub(crate) fn set_fixed(&mut self, i: usize, fixed: bool) {
+        self.particles[i].fixed = fixed;
     }
 
     /// Inertia of each particle's translation: its mass plus the added mass of fluid elements.

@@ -1,0 +1,147 @@
+//! An elastic segment between two particles: a compliant distance whose multiplier is the
+//! tension (`docs/theory/moorings.md`).
+//!
+//! With d = q_i - q_j, u = d/|d| and the unstretched length L(t) (a law: a winch; a segment's
+//! share of its line's law):
+//! - Phi = L(t) - |d|
+//! - Phi_q: dPhi/dq_i = -u^T, dPhi/dq_j = +u^T
+//! - Hessian: d2Phi/dq_i2 = d2Phi/dq_j2 = -(I - u u^T)/|d|, d2Phi/dq_i dq_j = +(I - u u^T)/|d|
+//! - Phi_t = L'(t)
+//! - Phi'' = L'' - u.(a_i - a_j) - (|w|^2 - (u.w)^2)/|d| with w = v_i - v_j, so
+//!   gamma = L'' - (|w|^2 - (u.w)^2)/|d|
+//! - scale 1 (Phi is a length).
+//!
+//! The constraint force on i is Phi_q^T lambda = -lambda u: lambda > 0 pulls i towards j, and the
+//! multiplier is the tension T itself (N).
+//!
+//! Hooke's law T = EA (|d| - L)/L, multiplied by the compliance c = L/EA, is the constraint
+//! equation `Phi + c T = 0`: the iteration matrix gets `c` (scaled) on the diagonal of the
+//! tension's row, and EA = infinity (c = 0) is the exact distance |d| = L. The compliance is a
+//! length per newton, so the matrix stays bounded as EA grows: its only entry that depends on EA
+//! tends to zero, whereas a penalty spring's stiffness EA/L would grow without bound.
+
+use super::Hessian;
+use crate::laws::Law;
+use crate::math::{dot, norm, outer, scale_mat, sub, Mat3, Vec3};
+
+/// |q_i - q_j| = L(t) + (L(t)/EA) T, the multiplier T being the tension.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ElasticDistance {
+    /// The two particles.
+    pub particles: [usize; 2],
+    /// The unstretched length L(t) > 0 (m) is `share` times this law: a constant, or a law for a
+    /// winch (the law of a whole line, of which each of its n segments has the share 1/n).
+    pub length: Law,
+    /// The segment's share of `length` (1 for a segment of its own).
+    pub share: f64,
+    /// The axial stiffness EA (N); infinity: inextensible.
+    pub ea: f64,
+}
+
+/// The unit vector u, the length |d| and the projector I - u u^T over |d|.
+#[inline(always)]
+fn geometry(q: &[Vec3], particles: [usize; 2]) -> (Vec3, f64) {
+    let d = sub(q[particles[0]], q[particles[1]]);
+    let l = norm(d);
+    ([d[0] / l, d[1] / l, d[2] / l], l)
+}
+
+impl ElasticDistance {
+    pub(crate) fn particles(&self) -> &[usize] {
+        &self.particles
+    }
+
+    pub(crate) fn residual(&self, q: &[Vec3], t: f64) -> f64 {
+        let d = sub(q[self.particles[0]], q[self.particles[1]]);
+        self.share * self.length.value(t) - norm(d)
+    }
+
+    pub(crate) fn gradient(&self, q: &[Vec3], _t: f64) -> [Vec3; 2] {
+        let (u, _) = geometry(q, self.particles);
+        [[-u[0], -u[1], -u[2]], u]
+    }
+
+    /// `w` times the Hessian blocks (i, i), (i, j), (j, i), (j, j).
+    #[inline(always)]
+    pub(crate) fn hessian(&self, q: &[Vec3], w: f64) -> [Mat3; 4] {
+        let (u, l) = geometry(q, self.particles);
+        let mut p = outer(-1.0, u, u);
+        for (r, row) in p.iter_mut().enumerate() {
+            row[r] += 1.0;
+        }
+        let same = scale_mat(-w / l, p);
+        let other = scale_mat(w / l, p);
+        [same, other, other, same]
+    }
+
+    pub(crate) fn add_hessian(&self, q: &[Vec3], _t: f64, w: f64, out: &mut Hessian) {
+        for (o, h) in out.as_mut_slice().iter_mut().zip(self.hessian(q, w)) {
+            for r in 0..3 {
+                for c in 0..3 {
+                    o[r][c] += h[r][c];
+                }
+            }
+        }
+    }
+
+    pub(crate) fn phi_t(&self, _q: &[Vec3], t: f64) -> f64 {
+        self.share * self.length.eval(t).1
+    }
+
+    pub(crate) fn gamma(&self, q: &[Vec3], v: &[Vec3], t: f64) -> f64 {
+        let (u, l) = geometry(q, self.particles);
+        let w = sub(v[self.particles[0]], v[self.particles[1]]);
+        let uw = dot(u, w);
+        self.share * self.length.eval(t).2 - (dot(w, w) - uw * uw) / l
+    }
+
+    pub(crate) fn scale(&self) -> f64 {
+        1.0
+    }
+
+    /// The compliance c(t) = L(t)/EA (m/N) of the constraint equation Phi + c T = 0; 0 when
+    /// inextensible.
+    #[inline]
+    pub(crate) fn compliance(&self, t: f64) -> f64 {
+        if self.ea.is_finite() {
+            self.share * self.length.value(t) / self.ea
+        } else {
+            0.0
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{fd, Constraint};
+    use super::*;
+
+    /// Gradient, Hessian, Phi_t and gamma against finite differences, for a segment whose
+    /// length is paid out by a winch (a polynomial law).
+    #[test]
+    fn derivatives_match_finite_differences() {
+        let c = Constraint::ElasticDistance(Box::new(ElasticDistance {
+            particles: [0, 2],
+            length: Law::polynomial(vec![1.4, 0.4, -0.6]).unwrap(),
+            share: 0.5,
+            ea: 1e5,
+        }));
+        let q = [[0.1, 0.2, -0.3], [9.0, 9.0, 9.0], [0.5, -0.4, 0.25]];
+        let v = [[0.3, -1.0, 0.2], [0.0; 3], [-0.6, 0.1, 0.9]];
+        fd::check(&c, &q, &v, 0.3);
+    }
+
+    /// The compliance is L/EA, and zero for an inextensible segment.
+    #[test]
+    fn compliance_is_length_over_ea() {
+        let mut e = ElasticDistance {
+            particles: [0, 1],
+            length: Law::Constant(4.0),
+            share: 0.5,
+            ea: 4e6,
+        };
+        assert_eq!(e.compliance(0.0), 2.0 / 4e6);
+        e.ea = f64::INFINITY;
+        assert_eq!(e.compliance(0.0), 0.0);
+    }
+}

@@ -1,0 +1,195 @@
+//! Elastic segments (compliant distances whose multiplier is the tension) through the public
+//! API, against closed forms (`docs/theory/moorings.md`):
+//!
+//! - a mass m hanging from a fixed point by one segment of unstretched length L and axial
+//!   stiffness EA, released at the unstretched length, oscillates about the static stretch
+//!   m g L / EA with amplitude m g L / EA at omega = sqrt(EA / (L m)) (a linear spring of
+//!   stiffness EA/L), and its tension averages m g;
+//! - EA = 1e15 N gives the exact distance's motion;
+//! - the tree elimination gives the general sparse LU's motion on an elastic chain;
+//! - a winch law pays the segment out: the static stretch follows the length.
+
+use vinculo::laws::Law;
+use vinculo::linear::SparseSolver;
+use vinculo::model::System;
+use vinculo::{simulate, SimulationOptions};
+
+const G: f64 = 9.81;
+
+/// A mass `m` hanging from the origin by a segment of length `l` and stiffness `ea`, released at
+/// rest at z = -l.
+fn hanging(m: f64, l: Law, ea: f64) -> System {
+    let mut s = System::new([0.0, 0.0, -G]);
+    let z0 = -l.value(0.0);
+    let a = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
+    let b = s.add_particle(m, [0.0, 0.0, z0], [0.0; 3], false).unwrap();
+    s.add_elastic_distance(a, b, (l, 1.0), ea).unwrap();
+    s
+}
+
+#[test]
+fn hanging_mass_oscillates_about_the_static_stretch_at_the_axial_frequency() {
+    let (m, l, ea) = (2.0, 1.5, 3.0e4);
+    let stretch = m * G * l / ea;
+    let omega = (ea / (l * m)).sqrt();
+    let period = 2.0 * std::f64::consts::PI / omega;
+    let options = SimulationOptions {
+        t_end: 3.3 * period,
+        dt: period / 2000.0,
+        ..Default::default()
+    };
+    let sol = simulate(&hanging(m, Law::Constant(l), ea), &options).unwrap();
+    assert!(sol.status.is_ok(), "{:?}", sol.status);
+    let z: Vec<f64> = (0..sol.len()).map(|k| sol.position(k, 1)[2]).collect();
+    let (lo, hi) = z
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+    // Closed form: z(t) = -l - stretch (1 - cos omega t), between -l and -l - 2 stretch; the
+    // trapezoidal rule conserves the amplitude (no numerical damping), sampling at 2000 steps
+    // per period misses the extremes by (pi/2000)^2/2 ~ 1e-6 of the amplitude.
+    assert!(((hi + l) / stretch).abs() < 1e-5, "top {hi}");
+    assert!(
+        ((lo + l + 2.0 * stretch) / stretch).abs() < 1e-5,
+        "bottom {lo}"
+    );
+    // Upward crossings of the equilibrium, interpolated linearly: the period.
+    let eq = -l - stretch;
+    let crossings: Vec<f64> = (1..z.len())
+        .filter(|&k| z[k - 1] < eq && z[k] >= eq)
+        .map(|k| {
+            let (t0, t1) = (sol.times[k - 1], sol.times[k]);
+            t0 + (t1 - t0) * (eq - z[k - 1]) / (z[k] - z[k - 1])
+        })
+        .collect();
+    assert_eq!(crossings.len(), 3, "{crossings:?}");
+    let measured = (crossings[2] - crossings[0]) / 2.0;
+    // Trapezoidal period error ~ (omega h)^2 / 12 ~ 1e-6.
+    assert!(
+        ((measured - period) / period).abs() < 1e-5,
+        "period {measured} vs {period}"
+    );
+    // The multiplier is the tension at the step's evaluation point (the trapezoidal rule's
+    // midpoint): EA (|d| - L)/L with |d| the mean of the step's end lengths, to the Newton
+    // tolerance; at the start, from the initial stretch (zero).
+    assert!(sol.multipliers[0].abs() < 1e-9);
+    for k in 1..sol.len() {
+        let stretched = -0.5 * (sol.position(k, 1)[2] + sol.position(k - 1, 1)[2]);
+        let hooke = ea * (stretched - l) / l;
+        let tension = sol.multipliers[k];
+        assert!(
+            (tension - hooke).abs() < 1e-6 * m * G,
+            "step {k}: {tension} vs {hooke}"
+        );
+    }
+}
+
+#[test]
+fn stiff_segment_moves_as_the_exact_distance() {
+    // A pendulum swinging 0.5 rad from the vertical: EA = 1e15 N against Phi = L^2 - |d|^2.
+    let (m, l) = (0.8, 1.2);
+    let start = [l * 0.5f64.sin(), 0.0, -l * 0.5f64.cos()];
+    let build = |elastic: bool| {
+        let mut s = System::new([0.0, 0.0, -G]);
+        let a = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
+        let b = s.add_particle(m, start, [0.0; 3], false).unwrap();
+        if elastic {
+            s.add_elastic_distance(a, b, (Law::Constant(l), 1.0), 1e15)
+                .unwrap();
+        } else {
+            s.add_distance(a, b, Some(l)).unwrap();
+        }
+        s
+    };
+    let options = SimulationOptions {
+        t_end: 3.0,
+        dt: 1e-3,
+        ..Default::default()
+    };
+    let exact = simulate(&build(false), &options).unwrap();
+    let elastic = simulate(&build(true), &options).unwrap();
+    assert!(exact.status.is_ok(), "{:?}", exact.status);
+    assert!(elastic.status.is_ok(), "{:?}", elastic.status);
+    assert_eq!(exact.len(), elastic.len());
+    // The stretch m g L / EA ~ 1e-14 m is below the Newton tolerance: the same motion.
+    let worst = exact
+        .positions
+        .iter()
+        .zip(&elastic.positions)
+        .fold(0.0f64, |w, (a, b)| w.max((a - b).abs()));
+    assert!(worst < 1e-8, "largest difference {worst} m");
+    // Same tension after the start: the exact distance's 2 lambda L against the elastic
+    // multiplier (whose initial value is the initial stretch's, zero here).
+    for k in 1..exact.len() {
+        let t_exact = 2.0 * exact.multipliers[k] * l;
+        let t_elastic = elastic.multipliers[k];
+        // The elastic tension is stretch / compliance: a round-off of 1e-16 m in the stretch
+        // is 0.1 N at c = 1.2e-15 m/N; the Newton iterate lands far closer (2e-6 of m g here).
+        assert!(
+            (t_exact - t_elastic).abs() < 1e-4 * m * G,
+            "{t_exact} vs {t_elastic}"
+        );
+    }
+}
+
+#[test]
+fn tree_elimination_equals_sparse_lu_on_an_elastic_chain() {
+    // A 40-link elastic chain released horizontally from a fixed anchor.
+    let mut s = System::new([0.0, 0.0, -G]);
+    let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
+    for i in 1..=40 {
+        let p = s
+            .add_particle(0.1, [0.1 * i as f64, 0.0, 0.0], [0.0; 3], false)
+            .unwrap();
+        s.add_elastic_distance(prev, p, (Law::Constant(0.1), 1.0), 5e3)
+            .unwrap();
+        prev = p;
+    }
+    let run = |solver: SparseSolver| {
+        let options = SimulationOptions {
+            t_end: 0.5,
+            dt: 1e-3,
+            dense_limit: 0,
+            sparse_solver: solver,
+            ..Default::default()
+        };
+        simulate(&s, &options).unwrap()
+    };
+    let tree = run(SparseSolver::Auto);
+    let lu = run(SparseSolver::SparseLu);
+    assert!(tree.status.is_ok() && lu.status.is_ok());
+    assert_eq!(
+        (tree.linear_solver, lu.linear_solver),
+        ("tree elimination", "sparse LU")
+    );
+    // Two direct solvers of one linear system: the motions agree to round-off amplified over
+    // the steps.
+    let worst = tree
+        .positions
+        .iter()
+        .zip(&lu.positions)
+        .fold(0.0f64, |w, (a, b)| w.max((a - b).abs()));
+    assert!(worst < 1e-9, "largest difference {worst} m");
+}
+
+#[test]
+fn winch_pays_out_the_segment() {
+    // L(t) = 1 + 0.1 t, slowly (0.1 m/s against the axial period 2 pi sqrt(L m / EA) ~ 0.04 s):
+    // the mass follows the static position -(L(t) + m g L(t) / EA), within the stretch's
+    // quasi-static lag. Backward Euler damps the axial oscillation of the start.
+    let (m, ea) = (1.0, 1e4);
+    let length = Law::polynomial(vec![1.0, 0.1]).unwrap();
+    let options = SimulationOptions {
+        t_end: 5.0,
+        dt: 1e-2,
+        scheme: vinculo::integrators::Scheme::GeneralizedTrapezoidal { alpha: 1.0 },
+        ..Default::default()
+    };
+    let sol = simulate(&hanging(m, length, ea), &options).unwrap();
+    assert!(sol.status.is_ok(), "{:?}", sol.status);
+    let last = sol.len() - 1;
+    let l_end = 1.0 + 0.1 * 5.0;
+    let expected = -(l_end + m * G * l_end / ea);
+    let z = sol.position(last, 1)[2];
+    assert!((z - expected).abs() < 1e-5, "z {z} vs {expected}");
+    assert!((sol.multipliers[last] - m * G).abs() < 1e-3 * m * G);
+}

@@ -1,0 +1,89 @@
+"""Mooring lines: MoorDyn input files, the elastic catenary, statics and runs of a mooring.
+
+- :mod:`vinculo.mooring.moordyn_file`: read a MoorDyn v2 input file into a
+  :class:`MoorDynFile` (:func:`read_moordyn`) and write one back (:func:`write_moordyn`).
+- :mod:`vinculo.mooring.catenary`: the elastic catenary with a frictionless seabed in closed
+  form (:func:`solve_catenary`), the reference of the line statics.
+- :mod:`vinculo.mooring.motion`: the prescribed motion of the coupled (Vessel) points.
+- :mod:`vinculo.mooring.model`: the vinculo model of a file (:func:`build_model`).
+- :mod:`vinculo.mooring.analysis`: :func:`statics` (the static equilibrium: end tensions and
+  laid lengths) and :func:`run` (a run with the coupled points moved by a motion), the Python
+  side of ``vinculo mooring statics`` and ``vinculo mooring run``.
+- :mod:`vinculo.mooring.peer`: run MoorDyn itself (the ``moordyn`` package) on the same file
+  with the same fairlead motion, for comparisons and benchmarks.
+
+Example:
+    >>> import vinculo.mooring as mooring
+    >>> result = mooring.statics("tests/data/moordyn/taut_line.txt")  # doctest: +SKIP
+    >>> result.to_csv("statics.csv")  # doctest: +SKIP
+"""
+
+import importlib
+import types
+from typing import Any
+
+from vinculo.mooring.analysis import MooringRun, MooringStatics, run
+from vinculo.mooring.analysis import statics as _statics
+from vinculo.mooring.catenary import CatenarySolution, solve_catenary, weight_in_water
+from vinculo.mooring.model import MooringModel, build_model
+from vinculo.mooring.moordyn_file import (
+    FileLine,
+    FileLineType,
+    FileOptions,
+    FilePoint,
+    MoorDynFile,
+    format_moordyn,
+    parse_moordyn,
+    read_moordyn,
+    write_moordyn,
+)
+from vinculo.mooring.motion import Motion
+
+
+class _CallableModule(types.ModuleType):
+    """The module vinculo.mooring.statics (the equilibrium solver), callable as the analysis
+    :func:`vinculo.mooring.analysis.statics`: ``vinculo.mooring.statics(path)`` and
+    ``vinculo.mooring.statics.solve_statics(system)`` both work."""
+
+    def __call__(self, *args: Any, **kwargs: Any) -> MooringStatics:
+        return _statics(*args, **kwargs)
+
+
+def _statics_entry() -> Any:
+    """The solver module made callable, or the analysis function alone without the module."""
+    try:
+        module = importlib.import_module("vinculo.mooring.statics")
+    except ModuleNotFoundError as missing:  # the equilibrium solver is not in this tree
+        if missing.name != "vinculo.mooring.statics":
+            raise
+        return _statics
+    module.__class__ = _CallableModule
+    return module
+
+
+statics = _statics_entry()
+"""The static equilibrium of a MoorDyn file: ``statics(path)`` is
+:func:`vinculo.mooring.analysis.statics` (end forces, tensions and laid lengths); the same name is
+the module of the equilibrium solver (``vinculo.mooring.statics.solve_statics``)."""
+
+__all__ = [
+    "CatenarySolution",
+    "FileLine",
+    "FileLineType",
+    "FileOptions",
+    "FilePoint",
+    "MoorDynFile",
+    "MooringModel",
+    "MooringRun",
+    "MooringStatics",
+    "Motion",
+    "build_model",
+    "format_moordyn",
+    "parse_moordyn",
+    "read_moordyn",
+    "run",
+    "solve_catenary",
+    "statics",
+    "weight_in_water",
+    "write_moordyn",
+]

@@ -1,0 +1,293 @@
+"""The two analyses of a mooring file: its statics and a run with moving fairleads.
+
+:func:`statics` builds the model of a MoorDyn file and solves its static equilibrium: each
+line's end forces, tensions and laid length (:class:`MooringStatics`, written as
+``statics.csv`` by ``vinculo mooring statics``). :func:`run` moves the coupled points by a
+recorded motion from that equilibrium and records the end forces over time
+(:class:`MooringRun`), with its CSV, NetCDF and plot outputs (``vinculo mooring run``).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from vinculo.errors import InvalidInputError
+from vinculo.mooring.moordyn_file import MoorDynFile
+from vinculo.mooring.motion import Motion
+
+__all__ = ["STATICS_COLUMNS", "LineEnd", "MooringRun", "MooringStatics", "run", "statics"]
+
+#: The columns of ``statics.csv``, in order: two rows per line, end A then end B.
+STATICS_COLUMNS = ("line", "end", "point", "x", "y", "z", "fx", "fy", "fz", "tension",
+                   "laid_length")
+
+
+@dataclass(frozen=True)
+class LineEnd:
+    """One end of a line in static equilibrium.
+
+    Arguments:
+        line: the line's number in the file (1-based).
+        end: ``"A"`` (MoorDyn's anchor end, AttachA) or ``"B"`` (the fairlead end, AttachB).
+        point: the number of the point the end is attached to (1-based).
+        position: the end's position (m).
+        force: the force the line exerts on the end point (N).
+        laid_length: the length of the line lying on the seabed (m; the same on both rows).
+    """
+
+    line: int
+    end: str
+    point: int
+    position: tuple[float, float, float]
+    force: tuple[float, float, float]
+    laid_length: float
+
+    @property
+    def tension(self) -> float:
+        """The magnitude of :attr:`force` (N)."""
+        return math.sqrt(sum(c * c for c in self.force))
+
+
+def _last(array: Any) -> np.ndarray:
+    """The last row of a (times, 3) array, or a (3,) array as it is."""
+    return np.asarray(array, dtype=float).reshape(-1, 3)[-1]
+
+
+def _line_ends(built: Any, source: Any, positions: np.ndarray) -> list[LineEnd]:
+    rows = []
+    for k, (row, line) in enumerate(zip(built.file.lines, built.lines, strict=True)):
+        force_a, force_b = line.end_forces(source)
+        laid = float(line.laid_length(positions, built.seabed_z))
+        a, b = built.line_ends(k)
+        for end, point, particle, force in (("A", row.attach_a, a, force_a),
+                                            ("B", row.attach_b, b, force_b)):
+            rows.append(LineEnd(line=row.id, end=end, point=point,
+                                position=tuple(float(c) for c in positions[particle]),
+                                force=tuple(float(c) for c in _last(force)),
+                                laid_length=laid))
+    return rows
+
+
+@dataclass
+class MooringStatics:
+    """The static equilibrium of a mooring.
+
+    Arguments:
+        model: the model (:class:`vinculo.mooring.model.MooringModel`), in equilibrium.
+        ends: two :class:`LineEnd` per line, end A then end B, in file order.
+        cpu_time: the CPU time of the equilibrium solve (s).
+    """
+
+    model: Any
+    ends: list[LineEnd]
+    cpu_time: float = 0.0
+
+    def table(self) -> str:
+        """A text table of the end tensions and laid lengths, one row per line end.
+
+        Returns:
+            The table, with a header line.
+        """
+        lines = [f"{'line':>4} {'end':>3} {'point':>5} {'tension (N)':>14} "
+                 f"{'fx (N)':>13} {'fy (N)':>13} {'fz (N)':>13} {'laid (m)':>10}"]
+        for e in self.ends:
+            lines.append(f"{e.line:>4} {e.end:>3} {e.point:>5} {e.tension:>14.6g} "
+                         f"{e.force[0]:>13.6g} {e.force[1]:>13.6g} {e.force[2]:>13.6g} "
+                         f"{e.laid_length:>10.4g}")
+        return "\n".join(lines)
+
+    def to_csv(self, path: str | Path) -> Path:
+        """Write ``statics.csv``: the columns :data:`STATICS_COLUMNS`, two rows per line.
+
+        Arguments:
+            path: the file to write.
+
+        Returns:
+            The path written.
+        """
+        path = Path(path)
+        with path.open("w", newline="", encoding="utf-8") as handle:
+            writer = csv.writer(handle)
+            writer.writerow(STATICS_COLUMNS)
+            for e in self.ends:
+                writer.writerow([e.line, e.end, e.point, *map(repr, e.position),
+                                 *map(repr, e.force), repr(e.tension), repr(e.laid_length)])
+        return path
+
+
+def statics(path: str | Path | MoorDynFile, motion: Motion | None = None,
+            **options: Any) -> MooringStatics:
+    """The static equilibrium of the mooring of a MoorDyn file.
+
+    Arguments:
+        path: the MoorDyn v2 input file (or its content).
+        motion: the coupled points' motion; their positions at t = 0 are used (None: the
+            file's positions).
+        **options: passed to :func:`vinculo.mooring.statics.solve_statics`.
+
+    Returns:
+        The equilibrium: each line's end forces, tensions and laid length.
+
+    Raises:
+        MooringFileError: for a malformed or unsupported file.
+        ConvergenceError: when the equilibrium cannot be found.
+    """
+    from vinculo.mooring.model import build_model
+
+    started = time.process_time()
+    built = build_model(path, motion, **options)
+    cpu = time.process_time() - started
+    positions = np.asarray(built.statics.positions, dtype=float)
+    return MooringStatics(model=built, ends=_line_ends(built, built.statics, positions),
+                          cpu_time=cpu)
+
+
+@dataclass
+class MooringRun:
+    """A run of a mooring with its coupled points moved by a motion.
+
+    Arguments:
+        model: the model (:class:`vinculo.mooring.model.MooringModel`).
+        solution: the :class:`vinculo.Solution` of the run.
+        times: the stored times (s).
+        end_forces: ``(times, lines, 2, 3)``: the force of each line on its end A and end B (N).
+        cpu_time: the CPU time of the time integration (s).
+        dt: the step size (s).
+        files: the files written (CSV, NetCDF, plots), by kind.
+    """
+
+    model: Any
+    solution: Any
+    times: np.ndarray
+    end_forces: np.ndarray
+    cpu_time: float
+    dt: float
+    files: dict[str, Path] = field(default_factory=dict)
+
+    @property
+    def end_tensions(self) -> np.ndarray:
+        """``(times, lines, 2)``: the end tensions (N)."""
+        return np.linalg.norm(self.end_forces, axis=-1)
+
+    def tension_columns(self) -> list[str]:
+        """The column names of :meth:`to_csv` after ``time``.
+
+        Returns:
+            ``line<k>_<end>_<fx|fy|fz|tension>`` for each line and end.
+        """
+        return [f"line{row.id}_{end}_{q}" for row in self.model.file.lines for end in "AB"
+                for q in ("fx", "fy", "fz", "tension")]
+
+    def to_csv(self, path: str | Path) -> Path:
+        """Write the end forces and tensions over time.
+
+        Arguments:
+            path: the CSV file: ``time``, then :meth:`tension_columns`.
+
+        Returns:
+            The path written.
+        """
+        path = Path(path)
+        tensions = self.end_tensions
+        with path.open("w", newline="", encoding="utf-8") as handle:
+            writer = csv.writer(handle)
+            writer.writerow(["time", *self.tension_columns()])
+            for i, t in enumerate(self.times):
+                row = [repr(float(t))]
+                for k in range(self.end_forces.shape[1]):
+                    for e in range(2):
+                        row += [repr(float(v)) for v in self.end_forces[i, k, e]]
+                        row.append(repr(float(tensions[i, k, e])))
+                writer.writerow(row)
+        return path
+
+
+def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_end: float, *,
+        dt: float = 0.02, output: str | Path | None = None, plots: bool = True,
+        progress: bool | Callable[[float, float], None] = False, **options: Any) -> MooringRun:
+    """Run a mooring from its static equilibrium with the coupled points moved by a motion.
+
+    Arguments:
+        path: the MoorDyn v2 input file (or its content).
+        motion: the coupled points' motion, or a motion CSV file (see
+            :mod:`vinculo.mooring.motion`); None: they stay where they are.
+        t_end: the end time (s).
+        dt: the step size (s).
+        output: a folder for ``tensions.csv``, ``run.nc`` and the plots (None: write nothing).
+        plots: also draw ``shapes.png`` and ``tensions.png`` into ``output``.
+        progress: True draws a progress bar on standard error (see :func:`vinculo.simulate`).
+        **options: run options passed to :func:`vinculo.simulate`.
+
+    Returns:
+        The run.
+
+    Raises:
+        MooringFileError: for a malformed or unsupported file.
+        InvalidInputError: for a motion that does not match the coupled points or does not
+            cover the run, or a bad step or end time.
+        ConvergenceError: when a step or the initial equilibrium fails.
+    """
+    from vinculo.mooring.model import _check_motion, build_model
+    from vinculo.mooring.moordyn_file import read_moordyn
+    from vinculo.simulate import simulate
+
+    if not isinstance(path, MoorDynFile):
+        path = read_moordyn(path)
+    if isinstance(motion, (str, Path)):
+        motion = Motion.from_csv(motion)
+    if not (math.isfinite(t_end) and t_end > 0.0):
+        raise InvalidInputError(f"t_end = {t_end!r}: give an end time > 0 s", name="t_end",
+                                value=t_end)
+    if motion is not None:
+        start, end = motion.domain()
+        if start > 0.0 or end < t_end:
+            raise InvalidInputError(
+                f"{motion.source} covers t = {start:g} to {end:g} s; the run needs 0 to "
+                f"{t_end:g} s: give a shorter --t-end or a longer record", name="t_end",
+                value=t_end)
+    _check_motion(path, motion)
+    built = build_model(path, motion)
+    if motion is not None and np.any(motion.velocities(0.0) != 0.0):
+        # The coupled points start moving: the velocities of the lines' nodes are made
+        # consistent with theirs (the least mass-weighted change).
+        built.system.project_initial_state()
+    started = time.process_time()
+    solution = simulate(built.system, t_end, dt, progress=progress, **options)
+    cpu = time.process_time() - started
+    forces = np.stack(
+        [np.stack([np.asarray(f, dtype=float).reshape(-1, 3) for f in line.end_forces(solution)],
+                  axis=1) for line in built.lines], axis=1)
+    result = MooringRun(model=built, solution=solution, times=np.asarray(solution.times),
+                        end_forces=forces, cpu_time=cpu, dt=dt)
+    if output is not None:
+        folder = Path(output)
+        folder.mkdir(parents=True, exist_ok=True)
+        result.files["tensions"] = result.to_csv(folder / "tensions.csv")
+        result.files["netcdf"] = Path(solution.save_netcdf(
+            folder / "run.nc", attributes=_attributes(built, dt)) or folder / "run.nc")
+        if plots:
+            from vinculo.mooring.plots import plot_shapes, plot_tensions
+
+            result.files["shapes"] = plot_shapes(result, folder / "shapes.png")
+            result.files["tensions_plot"] = plot_tensions(result, folder / "tensions.png")
+    return result
+
+
+def _attributes(built: Any, dt: float) -> dict[str, Any]:
+    o = built.file.options
+    return {
+        "mooring_file": str(built.file.path) if built.file.path else "",
+        "water_depth": o.depth,
+        "water_density": o.density,
+        "dt": dt,
+        "lines": len(built.lines),
+        "motion": built.motion.source if built.motion is not None else "still",
+    }

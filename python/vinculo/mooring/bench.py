@@ -1,0 +1,396 @@
+"""The benchmark of vinculo's mooring lines against MoorDyn on the same input files.
+
+Three cases, each with its fairlead surging harmonically (2 m, 10 s period, a one-period smooth
+start) from the static equilibrium:
+
+- ``chain``: a studless chain from an anchor on the seabed, part of it lying on the seabed;
+- ``hanging``: a 100 m chain held at both ends in water, clear of the seabed;
+- ``bending``: a power cable with bending stiffness hanging between two points.
+
+For each case and number of segments, both codes run the same MoorDyn file:
+
+- MoorDyn (explicit RK2): the range of its stable steps (no blow-up) by bisection on ``dtM``
+  from the axial-wave estimate ``l / sqrt(EA / m)`` of a segment of length ``l``, a reference
+  run at an eighth of it, its largest stable step by bisection (tensions within 5 % of the
+  reference), and the timed run at 0.9 of that step, whose end-tension error against the
+  reference is MoorDyn's accuracy;
+- vinculo (implicit): a reference run at a small step, then the largest step of a list whose
+  end-tension error against that reference is within MoorDyn's accuracy (or 0.1 % of the peak
+  tension, whichever is larger): equal accuracy in end tension.
+
+Each row reports the step, the CPU time of the time integration (``time.process_time``, the
+initial equilibrium excluded), the real-time factor (CPU time over simulated time), the error
+against the code's own reference, and the difference in end tension between the two codes.
+
+Run it with ``python -m vinculo.mooring.bench [--segments 20,100] [--t-end 60]``; it writes
+``bench.csv`` and ``bench.md`` (the README's table) into ``--output``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import dataclasses
+import math
+import sys
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from vinculo.mooring.moordyn_file import (
+    FileLine,
+    FileLineType,
+    FileOptions,
+    FilePoint,
+    MoorDynFile,
+)
+from vinculo.mooring.motion import Motion
+
+__all__ = ["CASES", "BenchRow", "bench_case", "main", "motion_for", "table"]
+
+
+def _options(depth: float, dtm: float) -> FileOptions:
+    return FileOptions(depth=depth, time_step=dtm,
+                       settings=(("writeLog", "0"), ("dtIC", "1.0"), ("TmaxIC", "100.0"),
+                                 ("threshIC", "1.0e-5")))
+
+
+def chain_on_seabed(segments: int = 63) -> MoorDynFile:
+    """315 m of studless chain from an anchor on the seabed (50 m deep) to a fairlead 40 m
+    above it and 300 m away: about 240 m lie on the seabed (tests/data/moordyn/
+    chain_on_seabed.txt).
+
+    Arguments:
+        segments: the number of segments.
+
+    Returns:
+        The model.
+    """
+    chain = FileLineType("chain", 0.137, 126.0, 5.0e8, -1.0, 0.0, 2.4, 1.0, 1.15, 0.5)
+    return MoorDynFile(
+        line_types={"chain": chain},
+        points=(FilePoint(1, "fixed", (-300.0, 0.0, -50.0)),
+                FilePoint(2, "coupled", (0.0, 0.0, -10.0))),
+        lines=(FileLine(1, "chain", 1, 2, 315.0, segments),),
+        options=_options(50.0, 5e-4), title="benchmark: a chain resting on the seabed")
+
+
+def hanging_line(segments: int = 20) -> MoorDynFile:
+    """A 100 m chain held at both ends in water, 80 m apart at 20 m depth, clear of the seabed
+    (tests/data/moordyn/hanging_line.txt).
+
+    Arguments:
+        segments: the number of segments.
+
+    Returns:
+        The model.
+    """
+    chain = FileLineType("chain", 0.05, 20.0, 1.0e8, -1.0, 0.0, 2.4, 1.0, 1.15, 0.5)
+    return MoorDynFile(
+        line_types={"chain": chain},
+        points=(FilePoint(1, "fixed", (-40.0, 0.0, -20.0)),
+                FilePoint(2, "coupled", (40.0, 0.0, -20.0))),
+        lines=(FileLine(1, "chain", 1, 2, 100.0, segments),),
+        options=_options(200.0, 2e-4), title="benchmark: a chain hanging between two points")
+
+
+def bending_line(segments: int = 20) -> MoorDynFile:
+    """A 30 m power cable with bending stiffness (EI = 2e4 N m^2) hanging between two points
+    25 m apart (tests/data/moordyn/bending_line.txt).
+
+    Arguments:
+        segments: the number of segments.
+
+    Returns:
+        The model.
+    """
+    cable = FileLineType("cable", 0.15, 40.0, 5.0e8, -1.0, 2.0e4, 1.2, 1.0, 0.01, 0.0)
+    return MoorDynFile(
+        line_types={"cable": cable},
+        points=(FilePoint(1, "fixed", (-12.5, 0.0, -30.0)),
+                FilePoint(2, "coupled", (12.5, 0.0, -30.0))),
+        lines=(FileLine(1, "cable", 1, 2, 30.0, segments),),
+        options=_options(100.0, 1e-4), title="benchmark: a cable with bending stiffness")
+
+
+#: The benchmark cases: name -> the model for a number of segments.
+CASES: dict[str, Callable[[int], MoorDynFile]] = {
+    "chain": chain_on_seabed,
+    "hanging": hanging_line,
+    "bending": bending_line,
+}
+
+
+def motion_for(model: MoorDynFile, amplitude: float = 2.0, period: float = 10.0) -> Motion:
+    """The benchmark's fairlead motion: a surge along x with a one-period smooth start.
+
+    Arguments:
+        model: the case.
+        amplitude: the surge amplitude (m).
+        period: its period (s).
+
+    Returns:
+        The motion of the coupled points.
+    """
+    return Motion.harmonic([p.position for p in model.coupled_points()], (amplitude, 0.0, 0.0),
+                           period=period, ramp_time=period)
+
+
+def wave_step(model: MoorDynFile) -> float:
+    """The time an axial wave takes to cross the shortest segment, ``l / sqrt(EA / m)`` (s), the
+    scale of an explicit scheme's stable step.
+
+    Arguments:
+        model: the case.
+
+    Returns:
+        The smallest such time over the lines.
+    """
+    steps = []
+    for line in model.lines:
+        kind = model.line_types[line.line_type]
+        length = line.unstretched_length / line.segments
+        steps.append(length / math.sqrt(kind.ea / kind.mass_per_length))
+    return min(steps)
+
+
+@dataclass(frozen=True)
+class BenchRow:
+    """One code on one case at one number of segments.
+
+    Arguments:
+        case: the case's name.
+        segments: the number of segments.
+        code: ``"moordyn"`` or ``"vinculo"``.
+        step: the time step used (s).
+        cpu_time: the CPU time of the time integration (s).
+        t_end: the simulated time (s).
+        error: the largest end-tension difference from the code's own small-step reference,
+            relative to the peak reference tension.
+        difference: the largest end-tension difference from the other code's reference,
+            relative to the peak tension (NaN when not computed).
+        stable_step: MoorDyn's largest stable step (s; NaN for vinculo).
+    """
+
+    case: str
+    segments: int
+    code: str
+    step: float
+    cpu_time: float
+    t_end: float
+    error: float
+    difference: float = math.nan
+    stable_step: float = math.nan
+
+    @property
+    def real_time_factor(self) -> float:
+        """CPU time over simulated time (below 1: faster than real time)."""
+        return self.cpu_time / self.t_end
+
+
+def _relative(a: np.ndarray, b: np.ndarray) -> float:
+    if a.shape != b.shape:
+        return math.inf
+    scale = float(np.nanmax(np.abs(b)))
+    return float(np.nanmax(np.abs(a - b)) / scale) if scale > 0 else math.inf
+
+
+def _on(times: np.ndarray, values: np.ndarray, grid: np.ndarray) -> np.ndarray:
+    """``values`` (times, ...) interpolated onto ``grid``."""
+    flat = values.reshape(values.shape[0], -1)
+    out = np.column_stack([np.interp(grid, times, flat[:, k]) for k in range(flat.shape[1])])
+    return out.reshape((grid.size, *values.shape[1:]))
+
+
+def bench_moordyn(model: MoorDynFile, motion: Motion, t_end: float, dt_output: float = 0.1
+                  ) -> tuple[BenchRow, np.ndarray, np.ndarray]:
+    """MoorDyn on one case: reference, largest stable step, timed run.
+
+    Arguments:
+        model: the case.
+        motion: the fairlead motion.
+        t_end: the simulated time (s).
+        dt_output: the output interval (s).
+
+    Returns:
+        ``(row, times, reference end tensions)``.
+    """
+    from vinculo.mooring.peer import largest_stable_step, run_moordyn
+
+    estimate = wave_step(model)
+    # The stable range without a reference (no blow-up), then the reference at an eighth of
+    # it, then the largest step that keeps the tensions within 5 % of the reference.
+    rough, _ = largest_stable_step(model, motion, t_end, low=estimate / 2, high=estimate,
+                                   ratio=1.5, dt_output=dt_output)
+    reference = run_moordyn(model, motion, t_end, dt_output=dt_output, time_step=rough / 8)
+    stable, _ = largest_stable_step(model, motion, t_end, reference, low=rough / 2,
+                                    high=rough * 1.5, dt_output=dt_output)
+    step = 0.9 * stable
+    timed = run_moordyn(model, motion, t_end, dt_output=dt_output, time_step=step)
+    error = _relative(timed.end_tensions, reference.end_tensions)
+    row = BenchRow(case="", segments=model.lines[0].segments, code="moordyn", step=step,
+                   cpu_time=timed.cpu_time, t_end=t_end, error=error, stable_step=stable)
+    return row, reference.times, reference.end_tensions
+
+
+def bench_vinculo(model: MoorDynFile, motion: Motion, t_end: float, target: float,
+                  grid: np.ndarray, steps: Sequence[float] = (0.2, 0.1, 0.05, 0.02, 0.01),
+                  ) -> tuple[BenchRow, np.ndarray]:
+    """vinculo on one case: a small-step reference, then the largest step within ``target``.
+
+    Arguments:
+        model: the case.
+        motion: the fairlead motion.
+        t_end: the simulated time (s).
+        target: the accuracy to meet (relative end-tension error).
+        grid: the output times to compare on (s).
+        steps: the steps to try, largest first (s).
+
+    Returns:
+        ``(row, end tensions on the grid at the chosen step)``.
+    """
+    from vinculo.mooring.analysis import run
+
+    def tensions(dt: float) -> tuple[np.ndarray, float]:
+        result = run(model, motion, t_end, dt=dt)
+        return _on(result.times, result.end_tensions, grid), result.cpu_time
+
+    reference, _ = tensions(min(steps) / 4)
+    chosen = None
+    for dt in sorted(steps, reverse=True):
+        values, cpu = tensions(dt)
+        error = _relative(values, reference)
+        if error <= target:
+            chosen = (dt, cpu, error, values)
+            break
+    if chosen is None:
+        dt = min(steps)
+        values, cpu = tensions(dt)
+        chosen = (dt, cpu, _relative(values, reference), values)
+    dt, cpu, error, values = chosen
+    row = BenchRow(case="", segments=model.lines[0].segments, code="vinculo", step=dt,
+                   cpu_time=cpu, t_end=t_end, error=error)
+    return row, values
+
+
+def bench_case(name: str, segments: int, t_end: float, *, with_vinculo: bool = True,
+               tolerance: float = 1e-3) -> list[BenchRow]:
+    """Both codes on one case at one number of segments.
+
+    Arguments:
+        name: a key of :data:`CASES`.
+        segments: the number of segments.
+        t_end: the simulated time (s).
+        with_vinculo: also run vinculo (False: MoorDyn alone).
+        tolerance: the smallest accuracy target of vinculo (relative end-tension error).
+
+    Returns:
+        The MoorDyn row, then the vinculo row.
+    """
+    model = CASES[name](segments)
+    motion = motion_for(model)
+    md, grid, md_reference = bench_moordyn(model, motion, t_end)
+    rows = [dataclasses.replace(md, case=name)]
+    if with_vinculo:
+        vc, values = bench_vinculo(model, motion, t_end, max(md.error, tolerance), grid)
+        difference = _relative(values, md_reference)
+        rows[0] = dataclasses.replace(rows[0], difference=difference)
+        rows.append(dataclasses.replace(vc, case=name, difference=difference))
+    return rows
+
+
+def table(rows: Sequence[BenchRow]) -> str:
+    """The benchmark as a Markdown table, one line per case and number of segments.
+
+    Arguments:
+        rows: the rows of :func:`bench_case`.
+
+    Returns:
+        The table.
+    """
+    lines = [
+        "| case | segments | MoorDyn step (largest stable) | MoorDyn CPU (s) | vinculo step | "
+        "vinculo CPU (s) | CPU ratio | vinculo real-time factor | error MoorDyn / vinculo | "
+        "difference |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    groups: dict[tuple[str, int], dict[str, BenchRow]] = {}
+    for row in rows:
+        groups.setdefault((row.case, row.segments), {})[row.code] = row
+    for (case, segments), by_code in groups.items():
+        md, vc = by_code.get("moordyn"), by_code.get("vinculo")
+        cells = [case, str(segments)]
+        cells += [f"{md.step:.3g} s ({md.stable_step:.3g})", f"{md.cpu_time:.3g}"] if md \
+            else ["", ""]
+        cells += [f"{vc.step:.3g} s", f"{vc.cpu_time:.3g}"] if vc else ["", ""]
+        cells.append(f"{md.cpu_time / vc.cpu_time:.3g}x" if md and vc and vc.cpu_time > 0
+                     else "")
+        cells.append(f"{vc.real_time_factor:.3g}" if vc else "")
+        cells.append(f"{md.error:.1e} / {vc.error:.1e}" if md and vc else
+                     (f"{md.error:.1e} / -" if md else ""))
+        diff = (vc or md).difference if (vc or md) else math.nan
+        cells.append(f"{diff:.1e}" if math.isfinite(diff) else "")
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def write_rows(rows: Sequence[BenchRow], path: str | Path) -> Path:
+    """Write the rows as CSV.
+
+    Arguments:
+        rows: the rows.
+        path: the CSV file.
+
+    Returns:
+        The path written.
+    """
+    path = Path(path)
+    names = [f.name for f in dataclasses.fields(BenchRow)] + ["real_time_factor"]
+    with path.open("w", newline="", encoding="utf-8") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(names)
+        for row in rows:
+            writer.writerow([getattr(row, n) for n in names])
+    return path
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the benchmark from the command line (``python -m vinculo.mooring.bench``).
+
+    Arguments:
+        argv: the arguments (default: ``sys.argv[1:]``).
+
+    Returns:
+        The exit code (0).
+    """
+    parser = argparse.ArgumentParser(prog="python -m vinculo.mooring.bench",
+                                     description=__doc__.split("\n\n")[0])
+    parser.add_argument("--cases", default=",".join(CASES),
+                        help=f"comma-separated cases from {', '.join(CASES)}")
+    parser.add_argument("--segments", default="20,100",
+                        help="comma-separated numbers of segments (default 20,100)")
+    parser.add_argument("--t-end", type=float, default=60.0, help="simulated time (s)")
+    parser.add_argument("--moordyn-only", action="store_true",
+                        help="run MoorDyn alone (no vinculo rows)")
+    parser.add_argument("--output", "-o", type=Path, default=Path("output") / "mooring-bench")
+    args = parser.parse_args(argv)
+    args.output.mkdir(parents=True, exist_ok=True)
+    rows: list[BenchRow] = []
+    for name in [c.strip() for c in args.cases.split(",") if c.strip()]:
+        for segments in [int(s) for s in args.segments.split(",") if s.strip()]:
+            new = bench_case(name, segments, args.t_end, with_vinculo=not args.moordyn_only)
+            rows += new
+            for row in new:
+                print(f"{row.case:8s} N={row.segments:<5d} {row.code:8s} step {row.step:.3g} s "
+                      f"CPU {row.cpu_time:.3g} s (x{row.real_time_factor:.3g} real time) "
+                      f"error {row.error:.1e} difference {row.difference:.1e}", flush=True)
+    write_rows(rows, args.output / "bench.csv")
+    (args.output / "bench.md").write_text(table(rows) + "\n", encoding="utf-8")
+    print(table(rows))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

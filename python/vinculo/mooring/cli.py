@@ -1,0 +1,161 @@
+"""``vinculo mooring``: the statics and runs of a MoorDyn input file from the command line.
+
+Usage::
+
+    vinculo mooring statics FILE [--output DIR]
+    vinculo mooring run FILE [--motion FILE.csv] --t-end T [--dt DT] [--output DIR]
+                        [--no-plots] [--no-progress]
+
+``statics`` prints each line's end tensions and laid length and writes ``DIR/statics.csv``
+(columns ``line,end,point,x,y,z,fx,fy,fz,tension,laid_length``, two rows per line: end A, then
+end B; ``fx fy fz`` the force the line exerts on the end point). ``run`` starts from that
+equilibrium, moves the Vessel/Coupled points by the motion file (``time``, then ``x, y, z`` of
+each coupled point in file order) and writes ``DIR/tensions.csv``, ``DIR/run.nc`` and the plots
+``DIR/shapes.png`` and ``DIR/tensions.png``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+__all__ = ["add_mooring_parser"]
+
+
+def _positive_time(text: str) -> float:
+    """An argparse type: a finite time > 0 (s)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not (math.isfinite(value) and value > 0.0):
+        raise argparse.ArgumentTypeError(f"{text!r}: give a time in s greater than 0")
+    return value
+
+
+_positive_time.__name__ = "time"
+
+
+def _existing_file(text: str) -> Path:
+    """An argparse type: a file that exists."""
+    path = Path(text)
+    if not path.is_file():
+        raise argparse.ArgumentTypeError(f"{text!r} is not a file")
+    return path
+
+
+_existing_file.__name__ = "file"
+
+
+def add_mooring_parser(commands: Any) -> None:
+    """Add ``vinculo mooring`` and its ``statics`` and ``run`` commands.
+
+    Arguments:
+        commands: the subparsers of the ``vinculo`` parser.
+    """
+    mooring = commands.add_parser(
+        "mooring",
+        help="statics and runs of a MoorDyn input file",
+        description=(
+            "Read a MoorDyn v2 input file (LINE TYPES, POINTS, LINES, OPTIONS) and solve its "
+            "static equilibrium, or run it with the Vessel/Coupled points moved by a recorded "
+            "motion. Rods, bodies and wave kinematics are not supported yet: such a file is "
+            "rejected with an error naming the line and the field."
+        ),
+    )
+    actions = mooring.add_subparsers(dest="mooring_command", metavar="ACTION")
+    actions.required = True
+    statics = actions.add_parser(
+        "statics",
+        help="static equilibrium: end tensions and laid lengths, statics.csv",
+        description=(
+            "Solve the static equilibrium of the mooring (Newton on the equilibrium equations, "
+            "no time step), print each line's end tensions and laid length, and write "
+            "DIR/statics.csv with the columns line,end,point,x,y,z,fx,fy,fz,tension,"
+            "laid_length: two rows per line, end A then end B; fx fy fz is the force the line "
+            "exerts on the end point (N), laid_length the length on the seabed (m)."
+        ),
+    )
+    statics.add_argument("file", metavar="FILE", type=_existing_file,
+                         help="the MoorDyn v2 input file")
+    statics.add_argument("--output", "-o", metavar="DIR", type=Path, default=Path("output"),
+                         help="folder of statics.csv (created if missing; default: output)")
+    statics.set_defaults(handler=_statics)
+    run = actions.add_parser(
+        "run",
+        help="move the coupled points by a recorded motion: tensions over time, NetCDF, plots",
+        description=(
+            "Start from the static equilibrium and move the Vessel/Coupled points by a recorded "
+            "motion; write the end forces and tensions over time (DIR/tensions.csv), the whole "
+            "run as NetCDF (DIR/run.nc) and plots of the line shapes and tensions "
+            "(DIR/shapes.png, DIR/tensions.png)."
+        ),
+    )
+    run.add_argument("file", metavar="FILE", type=_existing_file,
+                     help="the MoorDyn v2 input file")
+    run.add_argument("--motion", metavar="FILE.csv", type=_existing_file, default=None,
+                     help="the motion: a header line, then rows of time (s) and x, y, z (m) of "
+                     "each coupled point in the order of the POINTS section; the columns are "
+                     "interpolated by natural cubic splines (default: the points stay put)")
+    run.add_argument("--t-end", metavar="T", type=_positive_time, required=True,
+                     help="the end time (s)")
+    run.add_argument("--dt", metavar="DT", type=_positive_time, default=0.02,
+                     help="the step size (s; default 0.02): the implicit scheme has no "
+                     "stability limit, so the step follows the accuracy wanted")
+    run.add_argument("--output", "-o", metavar="DIR", type=Path, default=Path("output"),
+                     help="folder of the results (created if missing; default: output)")
+    run.add_argument("--no-plots", action="store_true", help="do not draw the plots")
+    run.add_argument("--no-progress", action="store_true", help="do not draw a progress bar")
+    run.set_defaults(handler=_run)
+
+
+def _output(folder: Path, parser: argparse.ArgumentParser) -> Path:
+    if folder.exists() and not folder.is_dir():
+        parser.error(f"--output {str(folder)!r} exists and is not a folder")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        parser.error(f"cannot create the output folder {str(folder)!r}: {exc.strerror}")
+    return folder
+
+
+def _statics(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
+    """Solve the statics, print the table and write statics.csv."""
+    from vinculo.mooring.analysis import statics
+    from vinculo.mooring.moordyn_file import read_moordyn
+
+    model = read_moordyn(args.file)  # a bad file fails before the output folder is made
+    folder = _output(args.output, parser)
+    result = statics(model)
+    print(f"{args.file}: {len(model.lines)} lines, {len(model.points)} points; static "
+          f"equilibrium in {result.cpu_time:.3g} s", flush=True)
+    print(result.table(), flush=True)
+    path = result.to_csv(folder / "statics.csv")
+    print(f"results: {path}", flush=True)
+    return 0
+
+
+def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
+    """Run the mooring with the motion and write its results."""
+    from vinculo.mooring.analysis import run
+    from vinculo.mooring.moordyn_file import read_moordyn
+    from vinculo.mooring.motion import Motion
+
+    model = read_moordyn(args.file)
+    motion = Motion.from_csv(args.motion) if args.motion is not None else None
+    folder = _output(args.output, parser)
+    result = run(model, motion, args.t_end, dt=args.dt, output=folder,
+                 plots=not args.no_plots, progress=not args.no_progress)
+    tensions = result.end_tensions
+    print(f"{args.file}: t = 0 to {result.times[-1]:g} s in {result.solution.num_steps} steps "
+          f"of {args.dt:g} s, {result.cpu_time:.3g} s CPU", flush=True)
+    for k, row in enumerate(model.lines):
+        print(f"line {row.id}: end B tension {tensions[:, k, 1].min():.6g} to "
+              f"{tensions[:, k, 1].max():.6g} N, end A {tensions[:, k, 0].min():.6g} to "
+              f"{tensions[:, k, 0].max():.6g} N", flush=True)
+    print(f"results: {', '.join(str(p) for p in result.files.values())}", file=sys.stdout,
+          flush=True)
+    return 0

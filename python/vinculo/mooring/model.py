@@ -1,0 +1,206 @@
+"""Build a vinculo :class:`~vinculo.System` from a MoorDyn file model.
+
+Each POINTS row becomes a particle:
+
+- ``Fixed``: a fixed particle (an anchor) at the file's position;
+- ``Coupled`` (MoorDyn's Vessel): a particle whose three coordinates follow the motion laws of
+  a :class:`~vinculo.mooring.motion.Motion` (fixed-coordinate constraints; the file's position
+  when no motion is given), so that the constraint multipliers carry the force that holds it;
+- ``Free``: a free particle with the point's mass, and, for a point with a volume, its buoyancy,
+  added mass (``Ca``) and drag (``CdA``) as a Morison element in still water (a point with no
+  volume, its drag ``1/2 rho CdA |v| v`` alone).
+
+Each LINES row becomes a line of lumped masses between its two points
+(:func:`vinculo.mooring.line.add_line`, with the line type, the water and the seabed of the
+file's OPTIONS), and the initial state is the static equilibrium
+(:func:`vinculo.mooring.statics.solve_statics`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from vinculo._core import ParticleId, System
+from vinculo.errors import InvalidInputError
+from vinculo.mooring.moordyn_file import (
+    FileLineType,
+    FileOptions,
+    MoorDynFile,
+    read_moordyn,
+)
+from vinculo.mooring.motion import Motion
+
+__all__ = ["MooringModel", "build_model", "line_type", "seabed", "water"]
+
+# A particle needs a positive mass; a point of the file without one gets this (kg), to which
+# the lines add the lumped mass of their end segments.
+_POINT_MASS_FLOOR = 1e-6
+
+
+def line_type(row: FileLineType) -> Any:
+    """The line type of a LINE TYPES row, as :func:`vinculo.mooring.line.add_line` takes it.
+
+    Arguments:
+        row: the row.
+
+    Returns:
+        A :class:`vinculo.mooring.line.LineType` with the same values (SI units).
+    """
+    from vinculo.mooring.line import LineType
+
+    return LineType(name=row.name, diameter=row.diameter, mass_per_length=row.mass_per_length,
+                    ea=row.ea, ba=row.ba, ei=row.ei, cd=row.cd, ca=row.ca, cdax=row.cdax,
+                    caax=row.caax)
+
+
+def water(options: FileOptions) -> Any:
+    """The water of a file's OPTIONS.
+
+    Arguments:
+        options: the options.
+
+    Returns:
+        A :class:`vinculo.mooring.line.Water`: depth, density and gravity.
+    """
+    from vinculo.mooring.line import Water
+
+    return Water(depth=options.depth, density=options.density, gravity=options.gravity)
+
+
+def seabed(options: FileOptions) -> Any:
+    """The seabed of a file's OPTIONS (MoorDyn's kBot, cBot and friction settings).
+
+    Arguments:
+        options: the options.
+
+    Returns:
+        A :class:`vinculo.mooring.line.Seabed`.
+    """
+    from vinculo.mooring.line import Seabed
+
+    return Seabed(kbot=options.kbot, cbot=options.cbot, friction=options.friction,
+                  axial_friction=options.axial_friction,
+                  friction_damping=options.friction_damping,
+                  static_dynamic_scale=options.static_dynamic_scale)
+
+
+@dataclass
+class MooringModel:
+    """A mooring built from a MoorDyn file.
+
+    Arguments:
+        file: the file's content.
+        system: the vinculo system: one particle per point, the lines' nodes and constraints.
+        points: the particle of each point, in file order (``points[k - 1]`` for point k).
+        lines: the lines (:class:`vinculo.mooring.line.Line`), in file order.
+        motion: the coupled points' motion (None: they stay where the file puts them).
+        statics: the static equilibrium the system starts from (None when not solved).
+    """
+
+    file: MoorDynFile
+    system: System
+    points: list[ParticleId]
+    lines: list[Any]
+    motion: Motion | None = None
+    statics: Any = None
+    coupling_constraints: list[list[Any]] = field(default_factory=list)
+
+    @property
+    def seabed_z(self) -> float:
+        """The height of the flat seabed, ``-depth`` (m)."""
+        return -self.file.options.depth
+
+    def line_ends(self, k: int) -> tuple[int, int]:
+        """The particle indices of the two ends of line ``k`` (0-based).
+
+        Arguments:
+            k: the line's position in the file (0 for line 1).
+
+        Returns:
+            ``(end A, end B)`` particle indices.
+        """
+        row = self.file.lines[k]
+        return self.points[row.attach_a - 1].index, self.points[row.attach_b - 1].index
+
+
+def _check_motion(model: MoorDynFile, motion: Motion | None) -> None:
+    coupled = model.coupled_points()
+    if motion is not None and motion.num_points != len(coupled):
+        raise InvalidInputError(
+            f"{motion.source} moves {motion.num_points} points but "
+            f"{model.path or 'the model'} has {len(coupled)} coupled (Vessel/Coupled) points; "
+            f"give x, y, z of each, in the order of the POINTS section",
+            name="motion", value=motion.num_points)
+
+
+def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, *,
+                solve: bool = True, **statics_options: Any) -> MooringModel:
+    """Build the vinculo model of a MoorDyn file and put it in static equilibrium.
+
+    Arguments:
+        source: the MoorDyn input file, or its content.
+        motion: the coupled points' motion (None: they stay at the file's positions); the
+            statics uses their positions at t = 0.
+        solve: solve the static equilibrium and start the system from it.
+        **statics_options: passed to :func:`vinculo.mooring.statics.solve_statics`
+            (``tolerance``, ``max_iterations``).
+
+    Returns:
+        The model.
+
+    Raises:
+        MooringFileError: for a malformed or unsupported file.
+        InvalidInputError: for a motion that does not match the coupled points.
+        ConvergenceError: when the static equilibrium cannot be found.
+    """
+    from vinculo.mooring.line import add_line
+
+    model = source if isinstance(source, MoorDynFile) else read_moordyn(source)
+    _check_motion(model, motion)
+    options = model.options
+    system = System(gravity=(0.0, 0.0, -options.gravity))
+    the_water, the_seabed = water(options), seabed(options)
+    start = motion.positions(0.0) if motion is not None else None
+    points: list[ParticleId] = []
+    coupling: list[list[Any]] = []
+    coupled_index = 0
+    for point in model.points:
+        mass = max(point.mass, _POINT_MASS_FLOOR)
+        if point.attachment == "fixed":
+            points.append(system.add_particle(mass, point.position, fixed=True))
+            continue
+        if point.attachment == "coupled":
+            laws = motion.laws[coupled_index] if motion is not None else point.position
+            position = start[coupled_index] if start is not None else point.position
+            velocity = (motion.velocities(0.0)[coupled_index] if motion is not None
+                        else (0.0, 0.0, 0.0))
+            particle = system.add_particle(mass, tuple(float(c) for c in position),
+                                           velocity=tuple(float(c) for c in velocity))
+            coupling.append([system.add_fixed_coordinate(particle, axis, value)
+                             for axis, value in enumerate(laws)])
+            points.append(particle)
+            coupled_index += 1
+            continue
+        particle = system.add_particle(mass, point.position)
+        if point.volume > 0.0:
+            system.add_morison(particle, volume=point.volume, area=point.cda,
+                               drag_coefficient=1.0 if point.cda > 0.0 else 0.0,
+                               added_mass_coefficient=point.ca, density=options.density)
+        elif point.cda > 0.0:  # drag alone: 1/2 rho CdA |v| v against the motion
+            system.add_quadratic_drag(particle, 0.5 * options.density * point.cda)
+        points.append(particle)
+    lines = []
+    for row in model.lines:
+        lines.append(add_line(
+            system, points[row.attach_a - 1].index, points[row.attach_b - 1].index,
+            line_type(model.line_types[row.line_type]), row.unstretched_length, row.segments,
+            the_water, the_seabed, name=f"line {row.id}"))
+    built = MooringModel(file=model, system=system, points=points, lines=lines, motion=motion,
+                         coupling_constraints=coupling)
+    if solve:
+        from vinculo.mooring.statics import solve_statics
+
+        built.statics = solve_statics(system, **statics_options)
+    return built

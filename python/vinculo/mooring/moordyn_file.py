@@ -1,0 +1,779 @@
+"""MoorDyn v2 input files: read them into a :class:`MoorDynFile`, write one back.
+
+A MoorDyn v2 input file is plain text divided into sections, each opened by a header line of
+dashes around a key phrase (``---- LINE TYPES ----``). A table section has two lines of column
+names and units after its header, then one row per entry, values separated by white space;
+``#`` starts a comment. The OPTIONS section has one ``value key [description]`` line per option.
+The format is MoorDyn's (moordyn.readthedocs.io, "Input Files", "The V2 Input File").
+
+What is read: LINE TYPES (name, diameter, mass per length, EA, BA or a negative damping ratio,
+EI, Cd, Ca, CdAx, CaAx), POINTS (also spelled POINT PROPERTIES, CONNECTION PROPERTIES or
+NODE PROPERTIES; attachments Fixed, Coupled/Vessel and Free/Point/Connect), LINES, OPTIONS
+(water depth, density, gravity, seabed contact and friction, time step and MoorDyn's own
+simulation settings) and OUTPUTS (kept for writing back). What is not supported yet raises a
+:class:`~vinculo.errors.MooringFileError` that names the file, the line and the field: rods,
+bodies, failures, external loads, control channels, wave and current kinematics, a bathymetry
+file, non-linear or viscoelastic stiffness, vortex-induced vibration, points attached to bodies.
+
+Units are SI throughout (m, kg, N, s), as in the file.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from vinculo.errors import MooringFileError
+
+__all__ = [
+    "ATTACHMENTS",
+    "FileLine",
+    "FileLineType",
+    "FileOptions",
+    "FilePoint",
+    "MoorDynFile",
+    "format_moordyn",
+    "parse_moordyn",
+    "read_moordyn",
+    "write_moordyn",
+]
+
+#: The point attachments vinculo supports, as stored in :attr:`FilePoint.attachment`.
+ATTACHMENTS = ("fixed", "coupled", "free")
+
+# The spellings MoorDyn accepts for each supported attachment (compared in lower case).
+_ATTACHMENT_NAMES = {
+    "fixed": "fixed",
+    "fix": "fixed",
+    "anchor": "fixed",
+    "coupled": "coupled",
+    "vessel": "coupled",
+    "vess": "coupled",
+    "ves": "coupled",
+    "cpld": "coupled",
+    "free": "free",
+    "point": "free",
+    "connect": "free",
+    "con": "free",
+}
+
+# Section key phrases (upper case, spaces collapsed) -> section kind.
+_SECTIONS = {
+    "LINE TYPES": "line_types",
+    "LINE DICTIONARY": "line_types",
+    "ROD TYPES": "rod_types",
+    "ROD DICTIONARY": "rod_types",
+    "BODIES": "bodies",
+    "BODY LIST": "bodies",
+    "BODY PROPERTIES": "bodies",
+    "RODS": "rods",
+    "ROD LIST": "rods",
+    "ROD PROPERTIES": "rods",
+    "POINTS": "points",
+    "POINT LIST": "points",
+    "POINT PROPERTIES": "points",
+    "CONNECTION PROPERTIES": "points",
+    "CONNECTIONS": "points",
+    "NODE PROPERTIES": "points",
+    "LINES": "lines",
+    "LINE LIST": "lines",
+    "LINE PROPERTIES": "lines",
+    "OPTIONS": "options",
+    "SOLVER OPTIONS": "options",
+    "OUTPUTS": "outputs",
+    "OUTPUT": "outputs",
+    "OUTPUT LIST": "outputs",
+    "FAILURE": "failure",
+    "FAILURES": "failure",
+    "CONTROL": "control",
+    "EXTERNAL LOADS": "external_loads",
+}
+
+# Sections whose rows vinculo cannot model yet, and what they hold.
+_UNSUPPORTED_SECTIONS = {
+    "rod_types": "rod types",
+    "rods": "rods",
+    "bodies": "bodies",
+    "failure": "line failures",
+    "control": "control channels",
+    "external_loads": "external loads",
+}
+
+
+@dataclass(frozen=True)
+class FileLineType:
+    """A row of the LINE TYPES section.
+
+    Arguments:
+        name: the type's name, referred to by the LINES rows.
+        diameter: the volume-equivalent diameter (m).
+        mass_per_length: the mass per unit length in air (kg/m).
+        ea: the axial stiffness (N).
+        ba: the internal axial damping (N s), or, when negative, minus the damping ratio of each
+            segment's axial mode (MoorDyn's BA/-zeta column).
+        ei: the bending stiffness (N m^2).
+        cd: the transverse drag coefficient (on the frontal area d l).
+        ca: the transverse added-mass coefficient.
+        cdax: the tangential drag coefficient (on the surface area pi d l).
+        caax: the tangential added-mass coefficient.
+    """
+
+    name: str
+    diameter: float
+    mass_per_length: float
+    ea: float
+    ba: float = 0.0
+    ei: float = 0.0
+    cd: float = 0.0
+    ca: float = 0.0
+    cdax: float = 0.0
+    caax: float = 0.0
+
+
+@dataclass(frozen=True)
+class FilePoint:
+    """A row of the POINTS section.
+
+    Arguments:
+        id: the point's number (1, 2, ... in file order).
+        attachment: ``"fixed"`` (an anchor), ``"coupled"`` (moved by the caller: MoorDyn's
+            Coupled or Vessel) or ``"free"`` (a free point: MoorDyn's Free, Point or Connect).
+        position: (x, y, z) in m, z up, the water surface at z = 0; for a free point, the
+            initial guess of its position.
+        mass: a clump weight's mass (kg).
+        volume: a float's displaced volume (m^3).
+        cda: drag coefficient times projected area (m^2).
+        ca: added-mass coefficient (on the displaced volume).
+    """
+
+    id: int
+    attachment: str
+    position: tuple[float, float, float]
+    mass: float = 0.0
+    volume: float = 0.0
+    cda: float = 0.0
+    ca: float = 0.0
+
+
+@dataclass(frozen=True)
+class FileLine:
+    """A row of the LINES section.
+
+    Arguments:
+        id: the line's number (1, 2, ... in file order).
+        line_type: the name of its LINE TYPES row.
+        attach_a: the number of the point of end A (MoorDyn's anchor end, node 0).
+        attach_b: the number of the point of end B (the fairlead end, node N).
+        unstretched_length: the unstretched length (m).
+        segments: the number of segments N (the line has N + 1 nodes).
+        outputs: MoorDyn's output flags (``"-"``: none); kept for writing back.
+    """
+
+    id: int
+    line_type: str
+    attach_a: int
+    attach_b: int
+    unstretched_length: float
+    segments: int
+    outputs: str = "-"
+
+
+@dataclass(frozen=True)
+class FileOptions:
+    """The OPTIONS section, with MoorDyn-C's defaults for the options a file omits.
+
+    Arguments:
+        depth: water depth WtrDpth (m): the flat seabed is at z = -depth.
+        density: water density rhoW (kg/m^3).
+        gravity: gravitational acceleration g (m/s^2).
+        kbot: seabed stiffness per unit area kBot (Pa/m).
+        cbot: seabed damping per unit area cBot (Pa s/m).
+        friction: seabed friction coefficient FrictionCoefficient (MoorDyn-C; MoorDyn-F's MU_KT).
+        axial_friction: MoorDyn-F's axial friction coefficient MU_KA (None: not given).
+        friction_damping: FricDamp (MoorDyn-F's CV): the velocity scale of the regularised
+            friction (s/m).
+        static_dynamic_scale: StatDynFricScale (MoorDyn-F's MC): static over dynamic friction.
+        time_step: dtM, MoorDyn's time step (s); None when the file gives none.
+        settings: MoorDyn's simulation settings that do not change the model (writeLog,
+            tScheme, CFL, dtOut, the initial-condition settings dtIC, TmaxIC, CdScaleIC,
+            threshIC, ...), as (key, text) pairs in file order, kept for writing back.
+    """
+
+    depth: float = 0.0
+    density: float = 1025.0
+    gravity: float = 9.80665
+    kbot: float = 3.0e6
+    cbot: float = 3.0e5
+    friction: float = 0.0
+    axial_friction: float | None = None
+    friction_damping: float = 200.0
+    static_dynamic_scale: float = 1.0
+    time_step: float | None = None
+    settings: tuple[tuple[str, str], ...] = ()
+
+
+@dataclass(frozen=True)
+class MoorDynFile:
+    """The content of a MoorDyn v2 input file.
+
+    Arguments:
+        line_types: the LINE TYPES rows, by name, in file order.
+        points: the POINTS rows, in file order (point ``k`` is ``points[k - 1]``).
+        lines: the LINES rows, in file order.
+        options: the OPTIONS section.
+        title: the free text before the first section (without its header line).
+        outputs: the OUTPUTS channel names, kept for writing back.
+        path: the file read (None for a model parsed from text or built in code).
+    """
+
+    line_types: dict[str, FileLineType]
+    points: tuple[FilePoint, ...]
+    lines: tuple[FileLine, ...]
+    options: FileOptions = field(default_factory=FileOptions)
+    title: str = ""
+    outputs: tuple[str, ...] = ()
+    path: Path | None = None
+
+    def point(self, number: int) -> FilePoint:
+        """The point with MoorDyn number ``number``.
+
+        Arguments:
+            number: the point's ID (1-based, as in the file).
+
+        Returns:
+            Its row.
+
+        Raises:
+            MooringFileError: when there is no such point.
+        """
+        if not 1 <= number <= len(self.points):
+            raise MooringFileError(
+                f"{self.path or 'the model'}: there is no point {number} (the file has "
+                f"{len(self.points)} points)",
+                file=str(self.path) if self.path else None, field="point", value=number,
+            )
+        return self.points[number - 1]
+
+    def coupled_points(self) -> list[FilePoint]:
+        """The coupled (Vessel/Coupled) points, in file order: the order of MoorDyn's coupled
+        degrees of freedom and of the columns of a motion file.
+
+        Returns:
+            The coupled points' rows.
+        """
+        return [p for p in self.points if p.attachment == "coupled"]
+
+
+# --------------------------------------------------------------------------------------------
+# Reading
+
+
+@dataclass
+class _Line:
+    number: int  # 1-based line number in the file
+    text: str  # without the comment
+
+
+def _error(path: str, line: int | None, field_name: str, message: str, value: object = None
+           ) -> MooringFileError:
+    where = f"{path}, line {line}" if line is not None else path
+    return MooringFileError(f"{where}: {field_name}: {message}", file=path, line=line,
+                            field=field_name, value=value)
+
+
+def _section_kind(text: str) -> str | None:
+    """The kind of section a header line opens, None when it is not a header ("" for a header
+    line with no known key phrase, such as MoorDyn's closing line)."""
+    stripped = text.strip()
+    if not stripped.startswith("--"):
+        return None
+    phrase = re.sub(r"\s+", " ", stripped.strip("-").strip()).upper()
+    for key, kind in _SECTIONS.items():
+        if phrase == key or phrase.startswith(key + " ") or phrase.endswith(" " + key):
+            return kind
+    return ""
+
+
+def _number(path: str, line: _Line, field_name: str, text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise _error(path, line.number, field_name, f"{text!r} is not a number", text) from None
+    if not math.isfinite(value):
+        raise _error(path, line.number, field_name, f"{text!r} is not a finite number", text)
+    return value
+
+
+def _whole(path: str, line: _Line, field_name: str, text: str) -> int:
+    try:
+        return int(text)
+    except ValueError:
+        raise _error(path, line.number, field_name, f"{text!r} is not a whole number",
+                     text) from None
+
+
+def _positive(path: str, line: _Line, field_name: str, value: float, allow_zero: bool = False
+              ) -> float:
+    if value < 0.0 or (value == 0.0 and not allow_zero):
+        need = ">= 0" if allow_zero else "> 0"
+        raise _error(path, line.number, field_name, f"{value:g} must be {need}", value)
+    return value
+
+
+def _stiffness(path: str, line: _Line, field_name: str, text: str, what: str) -> float:
+    if "|" in text:
+        raise _error(path, line.number, field_name,
+                     f"{text!r}: {what} with static and dynamic values (viscoelastic lines) "
+                     f"is not supported yet; give one number", text)
+    try:
+        float(text)
+    except ValueError:
+        raise _error(path, line.number, field_name,
+                     f"{text!r} is not a number (a file name here, {what} from a table of a "
+                     f"non-linear line, is not supported yet)", text) from None
+    return _number(path, line, field_name, text)
+
+
+def _split_sections(path: str, text: str) -> Iterator[tuple[str, _Line, list[_Line]]]:
+    """(kind, header line, body lines) of each section; the front matter has kind "title"."""
+    kind, header, body = "title", _Line(0, ""), []
+    for number, raw in enumerate(text.splitlines(), start=1):
+        content = raw.split("#", 1)[0].rstrip()
+        found = _section_kind(content)
+        if found == "" and number == 1:
+            continue  # the optional "--- MoorDyn Input File ---" line opening the front matter
+        if found is None:
+            body.append(_Line(number, content))
+            continue
+        yield kind, header, body
+        kind, header, body = (found or "end"), _Line(number, content), []
+    yield kind, header, body
+
+
+def _table_rows(body: list[_Line]) -> list[tuple[_Line, list[str]]]:
+    """The entries of a table section: after the column-name and unit lines, the non-blank
+    lines split into fields."""
+    lines = [ln for ln in body if ln.text.strip()]
+    return [(ln, ln.text.split()) for ln in lines[2:]]
+
+
+def _check_columns(path: str, line: _Line, fields: list[str], names: tuple[str, ...],
+                   section: str) -> None:
+    if len(fields) < len(names):
+        missing = names[len(fields)]
+        raise _error(path, line.number, missing,
+                     f"the {section} row has {len(fields)} values; it needs "
+                     f"{len(names)} ({' '.join(names)})", " ".join(fields))
+
+
+_LINE_TYPE_COLUMNS = ("TypeName", "Diam", "Mass/m", "EA", "BA/-zeta", "EI", "Cd", "Ca", "CdAx",
+                      "CaAx")
+
+
+def _line_type(path: str, line: _Line, fields: list[str]) -> FileLineType:
+    _check_columns(path, line, fields, _LINE_TYPE_COLUMNS, "LINE TYPES")
+    cols = dict(zip(_LINE_TYPE_COLUMNS, fields, strict=False))
+    if len(fields) > len(_LINE_TYPE_COLUMNS):
+        lift = _number(path, line, "Cl", fields[10])
+        if lift != 0.0:
+            raise _error(path, line.number, "Cl",
+                         f"{lift:g}: vortex-induced vibration (a non-zero lift coefficient) is "
+                         f"not supported yet; give 0 or leave the column out", lift)
+    name = cols["TypeName"]
+    diameter = _positive(path, line, "Diam", _number(path, line, "Diam", cols["Diam"]))
+    mass = _positive(path, line, "Mass/m", _number(path, line, "Mass/m", cols["Mass/m"]))
+    ea = _positive(path, line, "EA", _stiffness(path, line, "EA", cols["EA"], "EA"))
+    ba = _stiffness(path, line, "BA/-zeta", cols["BA/-zeta"], "BA")
+    values = {}
+    for column in ("EI", "Cd", "Ca", "CdAx", "CaAx"):
+        values[column] = _positive(path, line, column,
+                                   _number(path, line, column, cols[column]), allow_zero=True)
+    return FileLineType(name=name, diameter=diameter, mass_per_length=mass, ea=ea, ba=ba,
+                        ei=values["EI"], cd=values["Cd"], ca=values["Ca"],
+                        cdax=values["CdAx"], caax=values["CaAx"])
+
+
+_POINT_COLUMNS = ("ID", "Attachment", "X", "Y", "Z", "Mass", "Volume", "CdA", "Ca")
+
+
+def _point(path: str, line: _Line, fields: list[str], expected_id: int) -> FilePoint:
+    _check_columns(path, line, fields, _POINT_COLUMNS, "POINTS")
+    number = _whole(path, line, "ID", fields[0])
+    if number != expected_id:
+        raise _error(path, line.number, "ID",
+                     f"point {number}: points must be numbered 1, 2, ... in order "
+                     f"(expected {expected_id})", number)
+    word = fields[1]
+    attachment = _ATTACHMENT_NAMES.get(word.lower())
+    if attachment is None:
+        if re.fullmatch(r"(?i)(body|turbine)\d*", word):
+            raise _error(path, line.number, "Attachment",
+                         f"{word!r}: points attached to bodies or turbines are not supported "
+                         f"yet; use Fixed, Coupled (Vessel) or Free", word)
+        raise _error(path, line.number, "Attachment",
+                     f"{word!r} is not a point attachment: use Fixed, Coupled (or Vessel) or "
+                     f"Free (or Point, Connect)", word)
+    x, y, z = (_number(path, line, name, fields[k]) for k, name in zip((2, 3, 4), "XYZ",
+                                                                        strict=True))
+    mass, volume, cda, ca = (
+        _positive(path, line, name, _number(path, line, name, fields[k]), allow_zero=True)
+        for k, name in zip((5, 6, 7, 8), ("Mass", "Volume", "CdA", "Ca"), strict=True)
+    )
+    return FilePoint(id=number, attachment=attachment, position=(x, y, z), mass=mass,
+                     volume=volume, cda=cda, ca=ca)
+
+
+_LINE_COLUMNS = ("ID", "LineType", "AttachA", "AttachB", "UnstrLen", "NumSegs")
+
+
+def _attach(path: str, line: _Line, field_name: str, text: str) -> int:
+    if re.fullmatch(r"(?i)r\d+[ab]", text):
+        raise _error(path, line.number, field_name,
+                     f"{text!r}: lines attached to rod ends are not supported yet; attach "
+                     f"lines to points", text)
+    number = _whole(path, line, field_name, text)
+    if number < 1:
+        raise _error(path, line.number, field_name, f"{number}: point numbers start at 1",
+                     number)
+    return number
+
+
+def _line(path: str, line: _Line, fields: list[str], expected_id: int) -> FileLine:
+    _check_columns(path, line, fields, _LINE_COLUMNS, "LINES")
+    number = _whole(path, line, "ID", fields[0])
+    if number != expected_id:
+        raise _error(path, line.number, "ID",
+                     f"line {number}: lines must be numbered 1, 2, ... in order "
+                     f"(expected {expected_id})", number)
+    attach_a = _attach(path, line, "AttachA", fields[2])
+    attach_b = _attach(path, line, "AttachB", fields[3])
+    length = _positive(path, line, "UnstrLen", _number(path, line, "UnstrLen", fields[4]))
+    segments = _whole(path, line, "NumSegs", fields[5])
+    if segments < 1:
+        raise _error(path, line.number, "NumSegs", f"{segments}: give at least 1 segment",
+                     segments)
+    outputs = fields[6] if len(fields) > 6 else "-"
+    return FileLine(id=number, line_type=fields[1], attach_a=attach_a, attach_b=attach_b,
+                    unstretched_length=length, segments=segments, outputs=outputs)
+
+
+# Options that change the model: key (lower case) -> FileOptions field.
+_MODEL_OPTIONS = {
+    "wtrdpth": "depth",
+    "depth": "depth",
+    "rhow": "density",
+    "rho": "density",
+    "wtrdnsty": "density",
+    "g": "gravity",
+    "gravity": "gravity",
+    "kbot": "kbot",
+    "kb": "kbot",
+    "cbot": "cbot",
+    "cb": "cbot",
+    "frictioncoefficient": "friction",
+    "mu_kt": "friction",
+    "mu_ka": "axial_friction",
+    "fricdamp": "friction_damping",
+    "cv": "friction_damping",
+    "statdynfricscale": "static_dynamic_scale",
+    "mc": "static_dynamic_scale",
+    "dtm": "time_step",
+}
+
+# MoorDyn's settings of its own run that do not change the model: kept, written back.
+_SETTINGS = {
+    "writelog", "tscheme", "cfl", "dtout", "dtic", "tmaxic", "cdscaleic", "threshic",
+    "icdfac", "icthresh", "ictmax", "icgendynamic", "disableoutput", "disableouttime",
+    "writeunits", "echo", "outswitch", "inertialf", "inertialf_rampt", "fileic",
+}
+
+# Options of features not supported yet: key -> what it asks for. A zero (or empty) value
+# switches the feature off and is accepted.
+_UNSUPPORTED_OPTIONS = {
+    "wavekin": "wave kinematics",
+    "currents": "currents",
+    "waterkin": "water kinematics",
+    "seafloorfile": "a bathymetry file",
+    "dtwave": "wave kinematics",
+    "unifycurrentgrid": None,
+}
+
+
+def _options(path: str, body: list[_Line]) -> FileOptions:
+    values: dict[str, float] = {}
+    settings: list[tuple[str, str]] = []
+    for line in body:
+        fields = line.text.split()
+        if not fields:
+            continue
+        if len(fields) < 2:
+            raise _error(path, line.number, fields[0],
+                         "an option line is 'value key [description]'; the key is missing",
+                         fields[0])
+        text, key = fields[0], fields[1]
+        lower = key.lower()
+        if lower in _MODEL_OPTIONS:
+            name = _MODEL_OPTIONS[lower]
+            if name == "depth":
+                try:
+                    float(text)
+                except ValueError:
+                    raise _error(path, line.number, key,
+                                 f"{text!r}: a bathymetry file as the water depth is not "
+                                 f"supported yet; give the depth in m", text) from None
+            value = _number(path, line, key, text)
+            _positive(path, line, key, value,
+                      allow_zero=name not in ("depth", "density", "gravity", "time_step"))
+            values[name] = value
+        elif lower in _SETTINGS:
+            settings.append((key, text))
+        elif lower in _UNSUPPORTED_OPTIONS:
+            what = _UNSUPPORTED_OPTIONS[lower]
+            if what is None:
+                settings.append((key, text))
+                continue
+            off = text in ("0", "0.0", "", "-", '""', "none") or (
+                lower == "dtwave")
+            if not off:
+                raise _error(path, line.number, key,
+                             f"{text!r}: {what} are not supported yet (still water only); "
+                             f"remove the option or set it to 0", text)
+            settings.append((key, text))
+        else:
+            known = sorted({*(_MODEL_OPTIONS), *(_SETTINGS)})
+            raise _error(path, line.number, key,
+                         f"unknown option {key!r}; known options: {', '.join(known)}", key)
+    return FileOptions(**values, settings=tuple(settings))
+
+
+def parse_moordyn(text: str, path: str | Path = "<text>") -> MoorDynFile:
+    """Read the text of a MoorDyn v2 input file.
+
+    Arguments:
+        text: the file's content.
+        path: the file's name, for error messages (and :attr:`MoorDynFile.path`).
+
+    Returns:
+        The file's content.
+
+    Raises:
+        MooringFileError: for a malformed value, a missing section or column, a reference to
+            an unknown line type or point, or a feature that vinculo does not support yet; the
+            message (and the ``file``, ``line`` and ``field`` attributes) says where.
+    """
+    name = str(path)
+    title = ""
+    line_types: dict[str, FileLineType] = {}
+    points: list[FilePoint] = []
+    lines: list[FileLine] = []
+    options = FileOptions()
+    outputs: list[str] = []
+    seen: dict[str, int] = {}
+    line_type_rows: dict[str, int] = {}
+    for kind, header, body in _split_sections(name, text):
+        if kind == "title":
+            title = "\n".join(ln.text for ln in body).strip("\n")
+            continue
+        if kind == "end":
+            rows = [ln for ln in body if ln.text.strip()]
+            if rows:
+                raise _error(name, header.number, header.text.strip("- ") or header.text,
+                             "not a MoorDyn section vinculo knows (LINE TYPES, POINTS, LINES, "
+                             "OPTIONS, OUTPUTS; ROD TYPES, RODS, BODIES are not supported "
+                             "yet)", header.text)
+            continue
+        if kind in seen:
+            raise _error(name, header.number, header.text.strip("- "),
+                         f"a second {header.text.strip('- ')} section (the first is on line "
+                         f"{seen[kind]})", header.text)
+        seen[kind] = header.number
+        if kind in _UNSUPPORTED_SECTIONS:
+            rows = _table_rows(body)
+            if rows:
+                line, fields = rows[0]
+                raise _error(name, line.number, header.text.strip("- "),
+                             f"{_UNSUPPORTED_SECTIONS[kind]} are not supported yet; vinculo "
+                             f"reads lines between points (remove the section)", fields[0])
+        elif kind == "line_types":
+            for line, fields in _table_rows(body):
+                lt = _line_type(name, line, fields)
+                if lt.name in line_types:
+                    raise _error(name, line.number, "TypeName",
+                                 f"line type {lt.name!r} is defined twice (first on line "
+                                 f"{line_type_rows[lt.name]})", lt.name)
+                line_types[lt.name] = lt
+                line_type_rows[lt.name] = line.number
+        elif kind == "points":
+            for line, fields in _table_rows(body):
+                points.append(_point(name, line, fields, len(points) + 1))
+        elif kind == "lines":
+            for line, fields in _table_rows(body):
+                ln = _line(name, line, fields, len(lines) + 1)
+                if ln.line_type not in line_types:
+                    known = ", ".join(line_types) or "none"
+                    raise _error(name, line.number, "LineType",
+                                 f"{ln.line_type!r} is not a line type of the LINE TYPES "
+                                 f"section (defined: {known})", ln.line_type)
+                for end, number in (("AttachA", ln.attach_a), ("AttachB", ln.attach_b)):
+                    if number > len(points):
+                        raise _error(name, line.number, end,
+                                     f"point {number} is not in the POINTS section (it has "
+                                     f"{len(points)} points, which must come before LINES)",
+                                     number)
+                if ln.attach_a == ln.attach_b:
+                    raise _error(name, line.number, "AttachB",
+                                 f"both ends of line {ln.id} are attached to point "
+                                 f"{ln.attach_a}", ln.attach_b)
+                lines.append(ln)
+        elif kind == "options":
+            options = _options(name, body)
+        elif kind == "outputs":
+            outputs = [ln.text.strip() for ln in body if ln.text.strip()]
+            outputs = [o for o in outputs if o.upper() != "END"]
+    if not lines:
+        raise _error(name, None, "LINES",
+                     "the file has no LINES section or no line in it; a MoorDyn model needs "
+                     "at least one line", None)
+    return MoorDynFile(line_types=line_types, points=tuple(points), lines=tuple(lines),
+                       options=options, title=title, outputs=tuple(outputs),
+                       path=Path(path) if name != "<text>" else None)
+
+
+def read_moordyn(path: str | Path) -> MoorDynFile:
+    """Read a MoorDyn v2 input file.
+
+    Arguments:
+        path: the file (MoorDyn's usual suffixes are .txt and .dat).
+
+    Returns:
+        The file's content.
+
+    Raises:
+        MooringFileError: when the file cannot be read, or for anything
+            :func:`parse_moordyn` rejects.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except OSError as exc:
+        raise MooringFileError(f"cannot read the MoorDyn file {str(path)!r}: {exc.strerror}",
+                               file=str(path), line=None, field=None, value=None) from None
+    return parse_moordyn(text, path)
+
+
+# --------------------------------------------------------------------------------------------
+# Writing
+
+
+def _g(value: float) -> str:
+    """A number as text that reads back to the same float."""
+    text = repr(float(value))
+    return text[:-2] if text.endswith(".0") and "e" not in text else text
+
+
+def _row(values: list[str], widths: list[int]) -> str:
+    return " ".join(v.ljust(w) for v, w in zip(values, widths, strict=True)).rstrip()
+
+
+def _table(names: list[str], units: list[str], rows: list[list[str]]) -> list[str]:
+    widths = [max(len(r[k]) for r in [names, units, *rows]) for k in range(len(names))]
+    return [_row(names, widths), _row(units, widths)] + [_row(r, widths) for r in rows]
+
+
+def _header(phrase: str) -> str:
+    return f"{'-' * 22} {phrase} {'-' * max(4, 50 - len(phrase))}"
+
+
+_ATTACHMENT_WORDS = {"fixed": "Fixed", "coupled": "Coupled", "free": "Free"}
+
+
+def format_moordyn(model: MoorDynFile) -> str:
+    """The text of a MoorDyn v2 input file for ``model``.
+
+    Arguments:
+        model: the model to write.
+
+    Returns:
+        The file's text; :func:`parse_moordyn` reads it back to an equal model.
+    """
+    out = [_header("MoorDyn Input File")]
+    out += (model.title or "MoorDyn v2 input file written by vinculo").splitlines()
+    out.append(_header("LINE TYPES"))
+    out += _table(
+        ["TypeName", "Diam", "Mass/m", "EA", "BA/-zeta", "EI", "Cd", "Ca", "CdAx", "CaAx"],
+        ["(name)", "(m)", "(kg/m)", "(N)", "(N-s/-)", "(N-m^2)", "(-)", "(-)", "(-)", "(-)"],
+        [[t.name, *map(_g, (t.diameter, t.mass_per_length, t.ea, t.ba, t.ei, t.cd, t.ca,
+                            t.cdax, t.caax))] for t in model.line_types.values()],
+    )
+    out.append(_header("POINTS"))
+    out += _table(
+        ["ID", "Attachment", "X", "Y", "Z", "Mass", "Volume", "CdA", "Ca"],
+        ["(#)", "(-)", "(m)", "(m)", "(m)", "(kg)", "(m^3)", "(m^2)", "(-)"],
+        [[str(p.id), _ATTACHMENT_WORDS[p.attachment], *map(_g, p.position),
+          *map(_g, (p.mass, p.volume, p.cda, p.ca))] for p in model.points],
+    )
+    out.append(_header("LINES"))
+    out += _table(
+        ["ID", "LineType", "AttachA", "AttachB", "UnstrLen", "NumSegs", "LineOutputs"],
+        ["(#)", "(name)", "(#)", "(#)", "(m)", "(-)", "(-)"],
+        [[str(ln.id), ln.line_type, str(ln.attach_a), str(ln.attach_b),
+          _g(ln.unstretched_length), str(ln.segments), ln.outputs or "-"]
+         for ln in model.lines],
+    )
+    out.append(_header("OPTIONS"))
+    o = model.options
+    defaults = FileOptions()
+    option_lines: list[tuple[str, str, str]] = []
+    for key, text in o.settings:
+        option_lines.append((text, key, ""))
+    named = [
+        ("time_step", "dtM", "time step (s)"),
+        ("gravity", "g", "gravitational acceleration (m/s^2)"),
+        ("density", "WtrDnsty", "water density (kg/m^3)"),
+        ("depth", "WtrDpth", "water depth (m)"),
+        ("kbot", "kBot", "seabed stiffness (Pa/m)"),
+        ("cbot", "cBot", "seabed damping (Pa-s/m)"),
+        ("friction", "FrictionCoefficient", "seabed friction coefficient (-)"),
+        ("axial_friction", "MU_KA", "axial seabed friction coefficient (-)"),
+        ("friction_damping", "FricDamp", "friction damping (s/m)"),
+        ("static_dynamic_scale", "StatDynFricScale", "static over dynamic friction (-)"),
+    ]
+    for attr, key, description in named:
+        value = getattr(o, attr)
+        if value is None or (attr not in ("depth", "gravity", "density")
+                             and value == getattr(defaults, attr)):
+            continue
+        option_lines.append((_g(value), key, description))
+    width_v = max((len(v) for v, _, _ in option_lines), default=1)
+    width_k = max((len(k) for _, k, _ in option_lines), default=1)
+    out += [f"{v.ljust(width_v)}  {k.ljust(width_k)}  {d}".rstrip() for v, k, d in option_lines]
+    if model.outputs:
+        out.append(_header("OUTPUTS"))
+        out += list(model.outputs)
+    out.append(_header("need this line"))
+    return "\n".join(out) + "\n"
+
+
+def write_moordyn(model: MoorDynFile, path: str | Path) -> Path:
+    """Write ``model`` as a MoorDyn v2 input file (which MoorDyn itself reads).
+
+    Arguments:
+        model: the model.
+        path: the file to write (replaced if it exists).
+
+    Returns:
+        The path written.
+
+    Raises:
+        MooringFileError: when the file cannot be written.
+    """
+    path = Path(path)
+    try:
+        path.write_text(format_moordyn(model), encoding="utf-8")
+    except OSError as exc:
+        raise MooringFileError(f"cannot write the MoorDyn file {str(path)!r}: {exc.strerror}",
+                               file=str(path), line=None, field=None, value=None) from None
+    return path

@@ -1,0 +1,318 @@
+"""Run MoorDyn itself on a mooring file: the peer code of the comparisons and benchmarks.
+
+MoorDyn-C's Python package (``moordyn`` on PyPI, an optional dependency) reads the same MoorDyn
+v2 input file. :func:`run_moordyn` computes MoorDyn's initial state (its own initial-condition
+solve), then moves the coupled points by a :class:`~vinculo.mooring.motion.Motion` and records
+the force of each line on each of its end points and, if asked, the lines' node positions.
+:func:`largest_stable_step` finds MoorDyn's largest stable time step on a case by bisection.
+
+MoorDyn writes a main output file next to its input file, so each run works on a copy of the
+file in a temporary folder; its console messages are silenced.
+
+MoorDyn integrates explicitly (second-order Runge-Kutta by default) with the time step ``dtM``;
+each call of its ``Step`` advances the coupling interval in steps of at most ``dtM``, moving the
+coupled points with the position and velocity given at the start of the interval.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import shutil
+import sys
+import tempfile
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from vinculo.errors import InvalidInputError, VinculoError
+from vinculo.mooring.moordyn_file import MoorDynFile, read_moordyn, write_moordyn
+from vinculo.mooring.motion import Motion
+
+__all__ = ["PeerError", "PeerRun", "largest_stable_step", "moordyn_available", "run_moordyn"]
+
+
+class PeerError(VinculoError, RuntimeError):
+    """MoorDyn failed: it is not installed, it rejected the file, or its run blew up.
+
+    Attributes:
+        time: the time at which the run failed (s; None when it did not start).
+    """
+
+    time: float | None = None
+
+
+def moordyn_available() -> bool:
+    """Whether MoorDyn's Python package can be imported.
+
+    Returns:
+        True when ``import moordyn`` works.
+    """
+    try:
+        import moordyn  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def _moordyn():
+    try:
+        import moordyn
+    except ImportError:
+        raise PeerError("MoorDyn's Python package is not installed: pip install moordyn "
+                        "(vinculo's requirements-dev.txt pins it)") from None
+    return moordyn
+
+
+@contextlib.contextmanager
+def _silenced() -> Iterator[None]:
+    """Send what MoorDyn's C++ code prints (to the process's stdout and stderr) to nowhere."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = [os.dup(1), os.dup(2)]
+    null = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(null, 1)
+        os.dup2(null, 2)
+        yield
+    finally:
+        os.dup2(saved[0], 1)
+        os.dup2(saved[1], 2)
+        for fd in (*saved, null):
+            os.close(fd)
+
+
+@dataclass
+class PeerRun:
+    """What a MoorDyn run recorded.
+
+    Arguments:
+        times: the output times (s), from 0.
+        end_forces: ``(times, lines, 2, 3)``: the force of each line on its end A (index 0)
+            and end B (index 1), in N, the sum of the line's tension and of the loads on its
+            end node (MoorDyn lumps half a segment at each end node).
+        node_positions: for each line, ``(times, nodes, 3)`` positions (m); empty when not
+            stored.
+        time_step: MoorDyn's time step dtM (s).
+        coupling_step: the interval between calls of MoorDyn's Step (s).
+        cpu_time: the CPU time of the time stepping (s), without the initial condition.
+        initial_cpu_time: the CPU time of MoorDyn's initial-condition solve (s).
+        steps: the number of MoorDyn time steps taken.
+        error: why the run stopped early (None when it reached the end).
+    """
+
+    times: np.ndarray
+    end_forces: np.ndarray
+    node_positions: list[np.ndarray] = field(default_factory=list)
+    time_step: float = math.nan
+    coupling_step: float = math.nan
+    cpu_time: float = 0.0
+    initial_cpu_time: float = 0.0
+    steps: int = 0
+    error: str | None = None
+
+    @property
+    def end_tensions(self) -> np.ndarray:
+        """``(times, lines, 2)``: the magnitude of each end force (N)."""
+        return np.linalg.norm(self.end_forces, axis=-1)
+
+
+def _model_and_file(source: str | Path | MoorDynFile, folder: Path,
+                    time_step: float | None) -> tuple[MoorDynFile, Path]:
+    """The model, and a copy of its file in ``folder`` (with ``dtM`` replaced if asked)."""
+    import dataclasses
+
+    model = source if isinstance(source, MoorDynFile) else read_moordyn(source)
+    if time_step is not None:
+        model = dataclasses.replace(
+            model, options=dataclasses.replace(model.options, time_step=float(time_step)))
+    if isinstance(source, MoorDynFile) or time_step is not None:
+        path = write_moordyn(model, folder / "mooring.txt")
+    else:
+        path = Path(shutil.copy(source, folder / "mooring.txt"))
+    return model, path
+
+
+def _end_forces(md, lines: list, sizes: list[int]) -> np.ndarray:
+    out = np.empty((len(lines), 2, 3))
+    for k, (line, n) in enumerate(zip(lines, sizes, strict=True)):
+        out[k, 0] = md.GetLineNodeForce(line, 0)
+        out[k, 1] = md.GetLineNodeForce(line, n)
+    return out
+
+
+def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: float, *,
+                dt_output: float = 0.1, coupling_step: float | None = None,
+                time_step: float | None = None, store_shapes: bool = False) -> PeerRun:
+    """Run MoorDyn on a mooring file with the coupled points moved by ``motion``.
+
+    Arguments:
+        source: the MoorDyn input file, or a model to write to one.
+        motion: the coupled points' motion (None: they stay at the file's positions).
+        t_end: the end time (s).
+        dt_output: the interval between stored outputs (s).
+        coupling_step: the interval between calls of MoorDyn's Step (s; default
+            ``dt_output``): MoorDyn extrapolates the coupled points linearly over it.
+        time_step: MoorDyn's time step dtM (s; default: the file's).
+        store_shapes: also store every line's node positions at each output time.
+
+    Returns:
+        What the run recorded; a run that blew up (NaN) stops there with ``error`` set.
+
+    Raises:
+        PeerError: when MoorDyn is not installed or rejects the file.
+        MooringFileError: when the file itself is malformed (read by vinculo first).
+        InvalidInputError: for a motion with the wrong number of points or times out of range.
+    """
+    md = _moordyn()
+    if not (math.isfinite(t_end) and t_end > 0.0 and dt_output > 0.0):
+        raise InvalidInputError(f"run_moordyn: t_end = {t_end!r} and dt_output = {dt_output!r} "
+                                f"must be positive", name="t_end", value=t_end)
+    coupling = float(coupling_step or dt_output)
+    per_output = max(1, round(dt_output / coupling))
+    coupling = dt_output / per_output
+    with tempfile.TemporaryDirectory(prefix="vinculo-moordyn-") as folder:
+        model, path = _model_and_file(source, Path(folder), time_step)
+        coupled = model.coupled_points()
+        if motion is None:
+            motion = Motion.still([p.position for p in coupled])
+        if motion.num_points != len(coupled):
+            raise InvalidInputError(
+                f"the motion moves {motion.num_points} points but the file has "
+                f"{len(coupled)} coupled points", name="motion", value=motion.num_points)
+        start, end = motion.domain()
+        if start > 0.0 or end < t_end:
+            raise InvalidInputError(
+                f"{motion.source} covers t = {start:g} to {end:g} s; the run needs 0 to "
+                f"{t_end:g} s", name="t_end", value=t_end)
+        dtm = model.options.time_step if model.options.time_step is not None else 1e-3
+        with _silenced():
+            try:
+                system = md.Create(str(path))
+            except Exception as exc:  # MoorDyn raises a bare RuntimeError
+                raise PeerError(f"MoorDyn rejected {path.name}: {exc}") from None
+            try:
+                lines = [md.GetLine(system, k + 1) for k in range(len(model.lines))]
+                sizes = [md.GetLineN(line) for line in lines]
+                x = motion.positions(0.0).ravel().tolist()
+                v = motion.velocities(0.0).ravel().tolist()
+                started = time.process_time()
+                if md.Init(system, x, v) != 0:
+                    raise PeerError("MoorDyn's initial condition failed", time=0.0)
+                initial_cpu = time.process_time() - started
+                outputs = math.floor(t_end / dt_output + 1e-9) + 1
+                times = np.arange(outputs) * dt_output
+                forces = np.full((outputs, len(lines), 2, 3), np.nan)
+                shapes = [np.full((outputs, n + 1, 3), np.nan) for n in sizes] if store_shapes \
+                    else []
+
+                def record(i: int) -> None:
+                    forces[i] = _end_forces(md, lines, sizes)
+                    for k, (line, n) in enumerate(zip(lines, sizes, strict=True)):
+                        if store_shapes:
+                            shapes[k][i] = [md.GetLineNodePos(line, j) for j in range(n + 1)]
+
+                if coupled:
+                    md.Step(system, x, v, 0.0, 0.0)  # the forces at t = 0
+                record(0)
+                error = None
+                cpu = 0.0
+                t = 0.0
+                for i in range(1, outputs):
+                    for _ in range(per_output):
+                        x = motion.positions(t).ravel().tolist()
+                        v = motion.velocities(t).ravel().tolist()
+                        tick = time.process_time()
+                        try:
+                            md.Step(system, x, v, t, coupling)
+                        except RuntimeError as exc:
+                            cpu += time.process_time() - tick
+                            error = f"MoorDyn failed at t = {t:g} s: {exc}"
+                            break
+                        cpu += time.process_time() - tick
+                        t += coupling
+                    if error is not None:
+                        times, forces = times[:i], forces[:i]
+                        shapes = [s[:i] for s in shapes]
+                        break
+                    record(i)
+                    if not np.all(np.isfinite(forces[i])):
+                        error = f"MoorDyn's forces are not finite at t = {times[i]:g} s"
+                        times, forces = times[: i + 1], forces[: i + 1]
+                        shapes = [s[: i + 1] for s in shapes]
+                        break
+            finally:
+                md.Close(system)
+    steps = (times.size - 1) * per_output * math.ceil(coupling / dtm - 1e-9)
+    return PeerRun(times=times, end_forces=forces, node_positions=shapes, time_step=dtm,
+                   coupling_step=coupling, cpu_time=cpu, initial_cpu_time=initial_cpu,
+                   steps=steps, error=error)
+
+
+def largest_stable_step(source: str | Path | MoorDynFile, motion: Motion | None, t_end: float,
+                        reference: PeerRun | None = None, *, low: float, high: float,
+                        tolerance: float = 0.05, ratio: float = 1.1,
+                        dt_output: float = 0.1) -> tuple[float, int]:
+    """MoorDyn's largest stable time step on a case, by bisection on dtM.
+
+    With a ``reference`` (a run at a small step with the same ``dt_output``), a step is stable
+    when the run reaches ``t_end`` with end tensions within ``tolerance`` (relative to the
+    largest reference tension) of the reference's. Without one, when the run reaches ``t_end``
+    with finite forces whose tensions never exceed ten times their largest value at t = 0 (no
+    blow-up).
+
+    Arguments:
+        source: the MoorDyn input file or model.
+        motion: the coupled points' motion.
+        t_end: the end time (s).
+        reference: a run at a step known to be stable and accurate (None: the blow-up test).
+        low: a step thought to be stable (s); halved until it is.
+        high: a step thought to be above the stable range (s); doubled until it is.
+        tolerance: the largest relative difference in end tension accepted.
+        ratio: stop when ``high / low`` is below this.
+        dt_output: the output interval (s), the same as the reference's.
+
+    Returns:
+        ``(step, runs)``: the largest stable step found (s) and the number of MoorDyn runs.
+
+    Raises:
+        PeerError: when no step down to a millionth of ``low`` is stable.
+    """
+    scale = float(np.nanmax(reference.end_tensions)) if reference is not None else math.nan
+    runs = 0
+
+    def stable(dt: float) -> bool:
+        nonlocal runs
+        runs += 1
+        run = run_moordyn(source, motion, t_end, dt_output=dt_output, time_step=dt)
+        if run.error is not None or run.times.size < round(t_end / dt_output) + 1:
+            return False
+        tensions = run.end_tensions
+        if not np.all(np.isfinite(tensions)):
+            return False
+        if reference is None:
+            return bool(tensions.max() <= 10.0 * max(tensions[0].max(), 1e-300))
+        if run.times.size != reference.times.size:
+            return False
+        return bool(np.abs(tensions - reference.end_tensions).max() <= tolerance * scale)
+
+    floor = low * 1e-6
+    while not stable(low):
+        high, low = low, low / 2.0
+        if low < floor:
+            raise PeerError(f"MoorDyn found no stable step down to {floor:g} s")
+    for _ in range(20):
+        if not stable(high):
+            break
+        low, high = high, 2.0 * high
+    while high / low > ratio:
+        middle = math.sqrt(low * high)
+        if stable(middle):
+            low = middle
+        else:
+            high = middle
+    return low, runs

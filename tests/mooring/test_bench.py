@@ -1,0 +1,34 @@
+"""The mooring benchmark's cases are the example files that MoorDyn runs in the tests, and the
+axial-wave estimate of MoorDyn's step is the time a wave takes to cross a segment."""
+
+import dataclasses
+import math
+from pathlib import Path
+
+import pytest
+
+from vinculo.mooring import read_moordyn
+from vinculo.mooring.bench import CASES, wave_step
+
+DATA = Path(__file__).resolve().parent.parent / "data" / "moordyn"
+FILES = {"chain": "chain_on_seabed", "hanging": "hanging_line", "bending": "bending_line"}
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_the_benchmark_cases_are_the_example_files(name):
+    built = CASES[name](read_moordyn(DATA / f"{FILES[name]}.txt").lines[0].segments)
+    stored = read_moordyn(DATA / f"{FILES[name]}.txt")
+    assert built.line_types == stored.line_types
+    assert built.points == stored.points
+    assert built.lines == stored.lines
+    keep = ("depth", "density", "gravity", "kbot", "cbot", "friction", "time_step")
+    assert {k: getattr(built.options, k) for k in keep} == {
+        k: getattr(stored.options, k) for k in keep}
+    assert dataclasses.replace(built.options, settings=()) == dataclasses.replace(
+        stored.options, settings=())
+
+
+def test_wave_step_is_a_segment_over_the_axial_wave_speed():
+    # hanging_line: 100 m in 20 segments, EA = 1e8 N, 20 kg/m: 5 m / sqrt(5e6 m^2/s^2).
+    assert wave_step(CASES["hanging"](20)) == pytest.approx(5.0 / math.sqrt(1e8 / 20.0),
+                                                            rel=1e-15)

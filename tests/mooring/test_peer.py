@@ -1,0 +1,95 @@
+"""The MoorDyn peer runner (vinculo.mooring.peer): MoorDyn's own equilibrium of the example
+files against the closed-form elastic catenary (two independent computations of the same line),
+and a slow fairlead motion that MoorDyn follows quasi-statically."""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from vinculo.errors import InvalidInputError
+from vinculo.mooring import Motion, read_moordyn, solve_catenary, weight_in_water
+
+moordyn = pytest.importorskip("moordyn")
+from vinculo.mooring.peer import largest_stable_step, run_moordyn  # noqa: E402
+
+DATA = Path(__file__).resolve().parent.parent / "data" / "moordyn"
+
+
+def _catenary(model, fairlead=None):
+    """The closed-form catenary of a one-line file from its point 1 to its point 2."""
+    line = model.lines[0]
+    kind = model.line_types[line.line_type]
+    a = np.array(model.points[0].position)
+    b = np.array(model.points[1].position if fairlead is None else fairlead)
+    o = model.options
+    w = weight_in_water(kind.mass_per_length, kind.diameter, o.density, o.gravity)
+    on_seabed = math.isclose(a[2], -o.depth)
+    return solve_catenary(math.hypot(*(b - a)[:2]), b[2] - a[2], line.unstretched_length, w,
+                          kind.ea, seabed_contact=on_seabed)
+
+
+@pytest.mark.parametrize(("name", "tmax"), [("taut_line", "10.0"), ("hanging_line", None)])
+def test_moordyns_equilibrium_is_the_elastic_catenary(tmp_path, name, tmax):
+    # MoorDyn's initial-condition solve of a 20-segment line against the closed form: within
+    # the lumped-mass discretisation error (3e-4 for the hanging chain, 2e-6 for the taut rope,
+    # measured; 1e-3 asserted). The taut rope settles within 10 s of MoorDyn's solve (TmaxIC).
+    text = (DATA / f"{name}.txt").read_text()
+    if tmax is not None:
+        text = text.replace("100.0         TmaxIC", f"{tmax}  TmaxIC")
+    path = tmp_path / f"{name}.txt"
+    path.write_text(text)
+    model = read_moordyn(path)
+    run = run_moordyn(path, None, 0.1)
+    cat = _catenary(model)
+    force_a, force_b = run.end_forces[0, 0]
+    # The force of the line on the fairlead pulls it towards the anchor and down.
+    assert force_b[0] == pytest.approx(-cat.horizontal_tension, rel=1e-3)
+    assert force_b[2] == pytest.approx(-cat.fairlead_vertical_tension, rel=1e-3)
+    assert np.linalg.norm(force_b) == pytest.approx(cat.fairlead_tension, rel=1e-3)
+    assert np.linalg.norm(force_a) == pytest.approx(cat.anchor_tension, rel=1e-3)
+
+
+def test_a_slow_fairlead_motion_is_followed_quasi_statically(tmp_path):
+    # The taut rope's fairlead moved 1 m towards the anchor and back over 200 s: slow enough
+    # that drag and inertia are negligible, so the fairlead force follows the catenary at the
+    # displaced position (closed form, within the 1e-3 of the lumped masses).
+    path = tmp_path / "taut_line.txt"
+    path.write_text((DATA / "taut_line.txt").read_text().replace("100.0         TmaxIC",
+                                                                 "10.0  TmaxIC"))
+    model = read_moordyn(path)
+    start = np.array([model.points[1].position])
+    motion = Motion.harmonic(start, (-1.0, 0.0, 0.0), period=200.0)
+    run = run_moordyn(path, motion, 50.0, dt_output=5.0, coupling_step=0.05, time_step=4e-4)
+    assert run.error is None and run.times[-1] == pytest.approx(50.0)
+    for i in (5, 10):  # t = 25 s and 50 s
+        fairlead = motion.positions(run.times[i])[0]
+        cat = _catenary(model, fairlead)
+        assert run.end_tensions[i, 0, 1] == pytest.approx(cat.fairlead_tension, rel=1e-3)
+    # The moving fairlead changes the tension by far more than that tolerance.
+    assert abs(run.end_tensions[10, 0, 1] / run.end_tensions[0, 0, 1] - 1.0) > 0.1
+
+
+def test_a_motion_with_the_wrong_number_of_points_is_rejected():
+    motion = Motion.still([[0.0, 0.0, -5.0], [1.0, 0.0, -5.0]])
+    with pytest.raises(InvalidInputError, match="2 points but the file has 1 coupled"):
+        run_moordyn(DATA / "taut_line.txt", motion, 1.0)
+
+
+@pytest.mark.slow
+def test_largest_stable_step_of_the_hanging_chain():
+    # MoorDyn's explicit RK2 step is bounded by the axial wave crossing a segment,
+    # dt ~ l / sqrt(EA / m) (5 m / sqrt(1e8 / 20) = 2.2 ms, times a factor of order one); the
+    # bisection finds a step of that order, and a step 1.5 x above it fails.
+    path = DATA / "hanging_line.txt"
+    model = read_moordyn(path)
+    motion = Motion.harmonic([model.points[1].position], (1.0, 0.0, 0.0), period=10.0,
+                             ramp_time=5.0)
+    reference = run_moordyn(path, motion, 10.0, time_step=1e-4)
+    step, runs = largest_stable_step(path, motion, 10.0, reference, low=1e-4, high=1e-3)
+    assert 1e-3 < step < 1e-2
+    assert runs >= 3
+    bad = run_moordyn(path, motion, 10.0, time_step=1.5 * step)
+    assert bad.error is not None or np.max(np.abs(bad.end_tensions - reference.end_tensions)) \
+        > 0.05 * np.max(reference.end_tensions)
