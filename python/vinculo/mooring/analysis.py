@@ -71,7 +71,7 @@ def _line_ends(built: Any, source: Any, positions: np.ndarray) -> list[LineEnd]:
                                             ("B", row.attach_b, b, force_b)):
             rows.append(LineEnd(line=row.id, end=end, point=point,
                                 position=tuple(float(c) for c in positions[particle]),
-                                force=tuple(float(c) for c in _last(force)),
+                                force=tuple(float(c) + 0.0 for c in _last(force)),
                                 laid_length=laid))
     return rows
 
