@@ -59,6 +59,9 @@ pub fn takes_in_no_energy(system: &System) -> bool {
         Constraint::FixedCoordinate(f) => f.value.is_constant(),
         Constraint::Plane(p) => still(&p.normal) && still(&p.point),
         Constraint::PointDistance(p) => still(&p.point),
+        // An elastic segment's strain energy lives in its multiplier (the tension), which
+        // `System::potential_energy` does not count, and a winch law puts work in: not watched.
+        Constraint::ElasticDistance(_) => false,
         Constraint::User(_) => false,
     });
     forces && constraints
