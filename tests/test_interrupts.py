@@ -140,6 +140,8 @@ def test_an_exception_of_the_progress_callback_carries_the_partial_solution():
 def test_ctrl_c_during_step_to_keeps_the_states_and_the_simulation(sigint_raises):
     system = pendulum()
     simulation = vinculo.Simulation(system, t_end=1e3, dt=1e-3)
+    simulation.step_to(0.1)
+    snapshot = simulation.snapshot()
     with pytest.raises(KeyboardInterrupt) as info, interrupt_after(0.3):
         simulation.step_to(1e3)
     assert isinstance(info.value, vinculo.Interrupted)
@@ -147,6 +149,11 @@ def test_ctrl_c_during_step_to_keeps_the_states_and_the_simulation(sigint_raises
     assert partial.times[-1] == simulation.time
     np.testing.assert_array_equal(simulation.solution().times, partial.times)
     assert_is_the_run_up_to_its_end(partial, system, 1e-3)
+    # A snapshot restored goes on as the uninterrupted run.
+    simulation.restore(snapshot)
+    simulation.step_to(0.2)
+    reference = vinculo.simulate(system, 0.2, 1e-3)
+    np.testing.assert_array_equal(simulation.solution().positions, reference.positions)
 
 
 # ---- re-entrant use ---------------------------------------------------------------------------
