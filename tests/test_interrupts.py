@@ -92,19 +92,44 @@ def test_ctrl_c_in_the_steps_raises_keyboard_interrupt_with_the_partial_solution
     assert_is_the_run_up_to_its_end(partial, system, 1e-3, save_every=7)
 
 
-def test_ctrl_c_inside_a_user_force_stays_a_keyboard_interrupt(sigint_raises):
-    # A linear damper -c v written in Python, slowed down so that the signal lands in it.
-    def damper(t, q, v):
-        time.sleep(2e-4)
-        return -0.3 * v
+def slow_damper(t, q, v):
+    """A linear damper -c v written in Python, slowed down so that the signal lands in it."""
+    time.sleep(2e-4)
+    return -0.3 * v
 
+
+def slow_rod(t, q):
+    """The rod |q| = L as a Python constraint, Phi = L^2 - |q|^2, slowed down likewise."""
+    time.sleep(2e-4)
+    return LENGTH**2 - np.sum(q * q, axis=1)
+
+
+def pendulum_with_a_damper() -> vinculo.System:
     system = pendulum()
-    system.add_force_group([0], damper, name="damper")
+    system.add_force_group([0], slow_damper, name="damper")
+    return system
+
+
+def pendulum_on_a_python_rod() -> vinculo.System:
+    system = vinculo.System(gravity=(0.0, 0.0, -GRAVITY))
+    system.add_particle(1.0, (LENGTH, 0.0, 0.0))
+    system.add_constraint_group([0], slow_rod, name="rod")
+    return system
+
+
+@pytest.mark.parametrize(
+    ("build", "group", "call"),
+    [(pendulum_with_a_damper, "damper", "force"), (pendulum_on_a_python_rod, "rod", "phi")],
+)
+def test_ctrl_c_inside_a_user_function_stays_a_keyboard_interrupt(
+    sigint_raises, build, group, call
+):
+    system = build()
     with pytest.raises(KeyboardInterrupt) as info, interrupt_after(0.3):
         vinculo.simulate(system, t_end=100.0, dt=1e-3)
     error = info.value
     assert isinstance(error, vinculo.Interrupted)
-    assert (error.group, error.call) == ("damper", "force")
+    assert (error.group, error.call) == (group, call)
     # The user's KeyboardInterrupt, with its traceback in the function, is the cause.
     assert type(error.__cause__) is KeyboardInterrupt
     assert_is_the_run_up_to_its_end(error.solution, system, 1e-3)
@@ -140,6 +165,8 @@ def test_an_exception_of_the_progress_callback_carries_the_partial_solution():
 def test_ctrl_c_during_step_to_keeps_the_states_and_the_simulation(sigint_raises):
     system = pendulum()
     simulation = vinculo.Simulation(system, t_end=1e3, dt=1e-3)
+    simulation.step_to(0.1)
+    snapshot = simulation.snapshot()
     with pytest.raises(KeyboardInterrupt) as info, interrupt_after(0.3):
         simulation.step_to(1e3)
     assert isinstance(info.value, vinculo.Interrupted)
@@ -147,6 +174,11 @@ def test_ctrl_c_during_step_to_keeps_the_states_and_the_simulation(sigint_raises
     assert partial.times[-1] == simulation.time
     np.testing.assert_array_equal(simulation.solution().times, partial.times)
     assert_is_the_run_up_to_its_end(partial, system, 1e-3)
+    # A snapshot restored goes on as the uninterrupted run.
+    simulation.restore(snapshot)
+    simulation.step_to(0.2)
+    reference = vinculo.simulate(system, 0.2, 1e-3)
+    np.testing.assert_array_equal(simulation.solution().positions, reference.positions)
 
 
 # ---- re-entrant use ---------------------------------------------------------------------------

@@ -103,11 +103,12 @@ class Interrupted(_Detailed, KeyboardInterrupt):
 
     Arguments:
         message: where the run stopped.
-        **details: ``time`` (the last completed step's end, s), ``solution``; for an interrupt
-            inside a user function also ``group`` and ``call`` (as :class:`UserFunctionError`).
+        **details: ``time``, ``solution``; for an interrupt inside a user function also
+            ``group`` and ``call`` (as :class:`UserFunctionError`).
 
     Attributes:
-        time: the time the run reached (s).
+        time: the time the run reached, the end of its last step (s); for an interrupt inside a
+            user function, the time of that function's call.
         solution: the partial :class:`vinculo.Solution` (None when the run was interrupted before
             its first state was computed).
     """

@@ -290,12 +290,31 @@ fn output_message(
         None => "the run would store".to_string(),
         Some(t) => format!("the run stopped at t = {t:.6} s: it has stored"),
     };
+    // Every step's size is stored, whatever save_every: when they alone exceed the limit, only
+    // a shorter run or longer steps help.
+    let remedy = if 8.0 * steps > limit {
+        "the step sizes alone exceed it (one is stored per step, whatever save_every or t_eval): \
+         shorten the run, take longer steps, or set max_output_bytes"
+            .to_string()
+    } else {
+        format!(
+            "raise save_every (now {save_every}), give fewer t_eval times, shorten the run, or \
+             set max_output_bytes"
+        )
+    };
+    let gb = |x: f64| {
+        let x = x / 1e9;
+        if x < 1e4 {
+            format!("{x:.3} GB")
+        } else {
+            format!("{x:.3e} GB")
+        }
+    };
     format!(
         "{what} about {states:.3e} states of {state_bytes} bytes and {steps:.3e} step sizes of 8 \
-         bytes, {:.3} GB, more than the {:.3} GB allowed ({source}): raise save_every (now \
-         {save_every}), give fewer t_eval times, shorten the run, or set max_output_bytes",
-        bytes / 1e9,
-        limit / 1e9
+         bytes, {}, more than the {} allowed ({source}): {remedy}",
+        gb(bytes),
+        gb(limit)
     )
 }
 
