@@ -133,18 +133,20 @@ def _pinned_chain(links: int, pinned: bool, closed: bool = False) -> tuple[vincu
     particle: the same mechanics. ``closed``: a zero-stiffness spring closes a loop (sparse LU).
     """
     system = vinculo.System(gravity=(0.0, 0.0, -G))
+    # The tip first and the top last: the top is not the first particle (the tree elimination
+    # used to root every tree at its first particle, which hid the defect).
+    chain = [
+        system.add_particle(
+            mass=0.1, position=(0.0, 0.0, -i / links), velocity=(0.5 * i / links, 0.0, 0.0)
+        )
+        for i in range(links, 0, -1)
+    ][::-1]
     top = system.add_particle(mass=1.0, position=(0.0, 0.0, 0.0), fixed=not pinned)
     if pinned:
         for axis in "xyz":
             system.add_fixed_coordinate(top, axis)
-    previous, chain = top, []
-    for i in range(1, links + 1):
-        joint = system.add_particle(
-            mass=0.1, position=(0.0, 0.0, -i / links), velocity=(0.5 * i / links, 0.0, 0.0)
-        )
-        system.add_distance(previous, joint)
-        previous = joint
-        chain.append(joint)
+    for above, below in zip([top, *chain[:-1]], chain, strict=True):
+        system.add_distance(above, below)
     if closed:
         system.add_spring_damper(chain[0], chain[-1], stiffness=0.0)
     return system, chain
