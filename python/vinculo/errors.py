@@ -204,8 +204,8 @@ class InstabilityError(ConvergenceError):
     formulation when the mechanical energy of a constrained model under gravity and drag alone
     (no springs or bending, constraints that do not move) exceeds its initial value plus all the
     energy the model can exchange: the scheme is unstable at that ``rho_inf`` and step (measured
-    table in the theory page "Time rules"). Use ``formulation='ggl'``, ``rho_inf <= 0.5``, or a smaller
-    step. ``solution`` holds every step before.
+    table in the theory page "Time rules"). Use ``formulation='ggl'``, ``rho_inf <= 0.5``, or a
+    smaller step. ``solution`` holds every step before.
 
     Attributes:
         time: the time at the end of the step where the energy passed the bound (s).
