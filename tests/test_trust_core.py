@@ -133,18 +133,20 @@ def _pinned_chain(links: int, pinned: bool, closed: bool = False) -> tuple[vincu
     particle: the same mechanics. ``closed``: a zero-stiffness spring closes a loop (sparse LU).
     """
     system = vinculo.System(gravity=(0.0, 0.0, -G))
+    # The tip first and the top last: the top is not the first particle (the tree elimination
+    # used to root every tree at its first particle, which hid the defect).
+    chain = [
+        system.add_particle(
+            mass=0.1, position=(0.0, 0.0, -i / links), velocity=(0.5 * i / links, 0.0, 0.0)
+        )
+        for i in range(links, 0, -1)
+    ][::-1]
     top = system.add_particle(mass=1.0, position=(0.0, 0.0, 0.0), fixed=not pinned)
     if pinned:
         for axis in "xyz":
             system.add_fixed_coordinate(top, axis)
-    previous, chain = top, []
-    for i in range(1, links + 1):
-        joint = system.add_particle(
-            mass=0.1, position=(0.0, 0.0, -i / links), velocity=(0.5 * i / links, 0.0, 0.0)
-        )
-        system.add_distance(previous, joint)
-        previous = joint
-        chain.append(joint)
+    for above, below in zip([top, *chain[:-1]], chain, strict=True):
+        system.add_distance(above, below)
     if closed:
         system.add_spring_damper(chain[0], chain[-1], stiffness=0.0)
     return system, chain
@@ -338,3 +340,15 @@ def test_an_adaptive_step_below_the_resolution_of_t_stops_with_a_typed_error():
     assert error.h_min == pytest.approx(50 * np.spacing(error.time), rel=1e-12)
     assert error.step_size < error.h_min
     assert np.all(np.diff(error.solution.times) > 0)
+
+
+@pytest.mark.parametrize("extra", [1e-10, 4e-10, 2e-9, 5e-9])
+def test_an_end_a_few_float_spacings_past_the_grid_is_reached_by_a_stretched_step(extra):
+    # t_end a few spacings of t (1.16e-10 s at 1e6 s) past the last grid point: the last step
+    # is stretched over the remainder instead of a step the times cannot resolve. Reference:
+    # the run ends exactly at t_end after 100 steps, every step within 1e-3 of dt.
+    t_end = 1e6 + 1e-3 + extra
+    solution = vinculo.simulate(_pendulum(), t_start=1e6, t_end=t_end, dt=1e-5)
+    assert solution.success
+    assert solution.times[-1] == t_end and len(solution.times) == 101
+    np.testing.assert_allclose(np.diff(solution.times), 1e-5, rtol=1e-3)

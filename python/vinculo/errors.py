@@ -268,11 +268,11 @@ class InstabilityError(ConvergenceError):
     """Index-3 generalised-alpha went unstable: the energy grew beyond what the model holds.
 
     Raised by :func:`vinculo.simulate` with ``scheme='generalized-alpha'`` and the index-3
-    formulation when the mechanical energy of a model that takes in no energy (gravity, springs,
-    bending, drag, constraints that do not move) exceeds its initial value plus all the energy
-    the model can exchange: the scheme is unstable at that ``rho_inf`` and step (measured table in
-    the theory page "Time rules"). Use ``formulation='ggl'``, ``rho_inf <= 0.5``, or a smaller
-    step. ``solution`` holds every step before.
+    formulation when the mechanical energy of a constrained model under gravity and drag alone
+    (no springs or bending, constraints that do not move) exceeds its initial value plus all the
+    energy the model can exchange: the scheme is unstable at that ``rho_inf`` and step (measured
+    table in the theory page "Time rules"). Use ``formulation='ggl'``, ``rho_inf <= 0.5``, or a
+    smaller step. ``solution`` holds every step before.
 
     Attributes:
         time: the time at the end of the step where the energy passed the bound (s).

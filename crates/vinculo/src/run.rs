@@ -128,12 +128,15 @@ impl FixedSteps {
     }
 
     /// The next step from `t` towards `stop` (`t_end`: the run's end, where the last step is
-    /// stretched or shortened, by at most a millionth of a step or to what remains, to land on
+    /// stretched or shortened, by at most a millionth of a step (or the smallest step the times
+    /// resolve, [`STEP_IN_TIME_SPACINGS`] spacings of `stop`) or to what remains, to land on
     /// it).
     fn propose(&self, t: f64, stop: f64, t_end: f64) -> (f64, StepEnd) {
         let h_nominal = self.unit * (1u64 << self.level) as f64;
         let remaining = stop - t;
-        if remaining > h_nominal * (1.0 + 1e-6) {
+        // The step before a remainder the times cannot resolve is stretched over it too.
+        let stretch = (1e-6 * h_nominal).max(STEP_IN_TIME_SPACINGS * time_spacing(stop));
+        if remaining > h_nominal + stretch {
             return (h_nominal, StepEnd::Natural);
         }
         if stop < t_end {

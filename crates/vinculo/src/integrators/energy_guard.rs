@@ -8,22 +8,27 @@
 //! `tools/generalized_alpha_stability.py` the script). The blow-up is a property of the scheme,
 //! not of its implementation; the guard makes it visible.
 //!
-//! The guard watches models that take in no energy: gravity, springs and bending (whose
-//! potentials [`System::potential_energy`] counts), linear and quadratic drag on still air
-//! (which only remove energy), and constraints that do not move (distances; fixed coordinates,
-//! planes and point distances with constant laws). Their exact mechanical energy never rises
-//! above its initial value E0, and a correct run's only rises by its discretisation error, a
-//! fraction of the energy the model exchanges between its forms. That exchange is bounded by
+//! The guard watches the models where that instability lives and nothing else can raise the
+//! energy: constrained models (at least one constraint; the instability is one of the
+//! constraint forces) under gravity and linear or quadratic drag on still air (which only
+//! remove energy), whose constraints do not move (distances; fixed coordinates, planes and
+//! point distances with constant laws). Their exact mechanical energy never rises above its
+//! initial value E0, and a correct run's only rises by its discretisation error, a fraction of
+//! the energy the model exchanges between its forms, bounded by
 //!
 //! ```text
-//! S = T0 + |V_elastic,0| + m_total |g| D
+//! S = T0 + m_free |g| D
 //! ```
 //!
-//! (the initial kinetic energy, the initial elastic energy, and the weight of the free
-//! particles lifted across the model's extent D, [`System::length_scale`]); the guard fires when E > E0 + S, an energy
-//! error as large as everything the model holds, which no correct run approaches. Models with
-//! an energy source (applied, fluid or user forces, moving or user constraints) are not
-//! watched: there the bound would need their work, which is not known.
+//! (the initial kinetic energy, and the weight of the free particles lifted across the model's
+//! extent D, [`System::length_scale`]); the guard fires when E > E0 + S, an energy error as
+//! large as everything the model holds, which no correct run approaches.
+//!
+//! Not watched: models with an energy source (applied, fluid or user forces, moving or user
+//! constraints), where the bound would need their work; and models with springs or bending,
+//! where a stiff mode the step does not resolve raises the energy of a stable run for a few
+//! steps before the scheme's damping removes it (the amplification matrix is not normal: on a
+//! mass and spring at omega h = 50 with rho_inf = 0, 900 times the initial energy, measured).
 
 use crate::constraints::Constraint;
 use crate::error::Error;
@@ -42,18 +47,14 @@ pub struct EnergyGuard {
     rho_inf: f64,
 }
 
-/// True when no element of `system` can put energy into it (module documentation).
-pub fn takes_in_no_energy(system: &System) -> bool {
+/// True when `system` is one the guard watches: constrained, and no element can put energy
+/// into it or store it elastically (module documentation).
+pub fn watched(system: &System) -> bool {
     let still = |law: &crate::laws::VectorLaw| law.0.iter().all(|l| l.is_constant());
-    let forces = system.forces().iter().all(|f| {
-        matches!(
-            f,
-            Force::SpringDamper(_)
-                | Force::Bending(_)
-                | Force::LinearDrag(_)
-                | Force::QuadraticDrag(_)
-        )
-    });
+    let forces = system
+        .forces()
+        .iter()
+        .all(|f| matches!(f, Force::LinearDrag(_) | Force::QuadraticDrag(_)));
     let constraints = system.constraints().iter().all(|c| match c {
         Constraint::Distance(_) => true,
         Constraint::FixedCoordinate(f) => f.value.is_constant(),
@@ -64,18 +65,17 @@ pub fn takes_in_no_energy(system: &System) -> bool {
         Constraint::ElasticDistance(_) => false,
         Constraint::User(_) => false,
     });
-    forces && constraints
+    !system.constraints().is_empty() && forces && constraints
 }
 
 impl EnergyGuard {
     /// The guard of a run of index-3 generalised-alpha at `rho_inf` from (q0, v0), or `None`
-    /// when the model may take in energy.
+    /// when the model is not one it watches.
     pub fn new(system: &System, rho_inf: f64, q0: &[Vec3], v0: &[Vec3]) -> Option<EnergyGuard> {
-        if !takes_in_no_energy(system) {
+        if !watched(system) {
             return None;
         }
         let kinetic = system.kinetic_energy(v0);
-        let elastic: f64 = system.forces().iter().map(|f| f.potential(q0)).sum();
         let mass: f64 = system
             .particles()
             .iter()
@@ -83,7 +83,7 @@ impl EnergyGuard {
             .map(|p| p.mass)
             .sum();
         let lift = mass * norm(system.gravity()) * system.length_scale();
-        let slack = kinetic + elastic.abs() + lift;
+        let slack = kinetic + lift;
         let initial = kinetic + system.potential_energy(q0);
         (slack > 0.0 && initial.is_finite()).then_some(EnergyGuard {
             initial,

@@ -925,17 +925,23 @@ mod tests {
     fn awkward_chain(n: usize, pinned: bool) -> System {
         let mut s = System::new([0.0, 0.0, -9.81]);
         if pinned {
-            let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], false).unwrap();
-            for axis in 0..3 {
-                s.add_fixed_coordinate(prev, axis, None).unwrap();
-            }
-            for i in 1..=n {
+            // The tip first, the pinned top last (not the first particle, which the analysis
+            // used to take as the root).
+            let mut below = None;
+            for i in (1..=n).rev() {
                 let z = -(i as f64) / n as f64;
                 let v = [0.5 * i as f64 / n as f64, 0.0, 0.0];
                 let p = s.add_particle(0.1, [0.0, 0.0, z], v, false).unwrap();
-                s.add_distance(prev, p, None).unwrap();
-                prev = p;
+                if let Some(b) = below {
+                    s.add_distance(p, b, None).unwrap();
+                }
+                below = Some(p);
             }
+            let top = s.add_particle(1.0, [0.0; 3], [0.0; 3], false).unwrap();
+            for axis in 0..3 {
+                s.add_fixed_coordinate(top, axis, None).unwrap();
+            }
+            s.add_distance(top, below.unwrap(), None).unwrap();
             return s;
         }
         let left = s
