@@ -107,7 +107,7 @@ def point_stiffness(system: Any, statics: Statics, particle: int) -> np.ndarray:
         ``(3, 3)`` stiffness, ``K[i, j] = -dF_i/dx_j``.
 
     Raises:
-        SingularMatrixError: when the equilibrium's Jacobian is singular at the point (an
+        ConvergenceError: when the equilibrium's Jacobian is singular at the point (an
             inextensible taut line is infinitely stiff along itself).
     """
     return np.asarray(_core.point_stiffness(system, statics.positions, statics.multipliers,
