@@ -696,7 +696,7 @@ class RunResult:
         ``vinculo.Solution`` as its ``solution`` attribute and, for a failed user function, the
         user's exception as its ``__cause__``."""
 
-def solve_statics(system: System, tolerance: float = 1e-9, max_iterations: int = 200,
+def solve_statics(system: System, tolerance: float = 1e-9, max_iterations: int = 1000,
                   t: float = 0.0, newton_first: bool = True
                   ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], float, int, str]:
     """The static equilibrium (see ``vinculo.mooring.statics.solve_statics``).

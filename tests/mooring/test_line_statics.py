@@ -125,3 +125,26 @@ def test_fairlead_stiffness_matches_finite_differences_of_the_statics():
     # Central differences over re-solved equilibria: O(h^2) truncation.
     np.testing.assert_allclose(k, fd, atol=1e-5 * np.abs(k).max())
     np.testing.assert_allclose(k, k.T, atol=1e-9 * np.abs(k).max())
+
+
+def test_chain_on_the_seabed_from_a_compressed_straight_start():
+    # The chain of tests/data/moordyn/chain_on_seabed.txt (315 m over a 302.6 m chord, part of it
+    # on the seabed) started on the straight chord, 4 % compressed: Newton's method fails there
+    # and the continuation buckles it down onto the seabed, to the equilibrium that Newton's
+    # method reaches from the catenary start, to round-off.
+    from vinculo.mooring.model import build_model
+
+    built = build_model("tests/data/moordyn/chain_on_seabed.txt", solve=False)
+    system, line = built.system, built.lines[0]
+    reference = solve_statics(system.copy(), apply=False)
+    assert reference.method == "newton"
+    q = np.array(system.initial_positions())
+    a, b = q[line.nodes[0]], q[line.nodes[-1]]
+    u = np.linspace(0.0, 1.0, len(line.nodes))[1:-1, None]
+    q[line.nodes[1:-1]] = a + u * (b - a)
+    straight = system.copy()
+    straight.set_initial_state(q)
+    eq = solve_statics(straight, apply=False)
+    assert eq.method == "continuation"
+    np.testing.assert_allclose(eq.positions, reference.positions, atol=1e-9)
+    np.testing.assert_allclose(eq.multipliers, reference.multipliers, rtol=1e-7)

@@ -20,7 +20,7 @@ type StaticsTuple<'py> = (
 
 /// Solves the static equilibrium of `system` at time `t` from its initial positions.
 #[pyfunction]
-#[pyo3(signature = (system, tolerance=1e-9, max_iterations=200, t=0.0, newton_first=true))]
+#[pyo3(signature = (system, tolerance=1e-9, max_iterations=1000, t=0.0, newton_first=true))]
 pub fn solve_statics<'py>(
     py: Python<'py>,
     system: Bound<'py, PySystem>,

@@ -71,7 +71,7 @@ impl Default for StaticsOptions {
     fn default() -> Self {
         StaticsOptions {
             tolerance: 1e-9,
-            max_iterations: 200,
+            max_iterations: 1000,
             t: 0.0,
             newton_first: true,
         }
@@ -198,9 +198,19 @@ fn static_residual(system: &System, ws: &mut StepWorkspace, t: f64, previous: &[
 /// fails.
 ///
 /// # Errors
-/// [`Error::NewtonFailed`] (with a zero step) when neither converges within
+/// [`Error::InvalidParameter`] for a tolerance that is not > 0, a time that is not finite or
+/// no iteration; [`Error::NewtonFailed`] (with a zero step) when neither converges within
 /// `options.max_iterations` iterations.
 pub fn solve_statics(system: &System, options: &StaticsOptions) -> Result<Statics> {
+    crate::error::positive("statics tolerance", options.tolerance)?;
+    crate::error::finite("statics time t", options.t)?;
+    if options.max_iterations == 0 {
+        return Err(Error::InvalidParameter {
+            name: "statics max_iterations".into(),
+            value: 0.0,
+            expected: "must be >= 1".into(),
+        });
+    }
     let t = options.t;
     let mut ws = StepWorkspace::new(system, 48);
     let q0 = system.initial_positions();
@@ -253,8 +263,11 @@ pub fn solve_statics(system: &System, options: &StaticsOptions) -> Result<Static
         .fold(0.0, f64::max);
     let mut mu = 100.0 * g / l + stiffest;
     let largest_mu = 1e4 * mu;
+    // A pseudo-step need not be solved tightly (only the last, plain Newton solve is), and
+    // its mu M (q - q_prev) rows put a round-off floor of about sigma mu M eps |q| on it.
     let step_options = NewtonOptions {
         max_iterations: 12,
+        tolerance: 1e3 * newton.tolerance,
         ..newton
     };
     let mut previous = ws.state.q.clone();
@@ -268,11 +281,13 @@ pub fn solve_statics(system: &System, options: &StaticsOptions) -> Result<Static
                 previous.clone_from(&ws.state.q);
                 lambda_previous.clone_from(&ws.state.lambda);
                 let residual = static_residual(system, &mut ws, t, &previous);
-                // Switched evolution relaxation (at most a tenfold decrease per step), kept
+                // Switched evolution relaxation (at most a tenfold decrease per step, at least
+                // a halving after a converged pseudo-step: the slow modes of a line, a
+                // pendulum's g / l, would take mu / omega^2 pseudo-steps otherwise), kept
                 // above the negative stiffness of compressed segments, |T| / (L m_ref), so that
                 // the pseudo-step's matrix stays definite while a line buckles.
-                let ratio = (residual / residual_previous).clamp(0.1, 2.0);
-                mu *= if ratio.is_finite() { ratio } else { 2.0 };
+                let ratio = (residual / residual_previous).clamp(0.1, 0.5);
+                mu *= if ratio.is_finite() { ratio } else { 0.5 };
                 mu = mu.max(2.0 * compression(system, &ws.state.lambda, t) / ws.mass_ref);
                 residual_previous = residual;
                 let close = residual < 1e3 * newton.tolerance || mu < 1e-6 * g / l;

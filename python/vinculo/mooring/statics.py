@@ -63,7 +63,7 @@ class Statics:
         system.set_initial_state(self.positions, np.zeros_like(self.positions))
 
 
-def solve_statics(system: Any, *, tolerance: float = 1e-9, max_iterations: int = 200,
+def solve_statics(system: Any, *, tolerance: float = 1e-9, max_iterations: int = 1000,
                   t: float = 0.0, newton_first: bool = True, apply: bool = True) -> Statics:
     """The static equilibrium of ``system``, from its initial positions.
 
