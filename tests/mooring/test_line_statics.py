@@ -148,3 +148,22 @@ def test_chain_on_the_seabed_from_a_compressed_straight_start():
     assert eq.method == "continuation"
     np.testing.assert_allclose(eq.positions, reference.positions, atol=1e-9)
     np.testing.assert_allclose(eq.multipliers, reference.multipliers, rtol=1e-7)
+
+
+def test_winch_pays_out_a_line_to_the_statics_of_its_new_length():
+    # A clump hanging by a 50 m rope that a winch pays out at 0.2 m/s (L(t) = 50 + 0.2 t, each
+    # of the 10 segments keeping its tenth): slowly against the axial period (0.3 s), so the
+    # clump follows the equilibrium of the current length; after 10 s it is where the statics
+    # at t = 10 s put it (backward Euler damps the start's oscillation), to 1 mm.
+    kind = LineType("rope", diameter=0.05, mass_per_length=5.0, ea=2.0e7)
+    s = vinculo.System(gravity=(0.0, 0.0, -G))
+    top = s.add_particle(1.0, (0.0, 0.0, -5.0), fixed=True)
+    clump = s.add_particle(500.0, (0.0, 0.0, -55.0))
+    add_line(s, top.index, clump.index, kind, vinculo.laws.polynomial([50.0, 0.2]), 10, WATER)
+    later = solve_statics(s.copy(), t=10.0, apply=False)
+    solve_statics(s)
+    sol = vinculo.simulate(s, 10.0, 0.01, alpha=1.0)
+    z = sol.particle(clump)[-1, 2]
+    assert z == pytest.approx(later.positions[clump.index, 2], abs=1e-3)
+    # 2 m paid out: the clump 2 m (and the stretch of the added line) lower.
+    assert z < -57.0
