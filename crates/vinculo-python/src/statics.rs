@@ -104,7 +104,7 @@ pub fn point_stiffness<'py>(
     check_sizes(&this.inner, &st)?;
     let k = statics::point_stiffness(&this.inner, &st, particle).map_err(to_py)?;
     let flat: Vec<f64> = k.iter().flatten().copied().collect();
-    Ok(PyArray1::from_vec(py, flat).reshape([3, 3])?)
+    PyArray1::from_vec(py, flat).reshape([3, 3])
 }
 
 /// The force (N) that the system's elements exert on `particle` in an equilibrium.
