@@ -206,7 +206,7 @@ fn ggl_formulation_refuses_compliant_segments_with_a_typed_error() {
     match simulate(&hanging(1.0, Law::Constant(1.0), 1e4), &options) {
         Err(vinculo::Error::InvalidParameter { name, expected, .. }) => {
             assert!(name.contains("elastic segment #0"), "{name}");
-            assert!(expected.contains("index3"), "{expected}");
+            assert!(expected.contains("index-3"), "{expected}");
         }
         other => panic!("expected InvalidParameter, got {other:?}"),
     }
