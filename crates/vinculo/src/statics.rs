@@ -394,14 +394,23 @@ fn finish(
     }
 }
 
+/// True when constraint `c` touches `particle` alone: one of the point's supports (the
+/// prescribed coordinates of a coupled point), not an element acting on it.
+fn support_of(c: &crate::constraints::Constraint, particle: usize) -> bool {
+    c.particles().iter().all(|&p| p == particle)
+}
+
 /// The force (N) that the elements of `system` (its constraints, through their multipliers,
 /// and its forces at v = 0) exert on `particle` in the equilibrium `statics`; gravity on the
-/// particle itself is not included.
+/// particle itself and the constraints on it alone (its supports) are not included.
 pub fn point_force(system: &System, statics: &Statics, particle: usize) -> Vec3 {
     let (q, t) = (&statics.positions, statics.t);
     let zero = vec![[0.0; 3]; q.len()];
     let mut f = [0.0; 3];
     for (k, con) in system.constraints().iter().enumerate() {
+        if support_of(con, particle) {
+            continue;
+        }
         if let Some(x) = con.particles().iter().position(|&p| p == particle) {
             let g = con.gradient(q, t);
             for r in 0..3 {
@@ -439,12 +448,15 @@ pub fn point_stiffness(system: &System, statics: &Statics, particle: usize) -> R
             ),
         });
     }
+    // The point is freed, and the constraints on it alone (the supports that prescribe a
+    // coupled point's coordinates) are left out: F is the force of the other elements.
     let mut free = system.clone();
     free.set_fixed(particle, false);
+    let kept = free.retain_constraints(|c| !support_of(c, particle));
     free.set_initial_state(&statics.positions, &vec![[0.0; 3]; statics.positions.len()]);
     let mut ws = StepWorkspace::new(&free, 48);
     ws.state.q.clone_from(&statics.positions);
-    ws.state.lambda.clone_from(&statics.multipliers);
+    ws.state.lambda = kept.iter().map(|&k| statics.multipliers[k]).collect();
     let t = statics.t;
     let sigma = row_scale(&free, ws.mass_ref);
     let zero = vec![[0.0; 3]; statics.positions.len()];
@@ -626,6 +638,26 @@ mod tests {
         }
         // Central differences: O(h^2) truncation, ~1e-6 of the largest entry at h = 1 mm.
         assert!(worst < 1e-5, "relative difference {worst}, K = {k:?}");
+        // A coupled fairlead (free, its three coordinates prescribed) has the same stiffness
+        // and the same force: its supports are not elements acting on it.
+        let mut coupled = s.clone();
+        coupled.set_fixed(n, false);
+        let id = coupled.particle_id(n).unwrap();
+        for axis in 0..3 {
+            coupled.add_fixed_coordinate(id, axis, None).unwrap();
+        }
+        let st_coupled = solve_statics(&coupled, &StaticsOptions::default()).unwrap();
+        let k_coupled = point_stiffness(&coupled, &st_coupled, n).unwrap();
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!((k_coupled[i][j] - k[i][j]).abs() < 1e-7 * scale);
+            }
+            let (f, g) = (
+                point_force(&s, &st, n),
+                point_force(&coupled, &st_coupled, n),
+            );
+            assert!((f[i] - g[i]).abs() < 1e-7 * scale);
+        }
         // A conservative system's stiffness is symmetric.
         for i in 0..3 {
             for j in 0..3 {
