@@ -125,3 +125,45 @@ def test_fairlead_stiffness_matches_finite_differences_of_the_statics():
     # Central differences over re-solved equilibria: O(h^2) truncation.
     np.testing.assert_allclose(k, fd, atol=1e-5 * np.abs(k).max())
     np.testing.assert_allclose(k, k.T, atol=1e-9 * np.abs(k).max())
+
+
+def test_chain_on_the_seabed_from_a_compressed_straight_start():
+    # The chain of tests/data/moordyn/chain_on_seabed.txt (315 m over a 302.6 m chord, part of it
+    # on the seabed) started on the straight chord, 4 % compressed: Newton's method fails there
+    # and the continuation buckles it down onto the seabed, to the equilibrium that Newton's
+    # method reaches from the catenary start, to round-off.
+    from vinculo.mooring.model import build_model
+
+    built = build_model("tests/data/moordyn/chain_on_seabed.txt", solve=False)
+    system, line = built.system, built.lines[0]
+    reference = solve_statics(system.copy(), apply=False)
+    assert reference.method == "newton"
+    q = np.array(system.initial_positions())
+    a, b = q[line.nodes[0]], q[line.nodes[-1]]
+    u = np.linspace(0.0, 1.0, len(line.nodes))[1:-1, None]
+    q[line.nodes[1:-1]] = a + u * (b - a)
+    straight = system.copy()
+    straight.set_initial_state(q)
+    eq = solve_statics(straight, apply=False)
+    assert eq.method == "continuation"
+    np.testing.assert_allclose(eq.positions, reference.positions, atol=1e-9)
+    np.testing.assert_allclose(eq.multipliers, reference.multipliers, rtol=1e-7)
+
+
+def test_winch_pays_out_a_line_to_the_statics_of_its_new_length():
+    # A clump hanging by a 50 m rope that a winch pays out at 0.2 m/s (L(t) = 50 + 0.2 t, each
+    # of the 10 segments keeping its tenth): slowly against the axial period (0.3 s), so the
+    # clump follows the equilibrium of the current length; after 10 s it is where the statics
+    # at t = 10 s put it (backward Euler damps the start's oscillation), to 1 mm.
+    kind = LineType("rope", diameter=0.05, mass_per_length=5.0, ea=2.0e7)
+    s = vinculo.System(gravity=(0.0, 0.0, -G))
+    top = s.add_particle(1.0, (0.0, 0.0, -5.0), fixed=True)
+    clump = s.add_particle(500.0, (0.0, 0.0, -55.0))
+    add_line(s, top.index, clump.index, kind, vinculo.laws.polynomial([50.0, 0.2]), 10, WATER)
+    later = solve_statics(s.copy(), t=10.0, apply=False)
+    solve_statics(s)
+    sol = vinculo.simulate(s, 10.0, 0.01, alpha=1.0)
+    z = sol.particle(clump)[-1, 2]
+    assert z == pytest.approx(later.positions[clump.index, 2], abs=1e-3)
+    # 2 m paid out: the clump 2 m (and the stretch of the added line) lower.
+    assert z < -57.0

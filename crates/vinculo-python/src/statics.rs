@@ -20,7 +20,7 @@ type StaticsTuple<'py> = (
 
 /// Solves the static equilibrium of `system` at time `t` from its initial positions.
 #[pyfunction]
-#[pyo3(signature = (system, tolerance=1e-9, max_iterations=200, t=0.0, newton_first=true))]
+#[pyo3(signature = (system, tolerance=1e-9, max_iterations=1000, t=0.0, newton_first=true))]
 pub fn solve_statics<'py>(
     py: Python<'py>,
     system: Bound<'py, PySystem>,
@@ -104,7 +104,7 @@ pub fn point_stiffness<'py>(
     check_sizes(&this.inner, &st)?;
     let k = statics::point_stiffness(&this.inner, &st, particle).map_err(to_py)?;
     let flat: Vec<f64> = k.iter().flatten().copied().collect();
-    Ok(PyArray1::from_vec(py, flat).reshape([3, 3])?)
+    PyArray1::from_vec(py, flat).reshape([3, 3])
 }
 
 /// The force (N) that the system's elements exert on `particle` in an equilibrium.

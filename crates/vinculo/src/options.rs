@@ -176,7 +176,7 @@ pub(crate) fn check_options(system: &System, o: &SimulationOptions) -> Result<()
                 ),
                 value: f64::NAN,
                 expected: "elastic segments (finite EA) run on the index-3 formulation: use \
-                           formulation 'index3'"
+                           formulation 'index-3'"
                     .into(),
             });
         }

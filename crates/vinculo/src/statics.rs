@@ -71,7 +71,7 @@ impl Default for StaticsOptions {
     fn default() -> Self {
         StaticsOptions {
             tolerance: 1e-9,
-            max_iterations: 200,
+            max_iterations: 1000,
             t: 0.0,
             newton_first: true,
         }
@@ -198,9 +198,19 @@ fn static_residual(system: &System, ws: &mut StepWorkspace, t: f64, previous: &[
 /// fails.
 ///
 /// # Errors
-/// [`Error::NewtonFailed`] (with a zero step) when neither converges within
+/// [`Error::InvalidParameter`] for a tolerance that is not > 0, a time that is not finite or
+/// no iteration; [`Error::NewtonFailed`] (with a zero step) when neither converges within
 /// `options.max_iterations` iterations.
 pub fn solve_statics(system: &System, options: &StaticsOptions) -> Result<Statics> {
+    crate::error::positive("statics tolerance", options.tolerance)?;
+    crate::error::finite("statics time t", options.t)?;
+    if options.max_iterations == 0 {
+        return Err(Error::InvalidParameter {
+            name: "statics max_iterations".into(),
+            value: 0.0,
+            expected: "must be >= 1".into(),
+        });
+    }
     let t = options.t;
     let mut ws = StepWorkspace::new(system, 48);
     let q0 = system.initial_positions();
@@ -253,8 +263,11 @@ pub fn solve_statics(system: &System, options: &StaticsOptions) -> Result<Static
         .fold(0.0, f64::max);
     let mut mu = 100.0 * g / l + stiffest;
     let largest_mu = 1e4 * mu;
+    // A pseudo-step need not be solved tightly (only the last, plain Newton solve is), and
+    // its mu M (q - q_prev) rows put a round-off floor of about sigma mu M eps |q| on it.
     let step_options = NewtonOptions {
         max_iterations: 12,
+        tolerance: 1e3 * newton.tolerance,
         ..newton
     };
     let mut previous = ws.state.q.clone();
@@ -268,11 +281,13 @@ pub fn solve_statics(system: &System, options: &StaticsOptions) -> Result<Static
                 previous.clone_from(&ws.state.q);
                 lambda_previous.clone_from(&ws.state.lambda);
                 let residual = static_residual(system, &mut ws, t, &previous);
-                // Switched evolution relaxation (at most a tenfold decrease per step), kept
+                // Switched evolution relaxation (at most a tenfold decrease per step, at least
+                // a halving after a converged pseudo-step: the slow modes of a line, a
+                // pendulum's g / l, would take mu / omega^2 pseudo-steps otherwise), kept
                 // above the negative stiffness of compressed segments, |T| / (L m_ref), so that
                 // the pseudo-step's matrix stays definite while a line buckles.
-                let ratio = (residual / residual_previous).clamp(0.1, 2.0);
-                mu *= if ratio.is_finite() { ratio } else { 2.0 };
+                let ratio = (residual / residual_previous).clamp(0.1, 0.5);
+                mu *= if ratio.is_finite() { ratio } else { 0.5 };
                 mu = mu.max(2.0 * compression(system, &ws.state.lambda, t) / ws.mass_ref);
                 residual_previous = residual;
                 let close = residual < 1e3 * newton.tolerance || mu < 1e-6 * g / l;
@@ -379,14 +394,23 @@ fn finish(
     }
 }
 
+/// True when constraint `c` touches `particle` alone: one of the point's supports (the
+/// prescribed coordinates of a coupled point), not an element acting on it.
+fn support_of(c: &crate::constraints::Constraint, particle: usize) -> bool {
+    c.particles().iter().all(|&p| p == particle)
+}
+
 /// The force (N) that the elements of `system` (its constraints, through their multipliers,
 /// and its forces at v = 0) exert on `particle` in the equilibrium `statics`; gravity on the
-/// particle itself is not included.
+/// particle itself and the constraints on it alone (its supports) are not included.
 pub fn point_force(system: &System, statics: &Statics, particle: usize) -> Vec3 {
     let (q, t) = (&statics.positions, statics.t);
     let zero = vec![[0.0; 3]; q.len()];
     let mut f = [0.0; 3];
     for (k, con) in system.constraints().iter().enumerate() {
+        if support_of(con, particle) {
+            continue;
+        }
         if let Some(x) = con.particles().iter().position(|&p| p == particle) {
             let g = con.gradient(q, t);
             for r in 0..3 {
@@ -424,12 +448,15 @@ pub fn point_stiffness(system: &System, statics: &Statics, particle: usize) -> R
             ),
         });
     }
+    // The point is freed, and the constraints on it alone (the supports that prescribe a
+    // coupled point's coordinates) are left out: F is the force of the other elements.
     let mut free = system.clone();
     free.set_fixed(particle, false);
+    let kept = free.retain_constraints(|c| !support_of(c, particle));
     free.set_initial_state(&statics.positions, &vec![[0.0; 3]; statics.positions.len()]);
     let mut ws = StepWorkspace::new(&free, 48);
     ws.state.q.clone_from(&statics.positions);
-    ws.state.lambda.clone_from(&statics.multipliers);
+    ws.state.lambda = kept.iter().map(|&k| statics.multipliers[k]).collect();
     let t = statics.t;
     let sigma = row_scale(&free, ws.mass_ref);
     let zero = vec![[0.0; 3]; statics.positions.len()];
@@ -611,6 +638,26 @@ mod tests {
         }
         // Central differences: O(h^2) truncation, ~1e-6 of the largest entry at h = 1 mm.
         assert!(worst < 1e-5, "relative difference {worst}, K = {k:?}");
+        // A coupled fairlead (free, its three coordinates prescribed) has the same stiffness
+        // and the same force: its supports are not elements acting on it.
+        let mut coupled = s.clone();
+        coupled.set_fixed(n, false);
+        let id = coupled.particle_id(n).unwrap();
+        for axis in 0..3 {
+            coupled.add_fixed_coordinate(id, axis, None).unwrap();
+        }
+        let st_coupled = solve_statics(&coupled, &StaticsOptions::default()).unwrap();
+        let k_coupled = point_stiffness(&coupled, &st_coupled, n).unwrap();
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!((k_coupled[i][j] - k[i][j]).abs() < 1e-7 * scale);
+            }
+            let (f, g) = (
+                point_force(&s, &st, n),
+                point_force(&coupled, &st_coupled, n),
+            );
+            assert!((f[i] - g[i]).abs() < 1e-7 * scale);
+        }
         // A conservative system's stiffness is symmetric.
         for i in 0..3 {
             for j in 0..3 {

@@ -193,3 +193,23 @@ fn winch_pays_out_the_segment() {
     assert!((z - expected).abs() < 1e-5, "z {z} vs {expected}");
     assert!((sol.multipliers[last] - m * G).abs() < 1e-3 * m * G);
 }
+
+#[test]
+fn ggl_formulation_refuses_compliant_segments_with_a_typed_error() {
+    // The stabilised (GGL) layout has no compliant rows: a finite EA is refused before the run,
+    // naming the segment and the formulation to use; an inextensible one runs.
+    let options = SimulationOptions {
+        t_end: 0.01,
+        formulation: vinculo::integrators::Formulation::Ggl,
+        ..Default::default()
+    };
+    match simulate(&hanging(1.0, Law::Constant(1.0), 1e4), &options) {
+        Err(vinculo::Error::InvalidParameter { name, expected, .. }) => {
+            assert!(name.contains("elastic segment #0"), "{name}");
+            assert!(expected.contains("index-3"), "{expected}");
+        }
+        other => panic!("expected InvalidParameter, got {other:?}"),
+    }
+    let rigid = simulate(&hanging(1.0, Law::Constant(1.0), f64::INFINITY), &options).unwrap();
+    assert!(rigid.status.is_ok(), "{:?}", rigid.status);
+}

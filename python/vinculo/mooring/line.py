@@ -121,6 +121,7 @@ class Line:
         name: a name for messages.
         end_loads: the constant loads (weight and buoyancy of the half segments, N) that the
             line puts on its end particles A and B.
+        damping: the dashpot coefficient BA / l of each segment (N s/m; 0: none).
     """
 
     nodes: list[int]
@@ -131,9 +132,11 @@ class Line:
     name: str = ""
     end_loads: tuple[np.ndarray, np.ndarray] = field(
         default_factory=lambda: (np.zeros(3), np.zeros(3)))
+    damping: float = 0.0
 
     def tensions(self, solution: Any) -> np.ndarray:
-        """The segments' tensions, from their multipliers.
+        """The segments' tensions: the elastic part from their multipliers, plus the axial
+        damping's ``(BA / l) u . (v_i - v_j)`` where the source has velocities (a run).
 
         Arguments:
             solution: a :class:`vinculo.Solution` of the line's system, or a static equilibrium
@@ -143,7 +146,15 @@ class Line:
             ``(times, segments)`` tensions (N); one row for an equilibrium.
         """
         multipliers = np.atleast_2d(np.asarray(solution.multipliers, dtype=float))
-        return multipliers[:, [c.index for c in self.segments]]
+        tension = multipliers[:, [c.index for c in self.segments]]
+        velocities = getattr(solution, "velocities", None)
+        if self.damping > 0.0 and velocities is not None:
+            q = np.asarray(solution.positions, dtype=float)[:, self.nodes]
+            v = np.asarray(velocities, dtype=float)[:, self.nodes]
+            d = q[:, 1:] - q[:, :-1]
+            u = d / np.linalg.norm(d, axis=2, keepdims=True)
+            tension = tension + self.damping * np.sum(u * (v[:, 1:] - v[:, :-1]), axis=2)
+        return tension
 
     def end_forces(self, solution: Any) -> tuple[np.ndarray, np.ndarray]:
         """The forces of the line on its end particles A and B: the end segments' tensions along
@@ -337,4 +348,4 @@ def add_line(system: Any, end_a: int, end_b: int, line_type: LineType,
     displaced = water.density * math.pi * line_type.diameter**2 / 4.0 * half
     load = (line_type.mass_per_length * half - displaced) * gravity
     return Line(nodes=nodes, segments=links, line_type=line_type, unstretched_length=length0,
-                water=water, name=name, end_loads=(load, load.copy()))
+                water=water, name=name, end_loads=(load, load.copy()), damping=damping)

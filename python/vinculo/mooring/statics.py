@@ -63,7 +63,7 @@ class Statics:
         system.set_initial_state(self.positions, np.zeros_like(self.positions))
 
 
-def solve_statics(system: Any, *, tolerance: float = 1e-9, max_iterations: int = 200,
+def solve_statics(system: Any, *, tolerance: float = 1e-9, max_iterations: int = 1000,
                   t: float = 0.0, newton_first: bool = True, apply: bool = True) -> Statics:
     """The static equilibrium of ``system``, from its initial positions.
 
@@ -107,7 +107,7 @@ def point_stiffness(system: Any, statics: Statics, particle: int) -> np.ndarray:
         ``(3, 3)`` stiffness, ``K[i, j] = -dF_i/dx_j``.
 
     Raises:
-        SingularMatrixError: when the equilibrium's Jacobian is singular at the point (an
+        ConvergenceError: when the equilibrium's Jacobian is singular at the point (an
             inextensible taut line is infinitely stiff along itself).
     """
     return np.asarray(_core.point_stiffness(system, statics.positions, statics.multipliers,

@@ -418,6 +418,18 @@ impl System {
         self.constraints[c].tension(lambda)
     }
 
+    /// Keeps the constraints for which `keep` is true (in order) and returns the indices they
+    /// had; the tension-only marks are dropped. How the linearised stiffness at a point removes
+    /// the point's own supports.
+    pub(crate) fn retain_constraints(&mut self, keep: impl Fn(&Constraint) -> bool) -> Vec<usize> {
+        let kept: Vec<usize> = (0..self.constraints.len())
+            .filter(|&k| keep(&self.constraints[k]))
+            .collect();
+        self.constraints.retain(|c| keep(c));
+        self.tension_only.clear();
+        kept
+    }
+
     /// Fixes or frees particle `i` (an index of this system): how the linearised stiffness at a
     /// point frees that point.
     pub(crate) fn set_fixed(&mut self, i: usize, fixed: bool) {
