@@ -164,6 +164,27 @@ class System:
             InvalidInputError: a == b, or a length that is not finite and positive.
             UnknownHandleError: a handle of another system.
         """
+    def add_elastic_distance(self, a: ParticleId, b: ParticleId, length: float | Law, ea: float,
+                             share: float = 1.0) -> ConstraintId:
+        """An elastic segment: |q_a - q_b| = l + (l / EA) T, its multiplier the tension T
+        (docs/theory/moorings.md).
+
+        Arguments:
+            a: one end.
+            b: the other end.
+            length: the unstretched length (m), or a law of time (a winch).
+            ea: the axial stiffness EA (N, > 0); ``math.inf``: inextensible.
+            share: the segment's share of ``length``, l = share length(t) (in (0, 1]; a line of
+                n segments on one winch law gives each 1/n).
+
+        Returns:
+            The constraint's handle (one equation; its multiplier is the tension in N).
+
+        Raises:
+            InvalidInputError: a == b, a length that is not positive at t = 0, a share out of
+                (0, 1] or an EA that is not positive.
+            UnknownHandleError: a handle of another system.
+        """
     def add_distance_to_point(self, particle: ParticleId, point: Vector,
                               length: float | None = None) -> ConstraintId:
         """A link from a particle to a prescribed point p(t): Phi = L^2 - |q - p(t)|^2.
@@ -443,10 +464,10 @@ class System:
         (docs/theory/seabed-and-line-loads.md).
 
         While the node penetrates (``p = -depth - z > 0``) the seabed pushes it up with
-        ``N = d l (kbot p - cbot v_z)``, and friction opposes its sliding velocity, separately
-        along the line (``axial_friction``) and across it (``friction``): ``-mu friction_damping w``
-        for slow sliding, ``-mu |N| w / |w|`` (Coulomb) once ``friction_damping |w| >
-        static_dynamic_scale |N|``.
+        ``N = d l (kbot p - cbot v_z)``, and friction opposes its sliding velocity ``w`` (or,
+        with ``axial_friction``, each of its parts along and across the line):
+        ``-mu friction_damping w`` for slow sliding, ``-mu |N| w / |w|`` (Coulomb) once
+        ``friction_damping |w| > static_dynamic_scale |N|``.
 
         Arguments:
             node: the line node.
@@ -458,11 +479,13 @@ class System:
             cbot: seabed damping per unit area (Pa s/m, >= 0), MoorDyn's cBot.
             tangent: (a, b): the line's direction at the node points from particle a to b (the
                 node's neighbours, or the node and its one neighbour at an end of the line);
-                None: friction with ``friction`` in every direction.
+                None: isotropic friction with ``friction``.
             friction: transverse kinetic friction coefficient (>= 0), MoorDyn's
                 FrictionCoefficient.
-            axial_friction: axial kinetic friction coefficient (>= 0); None: equal to
-                ``friction`` (MoorDyn-C's single coefficient).
+            axial_friction: axial kinetic friction coefficient (>= 0, MoorDyn-F's MuKA): the
+                sliding velocity splits along and across the line, each part with its own
+                coefficient; None: MoorDyn-C's single coefficient, ``friction`` on the whole
+                sliding velocity whatever the line's direction.
             friction_damping: slope of the friction at small speeds (N s/m, > 0), MoorDyn's
                 FricDamp.
             static_dynamic_scale: ratio of static to kinetic friction (>= 1), MoorDyn's
@@ -570,6 +593,17 @@ class System:
         """Sum 1/2 m |v|^2 for (..., n, 3) velocities; returns shape (...)."""
     def potential_energy(self, positions: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """Gravity and spring potential for (..., n, 3) positions; returns shape (...)."""
+    def set_initial_state(self, positions: npt.ArrayLike,
+                          velocities: npt.ArrayLike | None = None) -> None:
+        """Set the initial positions and velocities of every particle (fixed ones included).
+
+        Arguments:
+            positions: (n, 3) positions (m).
+            velocities: (n, 3) velocities (m/s); None: at rest.
+
+        Raises:
+            InvalidInputError: arrays of another shape, or non-finite values.
+        """
     def project_initial_state(self, tolerance: float = 1e-12, max_iterations: int = 50) -> dict[str, float]:
         """Move the initial positions and velocities onto Phi = 0 and Phi_q v + Phi_t = 0 with the
         least mass-weighted change; returns {'position_change': max |dq|, 'velocity_change': max |dv|,
@@ -662,6 +696,29 @@ class RunResult:
         ``vinculo.Solution`` as its ``solution`` attribute and, for a failed user function, the
         user's exception as its ``__cause__``."""
 
+def solve_statics(system: System, tolerance: float = 1e-9, max_iterations: int = 200,
+                  t: float = 0.0, newton_first: bool = True
+                  ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], float, int, str]:
+    """The static equilibrium (see ``vinculo.mooring.statics.solve_statics``).
+
+    Returns:
+        (positions (n, 3), multipliers (m,), residual, iterations, method).
+
+    Raises:
+        ConvergenceError: when neither Newton's method nor the continuation converges.
+    """
+def point_stiffness(system: System, positions: npt.NDArray[np.float64],
+                    multipliers: npt.NDArray[np.float64], particle: int,
+                    t: float = 0.0) -> npt.NDArray[np.float64]:
+    """The 3x3 stiffness K = -dF/dx (N/m) at a particle in an equilibrium.
+
+    Raises:
+        ConvergenceError: a singular equilibrium Jacobian at the point.
+    """
+def point_force(system: System, positions: npt.NDArray[np.float64],
+                multipliers: npt.NDArray[np.float64], particle: int,
+                t: float = 0.0) -> tuple[float, float, float]:
+    """The force (N) of the system's elements on a particle in an equilibrium."""
 def simulate(system: System, settings: RunSettings,
              progress: Callable[[float, float], None] | None = None) -> RunResult:
     """Integrate.

@@ -5,6 +5,7 @@ mod errors;
 mod laws;
 mod run;
 mod run_result;
+mod statics;
 mod stepping;
 mod system;
 mod user_physics;
@@ -24,5 +25,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<run::PyRunSettings>()?;
     m.add_class::<run_result::PyRunResult>()?;
     m.add_function(wrap_pyfunction!(run::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(statics::solve_statics, m)?)?;
+    m.add_function(wrap_pyfunction!(statics::point_stiffness, m)?)?;
+    m.add_function(wrap_pyfunction!(statics::point_force, m)?)?;
     Ok(())
 }

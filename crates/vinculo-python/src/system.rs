@@ -87,10 +87,6 @@ fn vec3(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<[f64; 3]> {
     Ok([v[0], v[1], v[2]])
 }
 
-/// mu_a / mu_t when the axial friction coefficient is not given: MoorDyn-C applies one
-/// coefficient to the whole sliding velocity.
-const AXIAL_FRICTION_RATIO: f64 = 1.0;
-
 impl PySystem {
     /// A line tangent given as a pair (a, b) of particles, or None.
     fn tangent(
@@ -229,6 +225,27 @@ impl PySystem {
     ) -> PyResult<PyConstraintId> {
         let (a, b) = (self.particle(a)?, self.particle(b)?);
         let id = self.inner.add_distance(a, b, length).map_err(to_py)?;
+        Ok(PyConstraintId { index: id.0 })
+    }
+
+    /// Elastic segment: |q_a - q_b| = l(t) + (l(t)/EA) T, its multiplier the tension T (N), with
+    /// l(t) = share length(t); `length` a number or a law of time (a winch), `share` the
+    /// segment's share of it; `ea` in N, `math.inf`: inextensible.
+    #[pyo3(signature = (a, b, length, ea, share=1.0))]
+    fn add_elastic_distance(
+        &mut self,
+        a: &Bound<'_, PyAny>,
+        b: &Bound<'_, PyAny>,
+        length: &Bound<'_, PyAny>,
+        ea: f64,
+        share: f64,
+    ) -> PyResult<PyConstraintId> {
+        let (a, b) = (self.particle(a)?, self.particle(b)?);
+        let length = scalar(length, "unstretched length")?;
+        let id = self
+            .inner
+            .add_elastic_distance(a, b, (length, share), ea)
+            .map_err(to_py)?;
         Ok(PyConstraintId { index: id.0 })
     }
 
@@ -498,7 +515,7 @@ impl PySystem {
             damping_ramp,
             friction: SeabedFriction {
                 transverse: friction,
-                axial: axial_friction.unwrap_or(friction * AXIAL_FRICTION_RATIO),
+                axial: axial_friction,
                 damping: friction_damping,
                 static_scale: static_dynamic_scale,
             },
@@ -785,6 +802,48 @@ impl PySystem {
         Ok(numpy::ndarray::ArrayD::from_shape_vec(outer, e)
             .expect("shape")
             .into_pyarray(py))
+    }
+
+    /// Sets the initial positions (n, 3) and velocities (n, 3; None: at rest) of every particle,
+    /// fixed ones included (a static equilibrium as the start of a run).
+    #[pyo3(signature = (positions, velocities=None))]
+    fn set_initial_state(
+        &mut self,
+        positions: PyReadonlyArrayDyn<'_, f64>,
+        velocities: Option<PyReadonlyArrayDyn<'_, f64>>,
+    ) -> PyResult<()> {
+        let (outer, q) = self.frames(&positions, "positions")?;
+        if !outer.is_empty() {
+            return Err(invalid(
+                "positions",
+                format!("{outer:?} frames"),
+                "expected one (n, 3) array",
+            ));
+        }
+        let v = match velocities {
+            Some(v) => {
+                let (outer, v) = self.frames(&v, "velocities")?;
+                if !outer.is_empty() {
+                    return Err(invalid(
+                        "velocities",
+                        format!("{outer:?} frames"),
+                        "expected one (n, 3) array",
+                    ));
+                }
+                v.into_iter().next().unwrap_or_default()
+            }
+            None => vec![[0.0; 3]; self.inner.particles().len()],
+        };
+        let q = q.into_iter().next().unwrap_or_default();
+        if q.iter().chain(&v).any(|x| x.iter().any(|c| !c.is_finite())) {
+            return Err(invalid(
+                "initial state",
+                "non-finite values",
+                "give finite positions and velocities",
+            ));
+        }
+        self.inner.set_initial_state(&q, &v);
+        Ok(())
     }
 
     /// Moves the initial state onto the position and velocity constraints with the least

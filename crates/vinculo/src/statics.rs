@@ -511,7 +511,7 @@ mod tests {
                 let x = shape(i as f64 / n as f64);
                 s.add_particle(node, x, [0.0; 3], false).unwrap()
             };
-            s.add_elastic_distance(prev, p, Law::Constant(length / n as f64), ea)
+            s.add_elastic_distance(prev, p, (Law::Constant(length / n as f64), 1.0), ea)
                 .unwrap();
             prev = p;
         }
@@ -526,7 +526,8 @@ mod tests {
         let mut s = System::new([0.0, 0.0, -G]);
         let a = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
         let b = s.add_particle(m, [0.0, 0.0, -l], [0.0; 3], false).unwrap();
-        s.add_elastic_distance(a, b, Law::Constant(l), ea).unwrap();
+        s.add_elastic_distance(a, b, (Law::Constant(l), 1.0), ea)
+            .unwrap();
         let st = solve_statics(&s, &StaticsOptions::default()).unwrap();
         assert_eq!(st.method, StaticsMethod::Newton);
         let z = st.positions[1][2];

@@ -23,7 +23,7 @@ fn hanging(m: f64, l: Law, ea: f64) -> System {
     let z0 = -l.value(0.0);
     let a = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
     let b = s.add_particle(m, [0.0, 0.0, z0], [0.0; 3], false).unwrap();
-    s.add_elastic_distance(a, b, l, ea).unwrap();
+    s.add_elastic_distance(a, b, (l, 1.0), ea).unwrap();
     s
 }
 
@@ -93,7 +93,7 @@ fn stiff_segment_moves_as_the_exact_distance() {
         let a = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
         let b = s.add_particle(m, start, [0.0; 3], false).unwrap();
         if elastic {
-            s.add_elastic_distance(a, b, Law::Constant(l), 1e15)
+            s.add_elastic_distance(a, b, (Law::Constant(l), 1.0), 1e15)
                 .unwrap();
         } else {
             s.add_distance(a, b, Some(l)).unwrap();
@@ -140,7 +140,7 @@ fn tree_elimination_equals_sparse_lu_on_an_elastic_chain() {
         let p = s
             .add_particle(0.1, [0.1 * i as f64, 0.0, 0.0], [0.0; 3], false)
             .unwrap();
-        s.add_elastic_distance(prev, p, Law::Constant(0.1), 5e3)
+        s.add_elastic_distance(prev, p, (Law::Constant(0.1), 1.0), 5e3)
             .unwrap();
         prev = p;
     }

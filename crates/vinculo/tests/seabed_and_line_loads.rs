@@ -99,7 +99,7 @@ fn sliding_node_decelerates_at_the_coulomb_rate() {
         let (mut s, n, tangent) = node(-DEPTH - p0, v0, 0.0, 0.0);
         let friction = SeabedFriction {
             transverse: mu_t,
-            axial: mu_a,
+            axial: Some(mu_a),
             damping: 200.0,
             static_scale: 1.0,
         };
@@ -114,6 +114,36 @@ fn sliding_node_decelerates_at_the_coulomb_rate() {
         assert!(
             ((decel - expected) / expected).abs() < 1e-6,
             "direction {direction}: deceleration {decel} against {expected} m/s^2"
+        );
+    }
+}
+
+/// Without an axial coefficient (MoorDyn-C's single coefficient) the friction is isotropic: a
+/// node sliding obliquely to the line decelerates at mu w / m along its velocity.
+#[test]
+fn isotropic_friction_decelerates_obliquely_sliding_node_at_the_coulomb_rate() {
+    let mu = 0.5;
+    let p0 = weight() / (3.0e6 * D * L);
+    let (c, s30) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+    let (mut s, n, tangent) = node(-DEPTH - p0, [4.0 * c, 4.0 * s30, 0.0], 0.0, 0.0);
+    let friction = SeabedFriction {
+        transverse: mu,
+        axial: None,
+        damping: 200.0,
+        static_scale: 1.0,
+    };
+    s.add_seabed_contact(n, Some(tangent), &seabed(friction))
+        .unwrap();
+    let sol = run(&s, 1.0, 1e-3);
+    let velocity = |t: f64| sol.velocity((t / 1e-3).round() as usize, 2);
+    let (v1, v2) = (velocity(0.2), velocity(0.7));
+    let expected = mu * weight() / MASS;
+    for (k, dir) in [(0, c), (1, s30)] {
+        let decel = (v1[k] - v2[k]) / 0.5;
+        assert!(
+            ((decel - expected * dir) / expected).abs() < 1e-6,
+            "component {k}: deceleration {decel} against {} m/s^2",
+            expected * dir
         );
     }
 }

@@ -1,7 +1,8 @@
 //! An elastic segment between two particles: a compliant distance whose multiplier is the
 //! tension (`docs/theory/moorings.md`).
 //!
-//! With d = q_i - q_j, u = d/|d| and the unstretched length L(t) (a law: a winch):
+//! With d = q_i - q_j, u = d/|d| and the unstretched length L(t) (a law: a winch; a segment's
+//! share of its line's law):
 //! - Phi = L(t) - |d|
 //! - Phi_q: dPhi/dq_i = -u^T, dPhi/dq_j = +u^T
 //! - Hessian: d2Phi/dq_i2 = d2Phi/dq_j2 = -(I - u u^T)/|d|, d2Phi/dq_i dq_j = +(I - u u^T)/|d|
@@ -28,8 +29,11 @@ use crate::math::{dot, norm, outer, scale_mat, sub, Mat3, Vec3};
 pub struct ElasticDistance {
     /// The two particles.
     pub particles: [usize; 2],
-    /// The unstretched length L(t) > 0 (m): a constant, or a law for a winch.
+    /// The unstretched length L(t) > 0 (m) is `share` times this law: a constant, or a law for a
+    /// winch (the law of a whole line, of which each of its n segments has the share 1/n).
     pub length: Law,
+    /// The segment's share of `length` (1 for a segment of its own).
+    pub share: f64,
     /// The axial stiffness EA (N); infinity: inextensible.
     pub ea: f64,
 }
@@ -49,7 +53,7 @@ impl ElasticDistance {
 
     pub(crate) fn residual(&self, q: &[Vec3], t: f64) -> f64 {
         let d = sub(q[self.particles[0]], q[self.particles[1]]);
-        self.length.value(t) - norm(d)
+        self.share * self.length.value(t) - norm(d)
     }
 
     pub(crate) fn gradient(&self, q: &[Vec3], _t: f64) -> [Vec3; 2] {
@@ -81,14 +85,14 @@ impl ElasticDistance {
     }
 
     pub(crate) fn phi_t(&self, _q: &[Vec3], t: f64) -> f64 {
-        self.length.eval(t).1
+        self.share * self.length.eval(t).1
     }
 
     pub(crate) fn gamma(&self, q: &[Vec3], v: &[Vec3], t: f64) -> f64 {
         let (u, l) = geometry(q, self.particles);
         let w = sub(v[self.particles[0]], v[self.particles[1]]);
         let uw = dot(u, w);
-        self.length.eval(t).2 - (dot(w, w) - uw * uw) / l
+        self.share * self.length.eval(t).2 - (dot(w, w) - uw * uw) / l
     }
 
     pub(crate) fn scale(&self) -> f64 {
@@ -100,7 +104,7 @@ impl ElasticDistance {
     #[inline]
     pub(crate) fn compliance(&self, t: f64) -> f64 {
         if self.ea.is_finite() {
-            self.length.value(t) / self.ea
+            self.share * self.length.value(t) / self.ea
         } else {
             0.0
         }
@@ -118,7 +122,8 @@ mod tests {
     fn derivatives_match_finite_differences() {
         let c = Constraint::ElasticDistance(Box::new(ElasticDistance {
             particles: [0, 2],
-            length: Law::polynomial(vec![0.7, 0.2, -0.3]).unwrap(),
+            length: Law::polynomial(vec![1.4, 0.4, -0.6]).unwrap(),
+            share: 0.5,
             ea: 1e5,
         }));
         let q = [[0.1, 0.2, -0.3], [9.0, 9.0, 9.0], [0.5, -0.4, 0.25]];
@@ -131,7 +136,8 @@ mod tests {
     fn compliance_is_length_over_ea() {
         let mut e = ElasticDistance {
             particles: [0, 1],
-            length: Law::Constant(2.0),
+            length: Law::Constant(4.0),
+            share: 0.5,
             ea: 4e6,
         };
         assert_eq!(e.compliance(0.0), 2.0 / 4e6);

@@ -186,7 +186,7 @@ impl Constraint {
     pub fn length(&self) -> f64 {
         match self {
             Constraint::Distance(c) => c.length,
-            Constraint::ElasticDistance(c) => c.length.value(0.0),
+            Constraint::ElasticDistance(c) => c.share * c.length.value(0.0),
             Constraint::PointDistance(c) => c.length,
             _ => 0.0,
         }

@@ -24,7 +24,9 @@
 //!
 //! with c_v = FricDamp (N s/m) and m_c = StatDynFricScale (>= 1). With m_c = 1 the friction is
 //! continuous (a kink where the branches meet); with m_c > 1 it drops from m_c mu |N| to mu |N|
-//! there. A node without a tangent gets the transverse coefficient in every direction.
+//! there. Without an axial coefficient (MoorDyn-C's single `FrictionCoefficient`), or without a
+//! tangent, the whole sliding velocity w = v_s gets the transverse coefficient (isotropic
+//! friction, MoorDyn-C's law).
 //!
 //! Smoothness: the normal force is continuous in q at p = 0 (a kink) but jumps by
 //! -A cBot v_z in v_z there, exactly as MoorDyn's; the Jacobian is the one of the branch the
@@ -45,8 +47,9 @@ use crate::math::{add, add_mat, diag, dot, norm, outer, scale, scale_mat, sub, M
 pub struct SeabedFriction {
     /// Transverse kinetic coefficient mu_t (MoorDyn's FrictionCoefficient, MoorDyn-F's MuKT).
     pub transverse: f64,
-    /// Axial kinetic coefficient mu_a (MoorDyn-F's MuKA).
-    pub axial: f64,
+    /// Axial kinetic coefficient mu_a (MoorDyn-F's MuKA); `None`: MoorDyn-C's isotropic
+    /// friction, mu_t on the whole sliding velocity whatever the line's direction.
+    pub axial: Option<f64>,
     /// Slope c_v of the linear branch (N s/m, MoorDyn's FricDamp / MoorDyn-F's CV, default 200).
     pub damping: f64,
     /// Ratio m_c of static to kinetic friction (MoorDyn's StatDynFricScale / MoorDyn-F's MC,
@@ -55,10 +58,15 @@ pub struct SeabedFriction {
 }
 
 impl SeabedFriction {
+    /// True when a coefficient is not zero.
+    pub fn acts(&self) -> bool {
+        self.transverse > 0.0 || self.axial.is_some_and(|a| a > 0.0)
+    }
+
     /// No friction.
     pub const NONE: SeabedFriction = SeabedFriction {
         transverse: 0.0,
-        axial: 0.0,
+        axial: None,
         damping: 200.0,
         static_scale: 1.0,
     };
@@ -122,7 +130,7 @@ impl SeabedContact {
     fn parts(&self, v: Vec3, tangent: Option<&Tangent>) -> [Option<Part>; 2] {
         let fr = &self.friction;
         let vs = [v[0], v[1], 0.0];
-        match tangent {
+        match tangent.zip(fr.axial) {
             None => [
                 (fr.transverse > 0.0).then_some(Part {
                     mu: fr.transverse,
@@ -132,7 +140,7 @@ impl SeabedContact {
                 }),
                 None,
             ],
-            Some(tg) => {
+            Some((tg, axial)) => {
                 let t = tg.t;
                 let tt = outer(1.0, t, t);
                 let va = scale(dot(t, vs), t);
@@ -145,8 +153,8 @@ impl SeabedContact {
                         dw_dv: add_mat(ALONG, scale_mat(-1.0, da_dv)),
                         dw_dt: Some(scale_mat(-1.0, da_dt)),
                     }),
-                    (fr.axial > 0.0).then_some(Part {
-                        mu: fr.axial,
+                    (axial > 0.0).then_some(Part {
+                        mu: axial,
                         w: va,
                         dw_dv: da_dv,
                         dw_dt: Some(da_dt),
@@ -175,7 +183,7 @@ impl SeabedContact {
             return [0.0; 3];
         };
         let mut f = [0.0, 0.0, n];
-        if self.friction.transverse > 0.0 || self.friction.axial > 0.0 {
+        if self.friction.acts() {
             let tangent = self.node.tangent(q);
             for part in self.parts(v[i], tangent.as_ref()).iter().flatten() {
                 f = add(f, self.friction_of(part, n).0);
@@ -209,7 +217,7 @@ impl SeabedContact {
         };
         dq[0][0][2][2] += dn_dz;
         dv[0][0][2][2] += dn_dvz;
-        if self.friction.transverse == 0.0 && self.friction.axial == 0.0 {
+        if !self.friction.acts() {
             return;
         }
         let tangent = self.node.tangent(q);
@@ -261,7 +269,7 @@ mod tests {
     fn friction(mc: f64) -> SeabedFriction {
         SeabedFriction {
             transverse: 0.8,
-            axial: 0.45,
+            axial: Some(0.45),
             damping: 200.0,
             static_scale: mc,
         }
@@ -299,6 +307,11 @@ mod tests {
             for tangent in [Some([0, 2]), None, Some([1, 0]), Some([2, 1])] {
                 for mc in [1.0, 1.5] {
                     let f = Force::SeabedContact(Box::new(contact(tangent, friction(mc))));
+                    fd::check(&f, &q, &v, 0.0);
+                    // MoorDyn-C's isotropic friction (no axial coefficient).
+                    let mut isotropic = friction(mc);
+                    isotropic.axial = None;
+                    let f = Force::SeabedContact(Box::new(contact(tangent, isotropic)));
                     fd::check(&f, &q, &v, 0.0);
                 }
             }

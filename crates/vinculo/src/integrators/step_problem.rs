@@ -346,11 +346,11 @@ mod tests {
         let d = s
             .add_particle(0.4, [1.2, 0.6, -0.1], [0.0, -0.3, 0.5], false)
             .unwrap();
-        s.add_elastic_distance(a, b, Law::Constant(0.5), 2e3)
+        s.add_elastic_distance(a, b, (Law::Constant(0.5), 1.0), 2e3)
             .unwrap();
         let winch = Law::polynomial(vec![0.45, 0.1, -0.05]).unwrap();
-        s.add_elastic_distance(b, c, winch, 2e3).unwrap();
-        s.add_elastic_distance(c, d, Law::Constant(0.8), f64::INFINITY)
+        s.add_elastic_distance(b, c, (winch, 1.0), 2e3).unwrap();
+        s.add_elastic_distance(c, d, (Law::Constant(0.8), 1.0), f64::INFINITY)
             .unwrap();
         s
     }

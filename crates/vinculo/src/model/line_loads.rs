@@ -22,7 +22,8 @@ pub struct SeabedSpec {
     pub damping: f64,
     /// Penetration over which the damping ramps up from zero (m, >= 0); 0: MoorDyn's law.
     pub damping_ramp: f64,
-    /// Friction (coefficients >= 0, FricDamp > 0, StatDynFricScale >= 1).
+    /// Friction (coefficients >= 0, FricDamp > 0, StatDynFricScale >= 1; no axial
+    /// coefficient: MoorDyn-C's isotropic friction).
     pub friction: SeabedFriction,
 }
 
@@ -107,7 +108,10 @@ impl System {
             damping_ramp: non_negative(field("damping ramp"), spec.damping_ramp)?,
             friction: SeabedFriction {
                 transverse: non_negative(field("friction coefficient"), fr.transverse)?,
-                axial: non_negative(field("axial friction coefficient"), fr.axial)?,
+                axial: fr
+                    .axial
+                    .map(|a| non_negative(field("axial friction coefficient"), a))
+                    .transpose()?,
                 damping: positive(field("friction damping"), fr.damping)?,
                 static_scale,
             },

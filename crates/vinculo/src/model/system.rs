@@ -138,18 +138,19 @@ impl System {
         }))
     }
 
-    /// An elastic segment between `a` and `b` of unstretched length `length(t)` (m; a law of
-    /// time for a winch) and axial stiffness `ea` (N; `f64::INFINITY`: inextensible), whose
-    /// multiplier is its tension (`docs/theory/moorings.md`).
+    /// An elastic segment between `a` and `b` of unstretched length `share length(t)` (m;
+    /// `length` a law of time for a winch, `share` the segment's share of it, 1 for a segment of
+    /// its own) and axial stiffness `ea` (N; `f64::INFINITY`: inextensible), whose multiplier is
+    /// its tension (`docs/theory/moorings.md`).
     ///
     /// # Errors
     /// [`Error::SameParticle`] when `a` is `b`; [`Error::InvalidParameter`] when the length is
-    /// not > 0 at t = 0 or `ea` is not > 0.
+    /// not > 0 at t = 0, `share` not in (0, 1] or `ea` not > 0.
     pub fn add_elastic_distance(
         &mut self,
         a: ParticleId,
         b: ParticleId,
-        length: Law,
+        (length, share): (Law, f64),
         ea: f64,
     ) -> Result<ConstraintId> {
         let (i, j) = (self.check(a)?, self.check(b)?);
@@ -162,8 +163,15 @@ impl System {
         }
         positive(
             format!("unstretched length of elastic segment #{index} (particles {i}-{j}) at t = 0"),
-            length.value(0.0),
+            share * length.value(0.0),
         )?;
+        if !(share > 0.0 && share <= 1.0) {
+            return Err(Error::InvalidParameter {
+                name: format!("share of the length law of elastic segment #{index}"),
+                value: share,
+                expected: "must be in (0, 1]".into(),
+            });
+        }
         if ea.is_nan() || ea <= 0.0 {
             return Err(Error::InvalidParameter {
                 name: format!("EA of elastic segment #{index} (particles {i}-{j})"),
@@ -174,6 +182,7 @@ impl System {
         self.push_constraint(Constraint::ElasticDistance(Box::new(ElasticDistance {
             particles: [i, j],
             length,
+            share,
             ea,
         })))
     }

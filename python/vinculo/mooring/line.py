@@ -1,0 +1,340 @@
+"""Mooring lines of lumped masses joined by elastic segments (MoorDyn's discretisation).
+
+A line of ``N`` segments between two particles of a :class:`vinculo.System` gets ``N - 1``
+interior nodes, each carrying the mass of one segment (``mass_per_length L / N``), and ``N``
+elastic segments: compliant distances whose multipliers are the segments' tensions
+(``docs/theory/moorings.md``; ``EA = inf`` is an exact distance). The two end particles carry the
+loads of the half segment next to them (weight, buoyancy, drag, seabed contact), as MoorDyn's end
+nodes belong to the points they attach to; their inertia stays the particles' own. Axial damping
+``BA`` (or, negative, MoorDyn's damping ratio ``-zeta`` of each segment's axial mode:
+``BA = zeta (L / N) sqrt(EA w)``, MoorDyn's documentation) is a dashpot in parallel with each
+segment, bending stiffness ``EI`` acts on consecutive node triples, Morison loads and seabed
+contact act on every node with MoorDyn's conventions.
+
+The interior nodes start on the closed-form elastic catenary of the line when it has one (a line
+hanging in a vertical plane, :func:`vinculo.mooring.catenary.solve_catenary`), else on a
+parabola of the line's length: a start close to the equilibrium that
+:func:`vinculo.mooring.statics.solve_statics` then finds.
+
+Example:
+    >>> import vinculo
+    >>> from vinculo.mooring.line import LineType, Water, add_line
+    >>> s = vinculo.System(gravity=(0.0, 0.0, -9.80665))
+    >>> a = s.add_particle(1.0, (0.0, 0.0, -50.0), fixed=True)
+    >>> b = s.add_particle(1.0, (80.0, 0.0, 0.0), fixed=True)
+    >>> chain = LineType("chain", diameter=0.1, mass_per_length=50.0, ea=5e8)
+    >>> line = add_line(s, a.index, b.index, chain, 110.0, 20, Water(depth=200.0))
+    >>> len(line.nodes), len(line.segments)
+    (21, 20)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from vinculo._core import Law
+from vinculo.errors import InvalidInputError
+
+
+@dataclass(frozen=True)
+class LineType:
+    """The properties of a line (a MoorDyn "LINE TYPES" row), SI units.
+
+    Arguments:
+        name: the type's name.
+        diameter: the volume-equivalent diameter d (m, > 0).
+        mass_per_length: the mass per unit length in air w (kg/m, > 0).
+        ea: the axial stiffness EA (N, > 0); ``math.inf``: inextensible.
+        ba: the axial damping BA (N s, >= 0); negative: minus the damping ratio of each
+            segment's axial mode (MoorDyn's BA/-zeta).
+        ei: the bending stiffness EI (N m^2, >= 0).
+        cd: the normal drag coefficient.
+        ca: the normal added-mass coefficient.
+        cdax: the axial drag coefficient.
+        caax: the axial added-mass coefficient.
+    """
+
+    name: str
+    diameter: float
+    mass_per_length: float
+    ea: float
+    ba: float = 0.0
+    ei: float = 0.0
+    cd: float = 0.0
+    ca: float = 0.0
+    cdax: float = 0.0
+    caax: float = 0.0
+
+
+@dataclass(frozen=True)
+class Water:
+    """The still water the lines are in: surface at z = 0, z up, flat seabed at z = -depth.
+
+    Arguments:
+        depth: the water depth (m, > 0).
+        density: the water density (kg/m^3, > 0).
+        gravity: the acceleration of gravity (m/s^2, > 0).
+    """
+
+    depth: float
+    density: float = 1025.0
+    gravity: float = 9.80665
+
+
+@dataclass(frozen=True)
+class Seabed:
+    """MoorDyn's seabed contact: a spring and a dashpot per unit area, regularised Coulomb
+    friction.
+
+    Arguments:
+        kbot: the contact stiffness per unit area (Pa/m), MoorDyn's kBot.
+        cbot: the contact damping per unit area (Pa s/m), MoorDyn's cBot.
+        friction: the transverse kinetic friction coefficient.
+        axial_friction: the axial kinetic friction coefficient (None: the transverse one on the
+            whole sliding velocity, MoorDyn-C's law).
+        friction_damping: the slope of the friction at small speeds (N s/m), MoorDyn's FricDamp.
+        static_dynamic_scale: static over kinetic friction, MoorDyn's StatDynFricScale.
+    """
+
+    kbot: float = 3.0e6
+    cbot: float = 3.0e5
+    friction: float = 0.0
+    axial_friction: float | None = None
+    friction_damping: float = 200.0
+    static_dynamic_scale: float = 1.0
+
+
+@dataclass
+class Line:
+    """The particles and elements of a line, and its results.
+
+    Arguments:
+        nodes: the particle indices from end A to end B (N + 1).
+        segments: the constraint handles of the N elastic segments, from end A.
+        line_type: the line's type.
+        unstretched_length: its unstretched length at t = 0 (m).
+        water: the water it is in.
+        name: a name for messages.
+        end_loads: the constant loads (weight and buoyancy of the half segments, N) that the
+            line puts on its end particles A and B.
+    """
+
+    nodes: list[int]
+    segments: list[Any]
+    line_type: LineType
+    unstretched_length: float
+    water: Water
+    name: str = ""
+    end_loads: tuple[np.ndarray, np.ndarray] = field(
+        default_factory=lambda: (np.zeros(3), np.zeros(3)))
+
+    def tensions(self, solution: Any) -> np.ndarray:
+        """The segments' tensions, from their multipliers.
+
+        Arguments:
+            solution: a :class:`vinculo.Solution` of the line's system, or a static equilibrium
+                (:class:`vinculo.mooring.statics.Statics`).
+
+        Returns:
+            ``(times, segments)`` tensions (N); one row for an equilibrium.
+        """
+        multipliers = np.atleast_2d(np.asarray(solution.multipliers, dtype=float))
+        return multipliers[:, [c.index for c in self.segments]]
+
+    def end_forces(self, solution: Any) -> tuple[np.ndarray, np.ndarray]:
+        """The forces of the line on its end particles A and B: the end segments' tensions along
+        them, and the weight and buoyancy of the half segments at the ends.
+
+        Arguments:
+            solution: a :class:`vinculo.Solution` or a static equilibrium.
+
+        Returns:
+            ``(times, 3)`` forces (N) on end A and on end B.
+        """
+        q = np.asarray(solution.positions, dtype=float)
+        q = q.reshape(-1, q.shape[-2], 3)
+        t = self.tensions(solution)
+        first = q[:, self.nodes[1]] - q[:, self.nodes[0]]
+        last = q[:, self.nodes[-2]] - q[:, self.nodes[-1]]
+        on_a = t[:, :1] * first / np.linalg.norm(first, axis=1, keepdims=True)
+        on_b = t[:, -1:] * last / np.linalg.norm(last, axis=1, keepdims=True)
+        return on_a + self.end_loads[0], on_b + self.end_loads[1]
+
+    def laid_length(self, positions: Any, seabed_z: float) -> float:
+        """The length of line lying on the seabed (unstretched).
+
+        A node is on the seabed when it is lower than ``seabed_z`` plus a tenth of the line's
+        diameter (the nodes on it sink into the contact spring, those next to the touchdown
+        point rise above it); the laid length sums the segments whose two nodes are on it, plus
+        half a segment where the line lifts off between two nodes.
+
+        Arguments:
+            positions: ``(particles, 3)`` positions (m).
+            seabed_z: the height of the seabed (m).
+
+        Returns:
+            The laid length (m, unstretched).
+        """
+        z = np.asarray(positions, dtype=float)[self.nodes, 2]
+        down = z <= seabed_z + 0.1 * self.line_type.diameter
+        segment = self.unstretched_length / len(self.segments)
+        both = int(np.sum(down[:-1] & down[1:]))
+        if both == 0:
+            return 0.0
+        # Lift-off between a node on the seabed and one above it: half a segment.
+        lift = int(np.sum(down[:-1] != down[1:]))
+        return segment * (both + 0.5 * lift)
+
+
+def _damping(line_type: LineType, segment: float) -> float:
+    """The dashpot coefficient BA / l (N s/m) of a segment of length ``segment``."""
+    ba = line_type.ba
+    if ba < 0.0:
+        if not math.isfinite(line_type.ea):
+            return 0.0
+        # MoorDyn: BA = zeta (L / N) sqrt(EA w).
+        ba = -ba * segment * math.sqrt(line_type.ea * line_type.mass_per_length)
+    return ba / segment
+
+
+def _initial_shape(a: np.ndarray, b: np.ndarray, line_type: LineType, length: float,
+                   segments: int, water: Water, seabed: Seabed | None) -> np.ndarray:
+    """Positions of the N + 1 nodes: on the closed-form catenary when it exists, else on a
+    parabola of arc length ``length`` sagging below the chord; the nodes on the seabed sunk by
+    the contact's static penetration w / (kbot d) (their contact force then carries them)."""
+    nodes = _guess(a, b, line_type, length, segments, water,
+                   seabed is not None and min(a[2], b[2]) <= -water.depth + 1e-6)
+    if seabed is not None and seabed.kbot > 0.0:
+        from vinculo.mooring.catenary import weight_in_water
+
+        w = weight_in_water(line_type.mass_per_length, line_type.diameter, water.density,
+                            water.gravity)
+        sink = max(w, 0.0) / (seabed.kbot * line_type.diameter)
+        down = nodes[:, 2] <= -water.depth + 1e-9
+        nodes[1:-1, 2] = np.where(down[1:-1], -water.depth - sink, nodes[1:-1, 2])
+    return nodes
+
+
+def _guess(a: np.ndarray, b: np.ndarray, line_type: LineType, length: float,
+           segments: int, water: Water, on_seabed: bool) -> np.ndarray:
+    """The catenary or the parabola of :func:`_initial_shape`."""
+    from vinculo.mooring.catenary import solve_catenary, weight_in_water
+
+    s = np.linspace(0.0, length, segments + 1)
+    low, high = (a, b) if a[2] <= b[2] else (b, a)
+    horizontal = high[:2] - low[:2]
+    span = float(np.hypot(*horizontal))
+    w = weight_in_water(line_type.mass_per_length, line_type.diameter, water.density,
+                        water.gravity)
+    try:
+        if span <= 0.0 or w <= 0.0:
+            raise InvalidInputError("no catenary")
+        cat = solve_catenary(span, float(high[2] - low[2]), length, w, line_type.ea,
+                             seabed_contact=on_seabed)
+        x, z = cat.profile(s)
+        heading = np.array([*horizontal / span, 0.0])
+        nodes = low + np.outer(x, heading) + np.outer(z, [0.0, 0.0, 1.0])
+        return nodes if low is a else nodes[::-1]
+    except (InvalidInputError, ValueError, ArithmeticError):
+        pass
+    # A parabola z = -4 f u (1 - u) below the chord, its sag f from the arc-length
+    # approximation L = c + 8 f^2 / (3 c) (c the chord), clipped at the seabed.
+    u = s / length
+    chord = float(np.linalg.norm(b - a))
+    sag = math.sqrt(max(3.0 * chord * (length - chord) / 8.0, 0.0))
+    nodes = a + np.outer(u, b - a) - np.outer(4.0 * sag * u * (1.0 - u), [0.0, 0.0, 1.0])
+    nodes[:, 2] = np.maximum(nodes[:, 2], -water.depth)
+    return nodes
+
+
+def add_line(system: Any, end_a: int, end_b: int, line_type: LineType,
+             unstretched_length: float | Law, segments: int, water: Water,
+             seabed: Seabed | None = None, name: str = "") -> Line:
+    """Add a line of ``segments`` elastic segments between two particles of ``system``.
+
+    Arguments:
+        system: the :class:`vinculo.System`.
+        end_a: the particle index of end A (a fixed, prescribed or free point).
+        end_b: the particle index of end B.
+        line_type: the line's properties.
+        unstretched_length: its unstretched length (m), or a law of time (a winch: every
+            segment keeps its share, 1 / segments, of the law's length).
+        segments: the number of segments N (>= 1).
+        water: the water (depth, density, gravity; the seabed at z = -depth).
+        seabed: the seabed contact (None: the line does not touch the seabed).
+        name: a name for messages.
+
+    Returns:
+        The :class:`Line`: its nodes, segment handles and results.
+
+    Raises:
+        InvalidInputError: for a non-positive length, diameter or mass per length, fewer than
+            one segment, or the same particle at both ends.
+    """
+    length0 = float(unstretched_length(0.0)) if isinstance(unstretched_length, Law) \
+        else float(unstretched_length)
+    label = name or "line"
+    checks = (("unstretched length", length0), ("diameter", line_type.diameter),
+              ("mass per length", line_type.mass_per_length), ("EA", line_type.ea))
+    for what, value in checks:
+        if not value > 0.0:
+            raise InvalidInputError(f"{label}: {what} = {value!r}: give a value > 0",
+                                    name=what, value=value)
+    if not (isinstance(segments, int) and segments >= 1):
+        raise InvalidInputError(f"{label}: {segments!r} segments: give an integer >= 1",
+                                name="segments", value=segments)
+    if end_a == end_b:
+        raise InvalidInputError(f"{label}: both ends are particle {end_a}: give two particles",
+                                name="end_b", value=end_b)
+    particles = system.particles()
+    q0 = np.asarray(system.initial_positions(), dtype=float)
+    a, b = q0[end_a], q0[end_b]
+    shape = _initial_shape(a, b, line_type, length0, segments, water, seabed)
+    segment = length0 / segments
+    mass = line_type.mass_per_length * segment
+    # The system's gravity (the water's is the same in a consistent model).
+    gravity = np.asarray(system.gravity, dtype=float)
+    nodes = [end_a]
+    for k in range(1, segments):
+        particle = system.add_particle(mass, tuple(float(c) for c in shape[k]))
+        nodes.append(particle.index)
+    nodes.append(end_b)
+    particles = system.particles()
+    handle = [particles[i] for i in nodes]
+    length_law = unstretched_length if isinstance(unstretched_length, Law) else length0
+    share = 1.0 / segments
+    links = [system.add_elastic_distance(handle[k], handle[k + 1], length_law, line_type.ea,
+                                         share)
+             for k in range(segments)]
+    damping = _damping(line_type, segment)
+    if damping > 0.0:
+        for k in range(segments):
+            system.add_spring_damper(handle[k], handle[k + 1], 0.0, damping, segment)
+    if line_type.ei > 0.0:
+        for k in range(1, segments):
+            system.add_bending(handle[k - 1], handle[k], handle[k + 1], line_type.ei, segment)
+    for k, node in enumerate(handle):
+        end = k in (0, segments)
+        piece = 0.5 * segment if end else segment
+        tangent = (handle[max(k - 1, 0)], handle[min(k + 1, segments)])
+        system.add_line_hydrodynamics(
+            node, diameter=line_type.diameter, length=piece, cd=line_type.cd,
+            cdax=line_type.cdax, ca=line_type.ca, caax=line_type.caax, density=water.density,
+            tangent=tangent)
+        if seabed is not None:
+            system.add_seabed_contact(
+                node, depth=water.depth, diameter=line_type.diameter, length=piece,
+                kbot=seabed.kbot, cbot=seabed.cbot, tangent=tangent, friction=seabed.friction,
+                axial_friction=seabed.axial_friction, friction_damping=seabed.friction_damping,
+                static_dynamic_scale=seabed.static_dynamic_scale)
+        if end:
+            system.add_force(node, tuple(float(c) for c in 0.5 * mass * gravity))
+    half = 0.5 * segment
+    displaced = water.density * math.pi * line_type.diameter**2 / 4.0 * half
+    load = (line_type.mass_per_length * half - displaced) * gravity
+    return Line(nodes=nodes, segments=links, line_type=line_type, unstretched_length=length0,
+                water=water, name=name, end_loads=(load, load.copy()))
