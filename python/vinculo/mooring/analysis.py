@@ -159,6 +159,8 @@ class MooringRun:
         solution: the :class:`vinculo.Solution` of the run.
         times: the stored times (s).
         end_forces: ``(times, lines, 2, 3)``: the force of each line on its end A and end B (N).
+        segment_tensions: ``(times, lines, 2)``: the tension of each line's first and last
+            segment (N).
         cpu_time: the CPU time of the time integration (s).
         dt: the step size (s).
         files: the files written (CSV, NetCDF, plots), by kind.
@@ -168,6 +170,7 @@ class MooringRun:
     solution: Any
     times: np.ndarray
     end_forces: np.ndarray
+    segment_tensions: np.ndarray
     cpu_time: float
     dt: float
     files: dict[str, Path] = field(default_factory=dict)
@@ -265,8 +268,10 @@ def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_en
     forces = np.stack(
         [np.stack([np.asarray(f, dtype=float).reshape(-1, 3) for f in line.end_forces(solution)],
                   axis=1) for line in built.lines], axis=1)
+    segment = np.stack([np.asarray(line.tensions(solution), dtype=float)[:, [0, -1]]
+                        for line in built.lines], axis=1)
     result = MooringRun(model=built, solution=solution, times=np.asarray(solution.times),
-                        end_forces=forces, cpu_time=cpu, dt=dt)
+                        end_forces=forces, segment_tensions=segment, cpu_time=cpu, dt=dt)
     if output is not None:
         folder = Path(output)
         folder.mkdir(parents=True, exist_ok=True)
