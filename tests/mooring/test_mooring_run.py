@@ -23,7 +23,7 @@ def _motion_file(tmp_path):
     return motion, motion.to_csv(tmp_path / "motion.csv", np.arange(0.0, 4.0001, 0.05))
 
 
-def test_run_moves_the_fairlead_and_writes_its_results(line_api, tmp_path, capsys):
+def test_run_moves_the_fairlead_and_writes_its_results(tmp_path, capsys):
     xarray = pytest.importorskip("xarray")
     motion, path = _motion_file(tmp_path)
     output = tmp_path / "out"
@@ -51,11 +51,9 @@ def test_run_moves_the_fairlead_and_writes_its_results(line_api, tmp_path, capsy
         assert (output / name).read_bytes()[:8] == PNG
 
 
-def test_run_api_returns_the_end_forces(line_api, tmp_path):
+def test_run_api_returns_the_end_forces(tmp_path):
     import vinculo.mooring as mooring
 
-    if line_api != "real":
-        pytest.skip("the stand-in's chain of exact distances is not in equilibrium at t = 0")
     _motion, path = _motion_file(tmp_path)
     result = mooring.run(HANGING, path, 1.0, dt=0.01)
     assert result.end_forces.shape == (result.times.size, 1, 2, 3)

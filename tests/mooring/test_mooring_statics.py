@@ -43,7 +43,7 @@ def _file(tmp_path, name, segments=None):
 
 @pytest.mark.parametrize(("name", "segments"), [("chain_on_seabed", 160), ("taut_line", 20),
                                                 ("hanging_line", 40)])
-def test_statics_csv_is_the_elastic_catenary(line_api, tmp_path, capsys, name, segments):
+def test_statics_csv_is_the_elastic_catenary(tmp_path, capsys, name, segments):
     path = _file(tmp_path, name, segments)
     model = read_moordyn(path)
     assert cli.main(["mooring", "statics", str(path), "--output", str(tmp_path / "out")]) == 0
@@ -72,7 +72,7 @@ def test_statics_csv_is_the_elastic_catenary(line_api, tmp_path, capsys, name, s
     assert abs(a["laid_length"] - cat.laid_length_stretched) <= segment
 
 
-def test_python_api_matches_the_command(line_api, tmp_path):
+def test_python_api_matches_the_command(tmp_path):
     import vinculo.mooring as mooring
 
     result = mooring.statics(DATA / "taut_line.txt")

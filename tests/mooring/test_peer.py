@@ -61,7 +61,7 @@ def test_a_slow_fairlead_motion_is_followed_quasi_statically(tmp_path):
     model = read_moordyn(path)
     start = np.array([model.points[1].position])
     motion = Motion.harmonic(start, (-1.0, 0.0, 0.0), period=200.0)
-    run = run_moordyn(path, motion, 50.0, dt_output=5.0, coupling_step=0.05, time_step=4e-4)
+    run = run_moordyn(path, motion, 50.0, dt_output=5.0, time_step=4e-4)
     assert run.error is None and run.times[-1] == pytest.approx(50.0)
     for i in (5, 10):  # t = 25 s and 50 s
         fairlead = motion.positions(run.times[i])[0]

@@ -159,6 +159,8 @@ class MooringRun:
         solution: the :class:`vinculo.Solution` of the run.
         times: the stored times (s).
         end_forces: ``(times, lines, 2, 3)``: the force of each line on its end A and end B (N).
+        segment_tensions: ``(times, lines, 2)``: the tension of each line's first and last
+            segment (N).
         cpu_time: the CPU time of the time integration (s).
         dt: the step size (s).
         files: the files written (CSV, NetCDF, plots), by kind.
@@ -168,6 +170,7 @@ class MooringRun:
     solution: Any
     times: np.ndarray
     end_forces: np.ndarray
+    segment_tensions: np.ndarray
     cpu_time: float
     dt: float
     files: dict[str, Path] = field(default_factory=dict)
@@ -262,11 +265,9 @@ def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_en
     started = time.process_time()
     solution = simulate(built.system, t_end, dt, progress=progress, **options)
     cpu = time.process_time() - started
-    forces = np.stack(
-        [np.stack([np.asarray(f, dtype=float).reshape(-1, 3) for f in line.end_forces(solution)],
-                  axis=1) for line in built.lines], axis=1)
+    forces, segment = _dynamic_end_loads(built.lines, solution)
     result = MooringRun(model=built, solution=solution, times=np.asarray(solution.times),
-                        end_forces=forces, cpu_time=cpu, dt=dt)
+                        end_forces=forces, segment_tensions=segment, cpu_time=cpu, dt=dt)
     if output is not None:
         folder = Path(output)
         folder.mkdir(parents=True, exist_ok=True)
@@ -279,6 +280,33 @@ def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_en
             result.files["shapes"] = plot_shapes(result, folder / "shapes.png")
             result.files["tensions_plot"] = plot_tensions(result, folder / "tensions.png")
     return result
+
+
+def _dynamic_end_loads(lines: list[Any], solution: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The end forces ``(times, lines, 2, 3)`` and end-segment tensions ``(times, lines, 2)`` of
+    a run, with the axial damping of the end segments (``BA`` times the rate of strain, a
+    dashpot beside each elastic segment) added to the elastic tension of the multipliers: the
+    tension a load cell at the end would measure, and MoorDyn's segment tension."""
+    from vinculo.mooring.line import _damping
+
+    q = np.asarray(solution.positions, dtype=float)
+    v = np.asarray(solution.velocities, dtype=float)
+    forces, tensions = [], []
+    for line in lines:
+        ends = [np.asarray(f, dtype=float).reshape(-1, 3) for f in line.end_forces(solution)]
+        elastic = np.asarray(line.tensions(solution), dtype=float)[:, [0, -1]].copy()
+        dashpot = _damping(line.line_type, line.unstretched_length / len(line.segments))
+        if dashpot > 0.0:
+            for e, (near, far) in enumerate(((line.nodes[0], line.nodes[1]),
+                                             (line.nodes[-1], line.nodes[-2]))):
+                chord = q[:, far] - q[:, near]
+                unit = chord / np.linalg.norm(chord, axis=1, keepdims=True)
+                rate = np.sum((v[:, far] - v[:, near]) * unit, axis=1)
+                elastic[:, e] += dashpot * rate
+                ends[e] = ends[e] + (dashpot * rate)[:, None] * unit
+        forces.append(np.stack(ends, axis=1))
+        tensions.append(elastic)
+    return np.stack(forces, axis=1), np.stack(tensions, axis=1)
 
 
 def _attributes(built: Any, dt: float) -> dict[str, Any]:

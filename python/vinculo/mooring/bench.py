@@ -20,7 +20,10 @@ For each case and number of segments, both codes run the same MoorDyn file:
 
 Each row reports the step, the CPU time of the time integration (``time.process_time``, the
 initial equilibrium excluded), the real-time factor (CPU time over simulated time), the error
-against the code's own reference, and the difference in end tension between the two codes.
+against the code's own reference, and the difference in end tension between the two codes. The
+end tensions compared are those of each line's first and last segments: the force on an end
+point also holds the loads the two codes lump differently on the end node (MoorDyn adds the
+drag and added mass of the half segment at a moving fairlead).
 
 Run it with ``python -m vinculo.mooring.bench [--segments 20,100] [--t-end 60]``; it writes
 ``bench.csv`` and ``bench.md`` (the README's table) into ``--output``.
@@ -232,7 +235,7 @@ def bench_moordyn(model: MoorDynFile, motion: Motion, t_end: float, dt_output: f
     error = _relative(timed.end_tensions, reference.end_tensions)
     row = BenchRow(case="", segments=model.lines[0].segments, code="moordyn", step=step,
                    cpu_time=timed.cpu_time, t_end=t_end, error=error, stable_step=stable)
-    return row, reference.times, reference.end_tensions
+    return row, reference.times, reference.segment_tensions
 
 
 def bench_vinculo(model: MoorDynFile, motion: Motion, t_end: float, target: float,
@@ -249,13 +252,13 @@ def bench_vinculo(model: MoorDynFile, motion: Motion, t_end: float, target: floa
         steps: the steps to try, largest first (s).
 
     Returns:
-        ``(row, end tensions on the grid at the chosen step)``.
+        ``(row, end-segment tensions on the grid at the chosen step)``.
     """
     from vinculo.mooring.analysis import run
 
     def tensions(dt: float) -> tuple[np.ndarray, float]:
         result = run(model, motion, t_end, dt=dt)
-        return _on(result.times, result.end_tensions, grid), result.cpu_time
+        return _on(result.times, result.segment_tensions, grid), result.cpu_time
 
     reference, _ = tensions(min(steps) / 4)
     chosen = None

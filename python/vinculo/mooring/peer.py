@@ -11,7 +11,8 @@ file in a temporary folder; its console messages are silenced.
 
 MoorDyn integrates explicitly (second-order Runge-Kutta by default) with the time step ``dtM``;
 each call of its ``Step`` advances the coupling interval in steps of at most ``dtM``, moving the
-coupled points with the position and velocity given at the start of the interval.
+coupled points with the position and velocity given at the start of the interval (every
+:data:`COUPLING_STEP` by default, as a coupled simulation would call it).
 """
 
 from __future__ import annotations
@@ -33,7 +34,18 @@ from vinculo.errors import InvalidInputError, VinculoError
 from vinculo.mooring.moordyn_file import MoorDynFile, read_moordyn, write_moordyn
 from vinculo.mooring.motion import Motion
 
-__all__ = ["PeerError", "PeerRun", "largest_stable_step", "moordyn_available", "run_moordyn"]
+__all__ = [
+    "COUPLING_STEP",
+    "PeerError",
+    "PeerRun",
+    "largest_stable_step",
+    "moordyn_available",
+    "run_moordyn",
+]
+
+
+#: The default interval between calls of MoorDyn's Step (s).
+COUPLING_STEP = 0.01
 
 
 class PeerError(VinculoError, RuntimeError):
@@ -95,6 +107,9 @@ class PeerRun:
         end_forces: ``(times, lines, 2, 3)``: the force of each line on its end A (index 0)
             and end B (index 1), in N, the sum of the line's tension and of the loads on its
             end node (MoorDyn lumps half a segment at each end node).
+        segment_tensions: ``(times, lines, 2)``: the tension of each line's first and last
+            segment (N), the line's own tension at its ends without the loads MoorDyn lumps on
+            the end nodes (their weight, drag and added mass).
         node_positions: for each line, ``(times, nodes, 3)`` positions (m); empty when not
             stored.
         time_step: MoorDyn's time step dtM (s).
@@ -107,6 +122,7 @@ class PeerRun:
 
     times: np.ndarray
     end_forces: np.ndarray
+    segment_tensions: np.ndarray
     node_positions: list[np.ndarray] = field(default_factory=list)
     time_step: float = math.nan
     coupling_step: float = math.nan
@@ -137,12 +153,15 @@ def _model_and_file(source: str | Path | MoorDynFile, folder: Path,
     return model, path
 
 
-def _end_forces(md, lines: list, sizes: list[int]) -> np.ndarray:
-    out = np.empty((len(lines), 2, 3))
+def _end_forces(md, lines: list, sizes: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    forces = np.empty((len(lines), 2, 3))
+    tensions = np.empty((len(lines), 2))
     for k, (line, n) in enumerate(zip(lines, sizes, strict=True)):
-        out[k, 0] = md.GetLineNodeForce(line, 0)
-        out[k, 1] = md.GetLineNodeForce(line, n)
-    return out
+        forces[k, 0] = md.GetLineNodeForce(line, 0)
+        forces[k, 1] = md.GetLineNodeForce(line, n)
+        tensions[k, 0] = np.linalg.norm(md.GetLineNodeTen(line, 0))
+        tensions[k, 1] = np.linalg.norm(md.GetLineNodeTen(line, n))
+    return forces, tensions
 
 
 def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: float, *,
@@ -156,7 +175,10 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
         t_end: the end time (s).
         dt_output: the interval between stored outputs (s).
         coupling_step: the interval between calls of MoorDyn's Step (s; default
-            ``dt_output``): MoorDyn extrapolates the coupled points linearly over it.
+            :data:`COUPLING_STEP`, or dtM when larger, at most ``dt_output``): MoorDyn moves the
+            coupled points at the constant velocity given at the start of each call, so the
+            velocity jumps from one call to the next; too long an interval (0.1 s on the
+            hanging chain) excites the stiff, damped axial modes and changes the tensions.
         time_step: MoorDyn's time step dtM (s; default: the file's).
         store_shapes: also store every line's node positions at each output time.
 
@@ -172,11 +194,12 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
     if not (math.isfinite(t_end) and t_end > 0.0 and dt_output > 0.0):
         raise InvalidInputError(f"run_moordyn: t_end = {t_end!r} and dt_output = {dt_output!r} "
                                 f"must be positive", name="t_end", value=t_end)
-    coupling = float(coupling_step or dt_output)
-    per_output = max(1, round(dt_output / coupling))
-    coupling = dt_output / per_output
     with tempfile.TemporaryDirectory(prefix="vinculo-moordyn-") as folder:
         model, path = _model_and_file(source, Path(folder), time_step)
+        dtm = model.options.time_step if model.options.time_step is not None else 1e-3
+        coupling = float(coupling_step or min(dt_output, max(COUPLING_STEP, dtm)))
+        per_output = max(1, round(dt_output / coupling))
+        coupling = dt_output / per_output
         coupled = model.coupled_points()
         if motion is None:
             motion = Motion.still([p.position for p in coupled])
@@ -189,7 +212,6 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
             raise InvalidInputError(
                 f"{motion.source} covers t = {start:g} to {end:g} s; the run needs 0 to "
                 f"{t_end:g} s", name="t_end", value=t_end)
-        dtm = model.options.time_step if model.options.time_step is not None else 1e-3
         with _silenced():
             try:
                 system = md.Create(str(path))
@@ -207,11 +229,12 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
                 outputs = math.floor(t_end / dt_output + 1e-9) + 1
                 times = np.arange(outputs) * dt_output
                 forces = np.full((outputs, len(lines), 2, 3), np.nan)
+                segment = np.full((outputs, len(lines), 2), np.nan)
                 shapes = [np.full((outputs, n + 1, 3), np.nan) for n in sizes] if store_shapes \
                     else []
 
                 def record(i: int) -> None:
-                    forces[i] = _end_forces(md, lines, sizes)
+                    forces[i], segment[i] = _end_forces(md, lines, sizes)
                     for k, (line, n) in enumerate(zip(lines, sizes, strict=True)):
                         if store_shapes:
                             shapes[k][i] = [md.GetLineNodePos(line, j) for j in range(n + 1)]
@@ -236,19 +259,21 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
                         cpu += time.process_time() - tick
                         t += coupling
                     if error is not None:
-                        times, forces = times[:i], forces[:i]
+                        times, forces, segment = times[:i], forces[:i], segment[:i]
                         shapes = [s[:i] for s in shapes]
                         break
                     record(i)
                     if not np.all(np.isfinite(forces[i])):
                         error = f"MoorDyn's forces are not finite at t = {times[i]:g} s"
                         times, forces = times[: i + 1], forces[: i + 1]
+                        segment = segment[: i + 1]
                         shapes = [s[: i + 1] for s in shapes]
                         break
             finally:
                 md.Close(system)
     steps = (times.size - 1) * per_output * math.ceil(coupling / dtm - 1e-9)
-    return PeerRun(times=times, end_forces=forces, node_positions=shapes, time_step=dtm,
+    return PeerRun(times=times, end_forces=forces, segment_tensions=segment,
+                   node_positions=shapes, time_step=dtm,
                    coupling_step=coupling, cpu_time=cpu, initial_cpu_time=initial_cpu,
                    steps=steps, error=error)
 
