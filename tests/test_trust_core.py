@@ -7,6 +7,7 @@ fact against an independent reference named in its comment.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -310,6 +311,9 @@ def test_unstable_generalized_alpha_raises_instead_of_reporting_success():
         {"scheme": "generalized-alpha", "rho_inf": 0.9, "formulation": "ggl"},
         {"scheme": "generalized-alpha", "rho_inf": 0.5},
         {"scheme": "trapezoidal"},
+        # The defaults: index-3 generalised-alpha without rho_inf is the stable 0.5, GGL 0.9.
+        {"scheme": "generalized-alpha"},
+        {"scheme": "generalized-alpha", "formulation": "ggl"},
     ],
 )
 def test_the_advised_choices_are_stable_at_the_same_step(options):
@@ -322,6 +326,19 @@ def test_the_advised_choices_are_stable_at_the_same_step(options):
     energy = solution.energy() / G
     assert np.max(energy - energy[0]) < 1e-2
     assert np.min(energy - energy[0]) > -0.2
+
+
+@pytest.mark.parametrize("formulation, rho_inf", [("index-3", 0.5), ("ggl", 0.9)])
+def test_the_default_rho_inf_is_the_stable_choice_of_each_formulation(formulation, rho_inf):
+    # The defaults come from the measured stability table of docs/theory/time-rules.md: index-3
+    # generalised-alpha at 0.5 (stable from 10 steps a period), GGL at 0.9 (stable at every step).
+    # A run without rho_inf is the run with that value, bit for bit.
+    run = functools.partial(
+        vinculo.simulate, _pendulum(), t_end=2.0, dt=0.05, scheme="generalized-alpha"
+    )
+    default = run(formulation=formulation)
+    explicit = run(formulation=formulation, rho_inf=rho_inf)
+    np.testing.assert_array_equal(default.positions, explicit.positions)
 
 
 def test_an_adaptive_step_below_the_resolution_of_t_stops_with_a_typed_error():

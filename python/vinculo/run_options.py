@@ -28,8 +28,12 @@ class RunOptions:
             generalised-alpha scheme of Arnold and Brüls for index-3 systems: second order, with
             numerical damping of the high frequencies set by ``rho_inf``).
         rho_inf: spectral radius at infinite frequency of 'generalized-alpha', in [0, 1]
-            (default 0.9): 1 adds no numerical damping, 0 removes the highest frequencies in one
-            step; the low frequencies are barely damped in every case.
+            (default 0.5 with the index-3 formulation, 0.9 with 'ggl'): 1 adds no numerical
+            damping, 0 removes the highest frequencies in one step; the low frequencies are barely
+            damped in every case. Index-3 generalised-alpha is unstable at coarse steps for large
+            ``rho_inf`` (0.9 needs about 100 steps per period of the fastest resolved motion, 0.5
+            about 10: docs/theory/time-rules.md), hence its smaller default; the GGL form is stable
+            at every ``rho_inf`` measured.
         formulation: 'index-3' (default: position constraints only, the velocities satisfy
             ``Phi_q v + Phi_t = 0`` to the scheme's accuracy) or 'ggl' (the stabilised index-2
             formulation of Gear, Gupta and Leimkuhler: the velocity constraints are added with a
