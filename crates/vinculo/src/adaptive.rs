@@ -144,7 +144,9 @@ impl ErrorControl {
     /// step doubling ([`crate::integrators::error_estimate`]): two steps of h/2 from the same
     /// start with the rule's state before the step `rule`, whose difference from the step gives
     /// its local error. `Ok(true)` when the weighted error is at most 1, `Ok(false)` when the
-    /// step must be retried; `ws.state` holds the step's own end state again on return.
+    /// step must be retried (a half step whose Newton iterations fail counts as an infinite
+    /// error); `ws.state` holds the step's own end state again on return. `acc`: the start's
+    /// accelerations, for the half steps' predictor; `newton`: the run's Newton options;
     /// `stabilized`: the GGL workspace of a GGL run (whose matrix is not the index-3 one the
     /// projection needs).
     #[allow(clippy::too_many_arguments)]
@@ -262,10 +264,11 @@ impl ErrorControl {
 }
 
 /// Replaces the vectors `a` (one per particle) by their part tangent to the constraints, with the
-/// factorisation of the step's last Newton matrix `[M/m_ref + K, -s G^T; s G, 0]` (K = O(h^2)):
-/// solving it with the right-hand side `[M a / m_ref; 0]` gives x with G x = 0 and
-/// (M/m_ref + K) x = M a / m_ref + s G^T mu, the M-orthogonal projection of a onto the tangent
-/// space up to O(h^2). What is left out is the acceleration the multipliers impose normal to the
+/// factorised matrix of the workspace: the step's last Newton matrix
+/// `[M/m_ref + K, -s G^T; s G, 0]` (K = O(h^2)) or the saddle matrix `[M/m_ref, -s G^T; s G, 0]`
+/// of [`factor_saddle`]. Solving it with the right-hand side `[M a / m_ref; 0]` gives x with
+/// G x = 0 and (M/m_ref + K) x = M a / m_ref + s G^T mu, the M-orthogonal projection of a onto
+/// the tangent space (up to O(h^2) with K). What is left out is the part of a normal to the
 /// constraints (see `integrators::error_estimate` for why the estimate needs it gone).
 fn tangential(ws: &mut StepWorkspace, a: &mut [Vec3], rhs: &mut [f64]) {
     rhs.fill(0.0);
