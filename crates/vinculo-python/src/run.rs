@@ -247,12 +247,7 @@ impl PyRunSettings {
             t_start,
             t_end,
             dt,
-            scheme: scheme_by_name(
-                scheme,
-                alpha,
-                rho_inf,
-                formulation_by_name(formulation)?,
-            )?,
+            scheme: scheme_by_name(scheme, alpha, rho_inf, formulation_by_name(formulation)?)?,
             formulation: formulation_by_name(formulation)?,
             newton: NewtonOptions {
                 tolerance,
