@@ -66,15 +66,16 @@ class RunOptions:
             not multipliers) and a PI controller so that each step meets ``rtol`` and ``atol``;
             ``dt`` is then the first step. False: fixed steps of ``dt`` (halved where Newton fails).
             The estimate is step doubling: each step is taken again as two half steps, whose
-            difference gives its local error (three Newton solves per step). Its weighted RMS
+            difference gives its local error (three Newton solves per step); the run goes on
+            from the two half steps' answer, the more accurate one. Its weighted RMS
             norm over the free coordinates, with the weights ``atol + rtol |q|`` for positions
             (counted per unit step: times ``T / h``, ``T = L / U``, ``L = system.length_scale()``,
             ``U`` the speed scale of ``initial_tolerance``) and ``atol U / L + rtol |v|`` for
             velocities (per step), must be <= 1. A rejected step is retried smaller
             (``Solution.steps_rejected`` counts them). Newton's tolerance is lowered to a
             hundredth of ``min(rtol, atol / L)`` when that is smaller. The position error of a run
-            is then about proportional to the tolerance, from 1e-3 down to 1e-10 (measured: 5 to
-            40 times it for the trapezoidal rule, up to 174 for generalised-alpha on runs of 5 to 6
+            is then about proportional to the tolerance, from 1e-3 down to 1e-10 (measured: 2 to
+            12 times it for the trapezoidal rule, up to 50 for generalised-alpha on runs of 5 to 6
             time scales ``T``; docs/theory/adaptive.md). Index-3 velocities drift off the
             velocity constraints by more: ``formulation='ggl'`` holds them.
         rtol: relative tolerance of adaptive steps, in (0, 1).

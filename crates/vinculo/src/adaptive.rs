@@ -3,7 +3,7 @@
 //! (`docs/theory/adaptive.md`).
 //!
 //! Each converged step's local error is estimated by step doubling (two half steps from the same
-//! start, [`crate::integrators::error_estimate`]; the step's own answer is kept) and weighed
+//! start, [`crate::integrators::error_estimate`]; the two halves' answer is kept) and weighed
 //! ([`crate::step_control`]): Newton's tolerance follows rtol and atol
 //! ([`crate::step_control::AdaptiveOptions::newton_tolerance`]); a step with err <= 1 is accepted, one above is rejected and
 //! retried with the PI controller's smaller step, one whose Newton iterations fail is retried with
@@ -60,8 +60,11 @@ pub(crate) struct ErrorControl {
     pub(crate) q_big: Vec<Vec3>,
     pub(crate) v_big: Vec<Vec3>,
     pub(crate) lambda_big: Vec<f64>,
+    /// The state between the two half steps (t + h/2) of the step last judged: the accepted
+    /// step's dense output interpolates through it.
     pub(crate) q_mid: Vec<Vec3>,
     pub(crate) v_mid: Vec<Vec3>,
+    pub(crate) lambda_mid: Vec<f64>,
 }
 
 impl ErrorControl {
@@ -94,6 +97,7 @@ impl ErrorControl {
             lambda_big: Vec::new(),
             q_mid: acc.to_vec(),
             v_mid: acc.to_vec(),
+            lambda_mid: Vec::new(),
         }
     }
 
@@ -143,12 +147,13 @@ impl ErrorControl {
     /// Judges a converged step of size `h` from (t, q, v) (the end state in `ws.state`) by
     /// step doubling ([`crate::integrators::error_estimate`]): two steps of h/2 from the same
     /// start with the rule's state before the step `rule`, whose difference from the step gives
-    /// its local error. `Ok(true)` when the weighted error is at most 1, `Ok(false)` when the
-    /// step must be retried (a half step whose Newton iterations fail counts as an infinite
-    /// error); `ws.state` holds the step's own end state again on return. `acc`: the start's
-    /// accelerations, for the half steps' predictor; `newton`: the run's Newton options;
-    /// `stabilized`: the GGL workspace of a GGL run (whose matrix is not the index-3 one the
-    /// projection needs).
+    /// its local error. `Ok(true)` when the weighted error is at most 1: `ws.state` then holds
+    /// the two half steps' end state (the more accurate answer, which the run keeps: its rule
+    /// state and end accelerations come from [`ErrorControl::adopt`], its state at t + h/2 from
+    /// [`ErrorControl::midpoint`]). `Ok(false)` when the step must be retried (a half step whose
+    /// Newton iterations fail counts as an infinite error). `acc`: the start's accelerations,
+    /// for the half steps' predictor; `newton`: the run's Newton options; `stabilized`: the GGL
+    /// workspace of a GGL run (whose matrix is not the index-3 one the projection needs).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn judge(
         &mut self,
@@ -176,6 +181,8 @@ impl ErrorControl {
             if k == 1 {
                 self.q_mid.copy_from_slice(&ws.state.q);
                 self.v_mid.copy_from_slice(&ws.state.v);
+                self.lambda_mid.clear();
+                self.lambda_mid.extend_from_slice(&ws.state.lambda);
             }
             let (q_k, v_k): (&[Vec3], &[Vec3]) = if k == 0 {
                 (q, v)
@@ -198,28 +205,23 @@ impl ErrorControl {
                 break;
             }
         }
-        if converged {
-            // Richardson: the step's error C h^(p+1) exceeds that of the two halves by
-            // (1 - 2^-p) C h^(p+1).
-            let factor = richardson_factor(self.scheme.order());
-            for i in 0..q.len() {
-                for c in 0..3 {
-                    self.e_q[i][c] = factor * (self.q_big[i][c] - ws.state.q[i][c]);
-                    self.e_v[i][c] = factor * (self.v_big[i][c] - ws.state.v[i][c]);
-                }
-            }
-        }
-        // The step's own end state back in place.
-        ws.state.q.copy_from_slice(&self.q_big);
-        ws.state.v.copy_from_slice(&self.v_big);
-        ws.state.lambda.copy_from_slice(&self.lambda_big);
         if !converged {
             self.err = f64::INFINITY;
             return Ok(false);
         }
+        // Richardson: the step's error C h^(p+1) exceeds that of the two halves by
+        // (1 - 2^-p) C h^(p+1).
+        let factor = richardson_factor(self.scheme.order());
+        for i in 0..q.len() {
+            for c in 0..3 {
+                self.e_q[i][c] = factor * (self.q_big[i][c] - ws.state.q[i][c]);
+                self.e_v[i][c] = factor * (self.v_big[i][c] - ws.state.v[i][c]);
+            }
+        }
         if stabilized.is_some() {
             // The GGL steps factorised their own matrix: the projection needs the index-3
-            // workspace's [M/m_ref, -s G^T; s G, 0] at the step's end.
+            // workspace's [M/m_ref, -s G^T; s G, 0] at the step's end (the one step's positions
+            // serve: both answers hold the constraints).
             factor_saddle(system, ws, &self.q_big, t + h)?;
         }
         tangential(ws, &mut self.e_q, &mut self.projection);
@@ -230,11 +232,26 @@ impl ErrorControl {
         factor_saddle(system, ws, q, t)?;
         ws.matrix.invalidate();
         tangential(ws, &mut self.e_v, &mut self.projection);
-        let ends = [(q, v), (&self.q_big[..], &self.v_big[..])];
+        let ends = [(q, v), (&ws.state.q[..], &ws.state.v[..])];
         self.err = self
             .weights
             .norm(h, &self.free, (&self.e_q, &self.e_v), ends);
         Ok(!self.err.is_nan() && self.err <= 1.0)
+    }
+
+    /// After [`ErrorControl::judge`] accepted a step of size `h` from `t` whose two half steps
+    /// ended with velocities `v`: the rule's state after them into `rule`, and the end
+    /// accelerations (the next step's predictor) into `acc`.
+    pub(crate) fn adopt(&self, t: f64, h: f64, v: &[Vec3], rule: &mut RuleState, acc: &mut [Vec3]) {
+        let rule_half = self.rule_half.as_ref().expect("set by judge");
+        rule.copy_from(rule_half);
+        let start = StepStart::new(t + 0.5 * h, &self.q_mid, &self.v_mid, 0.5 * h);
+        self.scheme.end_acceleration(rule_half, start, v, acc);
+    }
+
+    /// The state (q, v, lambda) at t + h/2 of the step last accepted, between its half steps.
+    pub(crate) fn midpoint(&self) -> (&[Vec3], &[Vec3], &[f64]) {
+        (&self.q_mid, &self.v_mid, &self.lambda_mid)
     }
 
     /// After a step of size `h` from `t` failed the error test: `Ok` with a smaller next step,

