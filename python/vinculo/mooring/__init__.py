@@ -28,7 +28,6 @@ from vinculo.mooring.catenary import CatenarySolution, solve_catenary, weight_in
 from vinculo.mooring.model import MooringModel, build_model
 from vinculo.mooring.moordyn_file import (
     FileLine,
-    FileLineType,
     FileOptions,
     FilePoint,
     MoorDynFile,
@@ -69,7 +68,6 @@ the module of the equilibrium solver (``vinculo.mooring.statics.solve_statics``)
 __all__ = [
     "CatenarySolution",
     "FileLine",
-    "FileLineType",
     "FileOptions",
     "FilePoint",
     "MoorDynFile",

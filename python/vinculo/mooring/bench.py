@@ -42,9 +42,9 @@ from pathlib import Path
 
 import numpy as np
 
+from vinculo.mooring.line import LineType
 from vinculo.mooring.moordyn_file import (
     FileLine,
-    FileLineType,
     FileOptions,
     FilePoint,
     MoorDynFile,
@@ -71,7 +71,7 @@ def chain_on_seabed(segments: int = 63) -> MoorDynFile:
     Returns:
         The model.
     """
-    chain = FileLineType("chain", 0.137, 126.0, 5.0e8, -1.0, 0.0, 2.4, 1.0, 1.15, 0.5)
+    chain = LineType("chain", 0.137, 126.0, 5.0e8, -1.0, 0.0, 2.4, 1.0, 1.15, 0.5)
     return MoorDynFile(
         line_types={"chain": chain},
         points=(FilePoint(1, "fixed", (-300.0, 0.0, -50.0)),
@@ -90,7 +90,7 @@ def hanging_line(segments: int = 20) -> MoorDynFile:
     Returns:
         The model.
     """
-    chain = FileLineType("chain", 0.05, 20.0, 1.0e8, -1.0, 0.0, 2.4, 1.0, 1.15, 0.5)
+    chain = LineType("chain", 0.05, 20.0, 1.0e8, -1.0, 0.0, 2.4, 1.0, 1.15, 0.5)
     return MoorDynFile(
         line_types={"chain": chain},
         points=(FilePoint(1, "fixed", (-40.0, 0.0, -20.0)),
@@ -109,7 +109,7 @@ def bending_line(segments: int = 20) -> MoorDynFile:
     Returns:
         The model.
     """
-    cable = FileLineType("cable", 0.15, 40.0, 5.0e8, -1.0, 2.0e4, 1.2, 1.0, 0.01, 0.0)
+    cable = LineType("cable", 0.15, 40.0, 5.0e8, -1.0, 2.0e4, 1.2, 1.0, 0.01, 0.0)
     return MoorDynFile(
         line_types={"cable": cable},
         points=(FilePoint(1, "fixed", (-12.5, 0.0, -30.0)),

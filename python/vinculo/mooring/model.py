@@ -25,34 +25,17 @@ from typing import Any
 from vinculo._core import ParticleId, System
 from vinculo.errors import InvalidInputError
 from vinculo.mooring.moordyn_file import (
-    FileLineType,
     FileOptions,
     MoorDynFile,
     read_moordyn,
 )
 from vinculo.mooring.motion import Motion
 
-__all__ = ["MooringModel", "build_model", "line_type", "seabed", "water"]
+__all__ = ["MooringModel", "build_model", "seabed", "water"]
 
 # A particle needs a positive mass; a point of the file without one gets this (kg), to which
 # the lines add the lumped mass of their end segments.
 _POINT_MASS_FLOOR = 1e-6
-
-
-def line_type(row: FileLineType) -> Any:
-    """The line type of a LINE TYPES row, as :func:`vinculo.mooring.line.add_line` takes it.
-
-    Arguments:
-        row: the row.
-
-    Returns:
-        A :class:`vinculo.mooring.line.LineType` with the same values (SI units).
-    """
-    from vinculo.mooring.line import LineType
-
-    return LineType(name=row.name, diameter=row.diameter, mass_per_length=row.mass_per_length,
-                    ea=row.ea, ba=row.ba, ei=row.ei, cd=row.cd, ca=row.ca, cdax=row.cdax,
-                    caax=row.caax)
 
 
 def water(options: FileOptions) -> Any:
@@ -195,7 +178,7 @@ def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, 
     for row in model.lines:
         lines.append(add_line(
             system, points[row.attach_a - 1].index, points[row.attach_b - 1].index,
-            line_type(model.line_types[row.line_type]), row.unstretched_length, row.segments,
+            model.line_types[row.line_type], row.unstretched_length, row.segments,
             the_water, the_seabed, name=f"line {row.id}"))
     built = MooringModel(file=model, system=system, points=points, lines=lines, motion=motion,
                          coupling_constraints=coupling)

@@ -27,11 +27,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from vinculo.errors import MooringFileError
+from vinculo.mooring.line import LineType
 
 __all__ = [
     "ATTACHMENTS",
     "FileLine",
-    "FileLineType",
     "FileOptions",
     "FilePoint",
     "MoorDynFile",
@@ -101,36 +101,6 @@ _UNSUPPORTED_SECTIONS = {
     "control": "control channels",
     "external_loads": "external loads",
 }
-
-
-@dataclass(frozen=True)
-class FileLineType:
-    """A row of the LINE TYPES section.
-
-    Arguments:
-        name: the type's name, referred to by the LINES rows.
-        diameter: the volume-equivalent diameter (m).
-        mass_per_length: the mass per unit length in air (kg/m).
-        ea: the axial stiffness (N).
-        ba: the internal axial damping (N s), or, when negative, minus the damping ratio of each
-            segment's axial mode (MoorDyn's BA/-zeta column).
-        ei: the bending stiffness (N m^2).
-        cd: the transverse drag coefficient (on the frontal area d l).
-        ca: the transverse added-mass coefficient.
-        cdax: the tangential drag coefficient (on the surface area pi d l).
-        caax: the tangential added-mass coefficient.
-    """
-
-    name: str
-    diameter: float
-    mass_per_length: float
-    ea: float
-    ba: float = 0.0
-    ei: float = 0.0
-    cd: float = 0.0
-    ca: float = 0.0
-    cdax: float = 0.0
-    caax: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -229,7 +199,7 @@ class MoorDynFile:
         path: the file read (None for a model parsed from text or built in code).
     """
 
-    line_types: dict[str, FileLineType]
+    line_types: dict[str, LineType]
     points: tuple[FilePoint, ...]
     lines: tuple[FileLine, ...]
     options: FileOptions = field(default_factory=FileOptions)
@@ -373,7 +343,7 @@ _LINE_TYPE_COLUMNS = ("TypeName", "Diam", "Mass/m", "EA", "BA/-zeta", "EI", "Cd"
                       "CaAx")
 
 
-def _line_type(path: str, line: _Line, fields: list[str]) -> FileLineType:
+def _line_type(path: str, line: _Line, fields: list[str]) -> LineType:
     _check_columns(path, line, fields, _LINE_TYPE_COLUMNS, "LINE TYPES")
     cols = dict(zip(_LINE_TYPE_COLUMNS, fields, strict=False))
     if len(fields) > len(_LINE_TYPE_COLUMNS):
@@ -391,7 +361,7 @@ def _line_type(path: str, line: _Line, fields: list[str]) -> FileLineType:
     for column in ("EI", "Cd", "Ca", "CdAx", "CaAx"):
         values[column] = _positive(path, line, column,
                                    _number(path, line, column, cols[column]), allow_zero=True)
-    return FileLineType(name=name, diameter=diameter, mass_per_length=mass, ea=ea, ba=ba,
+    return LineType(name=name, diameter=diameter, mass_per_length=mass, ea=ea, ba=ba,
                         ei=values["EI"], cd=values["Cd"], ca=values["Ca"],
                         cdax=values["CdAx"], caax=values["CaAx"])
 
@@ -566,7 +536,7 @@ def parse_moordyn(text: str, path: str | Path = "<text>") -> MoorDynFile:
     """
     name = str(path)
     title = ""
-    line_types: dict[str, FileLineType] = {}
+    line_types: dict[str, LineType] = {}
     points: list[FilePoint] = []
     lines: list[FileLine] = []
     options = FileOptions()
