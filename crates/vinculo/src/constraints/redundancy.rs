@@ -257,12 +257,8 @@ mod explain_tests {
     /// at the mass and force block and no longer suspects the constraint.
     #[test]
     fn a_singular_matrix_is_blamed_on_what_its_structure_shows() {
-        let mut s = System::new([0.0, 0.0, -9.81]);
-        let a = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
-        let b = s
-            .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], false)
-            .unwrap();
-        s.add_distance(a, b, None).unwrap();
+        let mut s = crate::integrators::fixtures::pendulum();
+        let (a, b) = (s.particle_id(0).unwrap(), s.particle_id(1).unwrap());
         let q = s.initial_positions();
         match explain_singular(&s, &q, 0.5, singular()) {
             Error::SingularMatrix { detail, .. } => {

@@ -110,18 +110,9 @@ impl EnergyGuard {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrators::fixtures::pendulum;
     use crate::integrators::Scheme;
     use crate::{simulate, SimulationOptions};
-
-    fn pendulum() -> System {
-        let mut s = System::new([0.0, 0.0, -9.81]);
-        let a = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
-        let b = s
-            .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], false)
-            .unwrap();
-        s.add_distance(a, b, None).unwrap();
-        s
-    }
 
     /// The pendulum's period from the horizontal, 4 sqrt(L/g) K(1/2) with K(1/2) = 1.854075
     /// (the complete elliptic integral of the first kind at m = 1/2).

@@ -136,6 +136,18 @@ pub(crate) fn perturbed_iterate(ws: &mut StepWorkspace, q_n: &[Vec3]) {
     ws.state.lambda = vec![0.8, -1.2, 0.5, 2.0, -0.7];
 }
 
+/// A 1 m pendulum released from the horizontal: a 1 kg particle at (1, 0, 0), at rest, on a
+/// distance to a fixed anchor at the origin (particle 0), under g = 9.81 m/s^2 along -z.
+pub(crate) fn pendulum() -> System {
+    let mut s = System::new([0.0, 0.0, -9.81]);
+    let a = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
+    let b = s
+        .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], false)
+        .unwrap();
+    s.add_distance(a, b, None).unwrap();
+    s
+}
+
 /// A horizontal chain of `n` point masses (0.1 m links, 0.1 kg) from a fixed anchor.
 pub(crate) fn chain(n: usize) -> System {
     let mut s = System::new([0.0, 0.0, -9.81]);

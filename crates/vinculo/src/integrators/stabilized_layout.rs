@@ -244,12 +244,7 @@ mod tests {
     /// (D,lambda), (Phi,q), (Psi,q) and (Psi,v): 45 in all.
     #[test]
     fn pendulum_pattern_has_the_expected_entries() {
-        let mut s = System::new([0.0, 0.0, -9.81]);
-        let a = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
-        let b = s
-            .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], false)
-            .unwrap();
-        s.add_distance(a, b, None).unwrap();
+        let s = crate::integrators::fixtures::pendulum();
         let layout = StabilizedLayout::new(&s, 0);
         assert_eq!(layout.unknowns(), 8);
         assert_eq!(layout.pattern.nnz(), 45);

@@ -1012,12 +1012,8 @@ mod tests {
     /// reported as singular, naming an unknown of that particle's block.
     #[test]
     fn singular_block_is_reported() {
-        let mut s = System::new([0.0, 0.0, -9.81]);
-        let a = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
-        let b = s
-            .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], false)
-            .unwrap();
-        s.add_distance(a, b, None).unwrap();
+        let mut s = crate::integrators::fixtures::pendulum();
+        let b = s.particle_id(1).unwrap();
         s.add_fixed_coordinate(b, 1, None).unwrap();
         s.add_fixed_coordinate(b, 1, None).unwrap();
         let layout = Layout::new(&s, 0);
