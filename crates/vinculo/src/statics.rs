@@ -30,7 +30,7 @@
 //! `(J^-1)_pp = S^-1`, so three solves with the factorised J give it.
 
 use crate::error::{Error, Result};
-use crate::integrators::newton::{self, NewtonFailure, NewtonOptions, NewtonProblem};
+use crate::integrators::newton::{self, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem};
 use crate::integrators::{Index3Rule, StepPoint, StepProblem, StepStart, StepWorkspace};
 use crate::math::{Mat3, Vec3};
 use crate::model::System;
@@ -148,13 +148,14 @@ fn row_scale(system: &System, mass_ref: f64) -> f64 {
     }
 }
 
-/// One Newton solve of the (pseudo-)static equations from the workspace's iterate.
-fn newton_solve(
+/// Runs `f` on the (pseudo-)static problem of parameter `mu` at time `t`, from the positions
+/// `previous` of the last pseudo-step, at the workspace's iterate.
+fn with_static_problem<'p, T>(
     system: &System,
     ws: &mut StepWorkspace,
-    (t, mu, previous): (f64, f64, &[Vec3]),
-    options: &NewtonOptions,
-) -> std::result::Result<newton::NewtonReport, NewtonFailure> {
+    (t, mu, previous): (f64, f64, &'p [Vec3]),
+    f: impl FnOnce(StepProblem<'_, StaticRule<'p>>, LinearWork<'_>) -> T,
+) -> T {
     let sigma = row_scale(system, ws.mass_ref);
     let zero = vec![[0.0; 3]; previous.len()];
     let start = StepStart::new(t, previous, &zero, 1.0);
@@ -164,27 +165,29 @@ fn newton_solve(
         sigma,
     };
     let rule = StaticRule { mu, previous };
+    let (problem, work) = StepProblem::new(system, ws, (&start, point), rule);
+    f(problem, work)
+}
+
+/// One Newton solve of the (pseudo-)static equations from the workspace's iterate.
+fn newton_solve(
+    system: &System,
+    ws: &mut StepWorkspace,
+    (t, mu, previous): (f64, f64, &[Vec3]),
+    options: &NewtonOptions,
+) -> std::result::Result<newton::NewtonReport, NewtonFailure> {
     ws.matrix.invalidate();
-    let (mut problem, work) = StepProblem::new(system, ws, (&start, point), rule);
-    newton::solve(&mut problem, work, [mu, f64::NAN], options)
+    with_static_problem(system, ws, (t, mu, previous), |mut problem, work| {
+        newton::solve(&mut problem, work, [mu, f64::NAN], options)
+    })
 }
 
 /// The largest scaled residual of the equilibrium equations (mu = 0) at the workspace's iterate.
 fn static_residual(system: &System, ws: &mut StepWorkspace, t: f64, previous: &[Vec3]) -> f64 {
-    let sigma = row_scale(system, ws.mass_ref);
-    let zero = vec![[0.0; 3]; previous.len()];
-    let start = StepStart::new(t, previous, &zero, 1.0);
-    let point = StepPoint {
-        t_eval: t,
-        t_end: t,
-        sigma,
-    };
-    let rule = StaticRule { mu: 0.0, previous };
     let mut r = std::mem::take(&mut ws.r);
-    {
-        let (mut problem, _) = StepProblem::new(system, ws, (&start, point), rule);
-        problem.residual(&mut r);
-    }
+    with_static_problem(system, ws, (t, 0.0, previous), |mut problem, _| {
+        problem.residual(&mut r)
+    });
     let worst = r.iter().fold(
         0.0f64,
         |m, x| if x.is_nan() { f64::NAN } else { m.max(x.abs()) },
