@@ -10,18 +10,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from vinculo.plotting import _save
+
 __all__ = ["plot_shapes", "plot_tensions"]
-
-
-def _save(figure: Figure, path: str | Path) -> Path:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    FigureCanvasAgg(figure)
-    figure.savefig(path, dpi=110)
-    return path
 
 
 def _horizontal(points: np.ndarray, origin: np.ndarray) -> np.ndarray:
