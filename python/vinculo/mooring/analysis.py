@@ -284,28 +284,15 @@ def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_en
 
 def _dynamic_end_loads(lines: list[Any], solution: Any) -> tuple[np.ndarray, np.ndarray]:
     """The end forces ``(times, lines, 2, 3)`` and end-segment tensions ``(times, lines, 2)`` of
-    a run, with the axial damping of the end segments (``BA`` times the rate of strain, a
-    dashpot beside each elastic segment) added to the elastic tension of the multipliers: the
-    tension a load cell at the end would measure, and MoorDyn's segment tension."""
-    from vinculo.mooring.line import _damping
-
-    q = np.asarray(solution.positions, dtype=float)
-    v = np.asarray(solution.velocities, dtype=float)
+    a run: each end segment's tension from Hooke's law at the stored positions plus its axial
+    damping (``BA`` times the rate of strain, a dashpot beside each elastic segment), the tension
+    a load cell at the end would measure and MoorDyn's segment tension (see
+    :meth:`vinculo.mooring.line.Line.tensions`)."""
     forces, tensions = [], []
     for line in lines:
         ends = [np.asarray(f, dtype=float).reshape(-1, 3) for f in line.end_forces(solution)]
-        elastic = np.asarray(line.tensions(solution), dtype=float)[:, [0, -1]].copy()
-        dashpot = _damping(line.line_type, line.unstretched_length / len(line.segments))
-        if dashpot > 0.0:
-            for e, (near, far) in enumerate(((line.nodes[0], line.nodes[1]),
-                                             (line.nodes[-1], line.nodes[-2]))):
-                chord = q[:, far] - q[:, near]
-                unit = chord / np.linalg.norm(chord, axis=1, keepdims=True)
-                rate = np.sum((v[:, far] - v[:, near]) * unit, axis=1)
-                elastic[:, e] += dashpot * rate
-                ends[e] = ends[e] + (dashpot * rate)[:, None] * unit
         forces.append(np.stack(ends, axis=1))
-        tensions.append(elastic)
+        tensions.append(np.asarray(line.tensions(solution), dtype=float)[:, [0, -1]])
     return np.stack(forces, axis=1), np.stack(tensions, axis=1)
 
 

@@ -122,6 +122,8 @@ class Line:
         end_loads: the constant loads (weight and buoyancy of the half segments, N) that the
             line puts on its end particles A and B.
         damping: the dashpot coefficient BA / l of each segment (N s/m; 0: none).
+        length_law: the line's unstretched length as a law of time (a winch), or None when it
+            is :attr:`unstretched_length` at all times.
     """
 
     nodes: list[int]
@@ -133,6 +135,7 @@ class Line:
     end_loads: tuple[np.ndarray, np.ndarray] = field(
         default_factory=lambda: (np.zeros(3), np.zeros(3)))
     damping: float = 0.0
+    length_law: Any = None
 
     def tensions(self, solution: Any) -> np.ndarray:
         """The segments' tensions: the elastic part from their multipliers, plus the axial
@@ -148,6 +151,14 @@ class Line:
         multipliers = np.atleast_2d(np.asarray(solution.multipliers, dtype=float))
         tension = multipliers[:, [c.index for c in self.segments]]
         velocities = getattr(solution, "velocities", None)
+        times = getattr(solution, "times", None)
+        if times is not None and math.isfinite(self.line_type.ea):
+            # Hooke's law at the stored positions. A time rule evaluates the multiplier where
+            # it applies the tension (the step's midpoint for the trapezoidal rule), half a
+            # step away from the stored time; the stretch at the stored time gives the
+            # tension there, to the rule's order (docs/theory/moorings.md).
+            tension = self._elastic_tensions(np.asarray(solution.positions, dtype=float),
+                                             np.asarray(times, dtype=float))
         if self.damping > 0.0 and velocities is not None:
             q = np.asarray(solution.positions, dtype=float)[:, self.nodes]
             v = np.asarray(velocities, dtype=float)[:, self.nodes]
@@ -155,6 +166,17 @@ class Line:
             u = d / np.linalg.norm(d, axis=2, keepdims=True)
             tension = tension + self.damping * np.sum(u * (v[:, 1:] - v[:, :-1]), axis=2)
         return tension
+
+    def _elastic_tensions(self, positions: np.ndarray, times: np.ndarray) -> np.ndarray:
+        """``EA (|d| - l(t)) / l(t)`` of every segment at every stored time."""
+        q = positions.reshape(-1, positions.shape[-2], 3)[:, self.nodes]
+        stretched = np.linalg.norm(q[:, 1:] - q[:, :-1], axis=2)
+        if self.length_law is None:
+            lengths = np.full(len(times), self.unstretched_length)
+        else:
+            lengths = np.array([float(self.length_law(float(t))) for t in times])
+        segment = (lengths / len(self.segments))[:, None]
+        return self.line_type.ea * (stretched - segment) / segment
 
     def end_forces(self, solution: Any) -> tuple[np.ndarray, np.ndarray]:
         """The forces of the line on its end particles A and B: the end segments' tensions along
@@ -348,4 +370,5 @@ def add_line(system: Any, end_a: int, end_b: int, line_type: LineType,
     displaced = water.density * math.pi * line_type.diameter**2 / 4.0 * half
     load = (line_type.mass_per_length * half - displaced) * gravity
     return Line(nodes=nodes, segments=links, line_type=line_type, unstretched_length=length0,
-                water=water, name=name, end_loads=(load, load.copy()), damping=damping)
+                water=water, name=name, end_loads=(load, load.copy()), damping=damping,
+                length_law=unstretched_length if isinstance(unstretched_length, Law) else None)
