@@ -123,17 +123,23 @@ fn shift(d: usize, by: usize) -> usize {
 
 /// Appends the slots of the blocks between an element's particles `parts`: block (x, y) has the
 /// rows of particle x's unknowns shifted by `row` and the columns of particle y's shifted by
-/// `col` (absent where either is fixed), x-major.
+/// `col` (absent where either is fixed, and for the rows of the particles from `acting` on: an
+/// element that does not act on them), x-major.
 pub fn push_pair_blocks(
     out: &mut Vec<Block>,
     pattern: &Pattern,
     parts: &[usize],
+    acting: usize,
     dof: &[usize],
     (row, col): (usize, usize),
 ) {
-    for &a in parts {
+    for (x, &a) in parts.iter().enumerate() {
         for &b in parts {
-            out.push(pattern.block_slots(shift(dof[a], row), shift(dof[b], col)));
+            out.push(if x < acting {
+                pattern.block_slots(shift(dof[a], row), shift(dof[b], col))
+            } else {
+                [NO_SLOT; 9]
+            });
         }
     }
 }

@@ -125,8 +125,11 @@ impl Layout {
             }
         }
         for f in system.forces().iter().filter(|f| f.has_jacobian()) {
-            for (a, b) in pairs(f.particles()) {
-                block(&mut entries, a, b);
+            let parts = f.particles();
+            for &a in &parts[..f.acting()] {
+                for &b in parts {
+                    block(&mut entries, dof[a], dof[b]);
+                }
             }
         }
         let pattern = Pattern::new(n, entries, n <= dense_limit);
@@ -147,7 +150,14 @@ impl Layout {
             .collect();
         for (k, c) in system.constraints().iter().enumerate() {
             let parts = c.particles();
-            push_pair_blocks(&mut constraint_hessian, &pattern, parts, &dof, (0, 0));
+            push_pair_blocks(
+                &mut constraint_hessian,
+                &pattern,
+                parts,
+                parts.len(),
+                &dof,
+                (0, 0),
+            );
             push_column(
                 &mut constraint_column,
                 &pattern,
@@ -161,7 +171,8 @@ impl Layout {
         let mut force_block = Vec::with_capacity(force_offsets.pair_entries());
         for f in system.forces() {
             if f.has_jacobian() {
-                push_pair_blocks(&mut force_block, &pattern, f.particles(), &dof, (0, 0));
+                let parts = f.particles();
+                push_pair_blocks(&mut force_block, &pattern, parts, f.acting(), &dof, (0, 0));
             } else {
                 let n = f.particles().len();
                 force_block.extend(std::iter::repeat_n([NO_SLOT; 9], n * n));

@@ -94,6 +94,19 @@ impl Force {
         dispatch!(self, f => f.particles())
     }
 
+    /// The particles the force acts on: the first `acting()` of [`Force::particles`]. Every kind
+    /// acts on all its particles except the line-node elements ([`LineHydro`],
+    /// [`SeabedContact`]), which act on their node alone and read their neighbours only for the
+    /// node's tangent. Their Jacobian then has the node's rows alone, so the matrix pattern holds
+    /// no block between the two neighbours and a line stays a chain for the tree elimination.
+    #[inline]
+    pub fn acting(&self) -> usize {
+        match self {
+            Force::SeabedContact(_) | Force::LineHydro(_) => 1,
+            _ => self.particles().len(),
+        }
+    }
+
     /// Applied force on each touched particle.
     #[inline]
     pub fn force(&self, q: &[Vec3], v: &[Vec3], t: f64) -> Local {

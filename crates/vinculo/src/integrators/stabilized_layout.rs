@@ -129,7 +129,7 @@ impl StabilizedLayout {
             }
         }
         for f in system.forces().iter().filter(|f| f.has_jacobian()) {
-            for &a in f.particles() {
+            for &a in &f.particles()[..f.acting()] {
                 for &b in f.particles() {
                     block(&mut entries, shift(dof[a], vel), dof[b]);
                     block(&mut entries, shift(dof[a], vel), shift(dof[b], vel));
@@ -164,8 +164,22 @@ impl StabilizedLayout {
             (strips(), strips(), strips());
         for (k, c) in cons.iter().enumerate() {
             let parts = c.particles();
-            push_pair_blocks(&mut kinematic_hessian, &pattern, parts, &dof, (0, 0));
-            push_pair_blocks(&mut dynamic_hessian, &pattern, parts, &dof, (vel, 0));
+            push_pair_blocks(
+                &mut kinematic_hessian,
+                &pattern,
+                parts,
+                parts.len(),
+                &dof,
+                (0, 0),
+            );
+            push_pair_blocks(
+                &mut dynamic_hessian,
+                &pattern,
+                parts,
+                parts.len(),
+                &dof,
+                (vel, 0),
+            );
             push_column(&mut kinematic_mu, &pattern, parts, &dof, (0, mu + k));
             push_column(&mut dynamic_lambda, &pattern, parts, &dof, (vel, lam + k));
             push_row(&mut position_row, &pattern, parts, &dof, (lam + k, 0));
@@ -181,8 +195,8 @@ impl StabilizedLayout {
         for f in forces {
             let parts = f.particles();
             if f.has_jacobian() {
-                push_pair_blocks(&mut force_q, &pattern, parts, &dof, (vel, 0));
-                push_pair_blocks(&mut force_v, &pattern, parts, &dof, (vel, vel));
+                push_pair_blocks(&mut force_q, &pattern, parts, f.acting(), &dof, (vel, 0));
+                push_pair_blocks(&mut force_v, &pattern, parts, f.acting(), &dof, (vel, vel));
             } else {
                 let none = std::iter::repeat_n([NO_SLOT; 9], parts.len() * parts.len());
                 force_q.extend(none.clone());
