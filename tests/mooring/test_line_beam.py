@@ -22,7 +22,6 @@ are below 2e-3 of the result.
 
 import math
 
-import numpy as np
 import pytest
 from scipy.integrate import quad
 from scipy.optimize import brentq

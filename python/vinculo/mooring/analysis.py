@@ -229,10 +229,10 @@ def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_en
         progress: True draws a progress bar on standard error (see :func:`vinculo.simulate`).
         **options: run options passed to :func:`vinculo.simulate`. ``jacobian_reuse``
             defaults to True here (modified Newton): a line's iteration matrix changes slowly,
-            so one factorisation serves many steps, to the same tolerance: end tensions within 5e-6 of the peak tension of full Newton's
-            on the benchmark's hanging chain and cable, at a third to a half of the CPU time;
-            on the chain on the seabed, whose steps are halved at contact events, within
-            that case's time-step error.
+            so one factorisation serves many steps, to the same tolerance: end tensions
+            within 5e-6 of the peak tension of full Newton's on the benchmark's hanging chain
+            and cable, at a third to a half of the CPU time; on the chain on the seabed, whose
+            steps are halved at contact events, within that case's time-step error.
 
     Returns:
         The run.
