@@ -322,6 +322,30 @@ def bench_case(name: str, segments: int, t_end: float, *, with_vinculo: bool = T
     return rows
 
 
+def scaling(name: str, segments: Sequence[int], dt: float,
+            t_end: float) -> list[tuple[int, float]]:
+    """vinculo's real-time factor (CPU time over simulated time) on one case against the number
+    of segments, at one step.
+
+    Arguments:
+        name: a key of :data:`CASES`.
+        segments: the numbers of segments.
+        dt: the step (s).
+        t_end: the simulated time (s).
+
+    Returns:
+        ``(segments, real-time factor)`` pairs.
+    """
+    from vinculo.mooring.analysis import run
+
+    rows = []
+    for n in segments:
+        model = CASES[name](n)
+        result = run(model, motion_for(model), t_end, dt=dt)
+        rows.append((n, result.cpu_time / t_end))
+    return rows
+
+
 def table(rows: Sequence[BenchRow]) -> str:
     """The benchmark as a Markdown table, one line per case and number of segments.
 
@@ -395,12 +419,23 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--t-end", type=float, default=60.0, help="simulated time (s)")
     parser.add_argument("--moordyn-only", action="store_true",
                         help="run MoorDyn alone (no vinculo rows)")
+    parser.add_argument("--scaling", type=float, metavar="DT", default=None,
+                        help="instead: vinculo's real-time factor against the number of segments "
+                        "at the step DT (s), on each case")
     parser.add_argument("--output", "-o", type=Path, default=Path("output") / "mooring-bench")
     args = parser.parse_args(argv)
     args.output.mkdir(parents=True, exist_ok=True)
+    segment_list = [int(s) for s in args.segments.split(",") if s.strip()]
+    if args.scaling is not None:
+        print("| case | segments | step (s) | vinculo real-time factor |\n"
+              "| --- | ---: | ---: | ---: |")
+        for name in [c.strip() for c in args.cases.split(",") if c.strip()]:
+            for n, factor in scaling(name, segment_list, args.scaling, args.t_end):
+                print(f"| {name} | {n} | {args.scaling:g} | {factor:.3g} |", flush=True)
+        return 0
     rows: list[BenchRow] = []
     for name in [c.strip() for c in args.cases.split(",") if c.strip()]:
-        for segments in [int(s) for s in args.segments.split(",") if s.strip()]:
+        for segments in segment_list:
             new = bench_case(name, segments, args.t_end, with_vinculo=not args.moordyn_only)
             rows += new
             for row in new:

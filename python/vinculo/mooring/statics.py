@@ -70,6 +70,8 @@ def solve_statics(system: Any, *, tolerance: float = 1e-9, max_iterations: int =
     Arguments:
         system: the :class:`vinculo.System`.
         tolerance: on the scaled residual and increment, relative to the model's length scale.
+            Where the residual's own round-off is larger (a stiff bending line far from the
+            origin), Newton stops at that round-off once its increments stop shrinking.
         max_iterations: the largest number of Newton iterations in all.
         t: the time at which the laws (winches, prescribed points) are evaluated.
         newton_first: try Newton's method first (False: the continuation at once).
