@@ -1,6 +1,7 @@
 //! Consistent initial conditions.
 //!
-//! Both tasks solve saddle-point systems with the mass matrix and the constraint gradients G,
+//! Both tasks solve saddle-point systems with the mass matrix and the constraint gradients G
+//! (M with the line nodes' axial added-mass correction at q, `assembly/axial_added_mass.rs`),
 //! reusing the run's pattern and solver (scaled as in the step: dynamics rows by 1/m_ref,
 //! constraint rows by s_k):
 //!
@@ -41,6 +42,10 @@ fn fill_saddle_rows(
     for (i, m) in ws.inertia.iter().enumerate() {
         layout.add_to_particle_diagonal(values, i, m / ws.mass_ref);
     }
+    // The line nodes' axial added-mass correction at q (`assembly/axial_added_mass.rs`).
+    let blocks = &layout.particle_block[..];
+    let axial = &ws.axial_added_mass;
+    axial.add_mass_blocks(&mut values[..], blocks, q, 1.0 / ws.mass_ref);
     for (c, con) in system.constraints().iter().enumerate() {
         let g = con.gradient(q, t);
         // The saddle matrix has no Hessian term: no blocks.
