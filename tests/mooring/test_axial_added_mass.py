@@ -1,6 +1,7 @@
 """A line node's added mass is anisotropic, as MoorDyn's node mass matrix
 m I + rho V (Ca (I - t t^T) + CaAx t t^T): the node oscillates along the line with the inertia
-m + CaAx rho V and across it with m + Ca rho V (docs/theory/seabed-and-line-loads.md)."""
+m + CaAx rho V and across it with m + Ca rho V (docs/theory/seabed-and-line-loads.md), with
+both time rules, on the index-3 and the stabilised index-2 (GGL) formulations."""
 
 import math
 
@@ -20,16 +21,21 @@ RHO_V = RHO * math.pi * D * D / 4.0 * SPAN  # kg: the node stands for one segmen
 TENSION = EA * (SPAN - L0) / L0  # N, Hooke's law in each segment at rest
 
 
-def taut_node(displacement):
+def taut_node(displacement, springs=False):
     """One free node at the origin between two elastic segments to fixed ends at x = +-SPAN,
     without gravity nor drag, its tangent the x axis (from one end to the other), displaced by
-    ``displacement`` from rest."""
+    ``displacement`` from rest. ``springs``: the segments as spring-dampers of the same law
+    (stiffness EA/L0, rest length L0, no damping), for the GGL formulation, which runs elastic
+    segments on the index-3 one only."""
     system = vinculo.System(gravity=(0.0, 0.0, 0.0))
     a = system.add_particle(1.0, (-SPAN, 0.0, 0.0), fixed=True)
     node = system.add_particle(MASS, tuple(displacement))
     b = system.add_particle(1.0, (SPAN, 0.0, 0.0), fixed=True)
-    system.add_elastic_distance(a, node, L0, EA)
-    system.add_elastic_distance(node, b, L0, EA)
+    for p, r in ((a, node), (node, b)):
+        if springs:
+            system.add_spring_damper(p, r, EA / L0, 0.0, L0)
+        else:
+            system.add_elastic_distance(p, r, L0, EA)
     system.add_line_hydrodynamics(node, diameter=D, length=SPAN, ca=CA, caax=CAAX, density=RHO,
                                   tangent=(a, b))
     return system, node
@@ -44,17 +50,27 @@ def measured_period(times, x):
     return (crossings[-1] - crossings[0]) / (crossings.size - 1)
 
 
-SCHEMES = [{"scheme": "trapezoidal"}, {"scheme": "generalized-alpha", "rho_inf": 1.0}]
+SCHEMES = [
+    {"scheme": "trapezoidal"},
+    {"scheme": "generalized-alpha", "rho_inf": 1.0},
+    {"scheme": "trapezoidal", "formulation": "ggl"},
+    {"scheme": "generalized-alpha", "rho_inf": 1.0, "formulation": "ggl"},
+]
 
 
-@pytest.mark.parametrize("scheme", SCHEMES, ids=lambda s: s["scheme"])
+def name(scheme):
+    """A test id: the scheme, and the formulation when it is GGL."""
+    return "-".join(str(scheme[k]) for k in ("scheme", "formulation") if k in scheme)
+
+
+@pytest.mark.parametrize("scheme", SCHEMES, ids=name)
 def test_axial_period_follows_the_axial_added_mass(scheme):
     # Along x, each segment's tension EA (|d| - L0)/L0 is linear in the node's x while both stay
     # taut, so the restoring force is -(2 EA/L0) x exactly: a spring-mass of stiffness 2 EA/L0
     # and the node's axial inertia m + CaAx rho V, period 2 pi sqrt((m + CaAx rho V) L0/(2 EA)).
     # (With the isotropic added mass Ca rho V it would be 1.48 times longer.)
     period = 2.0 * math.pi * math.sqrt((MASS + CAAX * RHO_V) * L0 / (2.0 * EA))
-    system, node = taut_node((1e-3, 0.0, 0.0))
+    system, node = taut_node((1e-3, 0.0, 0.0), springs="formulation" in scheme)
     # 1000 steps per period: the rules' period error (omega h)^2/12 is 3e-6.
     solution = vinculo.simulate(system, 5.5 * period, period / 1000.0, **scheme)
     x = solution.particle(node)[:, 0]
@@ -62,13 +78,13 @@ def test_axial_period_follows_the_axial_added_mass(scheme):
     assert measured_period(solution.times, x) == pytest.approx(period, rel=1e-4)
 
 
-@pytest.mark.parametrize("scheme", SCHEMES, ids=lambda s: s["scheme"])
+@pytest.mark.parametrize("scheme", SCHEMES, ids=name)
 def test_transverse_period_follows_the_normal_added_mass(scheme):
     # Across the line, a small displacement y tilts both segments by y/SPAN: the restoring force
     # is -(2 T/SPAN) y to first order (the tension's change is second order in y; at y = 1 mm
     # it shifts the period by about 5e-6), so the period is 2 pi sqrt((m + Ca rho V) SPAN/(2 T)).
     period = 2.0 * math.pi * math.sqrt((MASS + CA * RHO_V) * SPAN / (2.0 * TENSION))
-    system, node = taut_node((0.0, 1e-3, 0.0))
+    system, node = taut_node((0.0, 1e-3, 0.0), springs="formulation" in scheme)
     solution = vinculo.simulate(system, 5.5 * period, period / 1000.0, **scheme)
     y = solution.particle(node)[:, 1]
     assert measured_period(solution.times, y) == pytest.approx(period, rel=1e-4)
