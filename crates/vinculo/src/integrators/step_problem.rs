@@ -16,6 +16,10 @@
 //! and the parallel ones ([`ParallelAssembly`]) read the same [`ResidualTerms`] and
 //! [`JacobianTerms`] built here.
 //!
+//! Line nodes whose axial added mass differs from their normal one add C_i(q_e) qdd_i to their
+//! inertia rows, qdd_i the rule's own acceleration (its inertia row with unit inertia and no
+//! gravity), once for every rule (`assembly/axial_added_mass.rs`).
+//!
 //! The equations, their scaling and the Jacobian with its Hessian term are derived in
 //! `docs/theory/formulation.md` and `docs/theory/newton.md`; each rule's module documentation
 //! (`trapezoidal.rs`, `generalized_alpha.rs`, `docs/theory/time-rules.md`) gives its kinematics.
