@@ -522,8 +522,9 @@ class System:
         With the volume ``V = pi d^2 / 4 l`` and the velocity relative to the current
         ``r = current - v`` split into its parts along (``r_a``) and across (``r_n``) the line:
         buoyancy ``rho V g`` upwards, normal drag ``1/2 rho cd d l |r_n| r_n``, axial drag
-        ``1/2 rho cdax pi d l |r_a| r_a``. The added mass ``ca rho V`` joins the node's inertia
-        in every direction (the axial coefficient ``caax`` is not yet applied separately).
+        ``1/2 rho cdax pi d l |r_a| r_a``. The added mass is MoorDyn's
+        ``rho V (ca (I - t t^T) + caax t t^T)``: ``ca rho V`` across the line and ``caax rho V``
+        along it (without a tangent, ``ca rho V`` in every direction).
 
         Arguments:
             node: the line node.
@@ -561,7 +562,9 @@ class System:
         """Length of each constraint (m); NaN for constraints that are not distances."""
     @property
     def inertia(self) -> npt.NDArray[np.float64]:
-        """Translational inertia of each particle: mass plus added mass (kg)."""
+        """Translational inertia of each particle: mass plus added mass (kg); a line node's
+        added mass is its normal one, Ca rho V (along the line, its inertia is
+        m + CaAx rho V: the step problems correct it)."""
     @property
     def num_particles(self) -> int:
         """Number of particles, fixed ones included."""

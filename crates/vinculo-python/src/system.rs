@@ -686,7 +686,8 @@ impl PySystem {
         Array1::from(v).into_pyarray(py)
     }
 
-    /// Inertia of each particle's translation (kg): mass plus added mass of fluid elements.
+    /// Inertia of each particle's translation (kg): mass plus added mass of fluid elements (a
+    /// line node's normal added mass; the step problems correct it along the line to CaAx).
     #[getter]
     fn inertia<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         Array1::from(self.inner.inertia()).into_pyarray(py)

@@ -224,14 +224,14 @@ impl ErrorControl {
             // serve: both answers hold the constraints).
             factor_saddle(system, ws, &self.q_big, t + h)?;
         }
-        tangential(ws, &mut self.e_q, &mut self.projection);
+        tangential(ws, &mut self.e_q, &mut self.projection, &self.q_big);
         // The velocities' difference holds twice the start's drift off the velocity constraints
         // (index 3: v_{n+1} = 2 (q_{n+1} - q_n)/h - v_n carries -v_n's normal part, two half
         // steps +v_n's), normal to the constraints at the start: projected there, what is left
         // of it is O(h) times the drift.
         factor_saddle(system, ws, q, t)?;
         ws.matrix.invalidate();
-        tangential(ws, &mut self.e_v, &mut self.projection);
+        tangential(ws, &mut self.e_v, &mut self.projection, q);
         let ends = [(q, v), (&ws.state.q[..], &ws.state.v[..])];
         self.err = self
             .weights
@@ -286,8 +286,10 @@ impl ErrorControl {
 /// of [`factor_saddle`]. Solving it with the right-hand side `[M a / m_ref; 0]` gives x with
 /// G x = 0 and (M/m_ref + K) x = M a / m_ref + s G^T mu, the M-orthogonal projection of a onto
 /// the tangent space (up to O(h^2) with K). What is left out is the part of a normal to the
-/// constraints (see `integrators::error_estimate` for why the estimate needs it gone).
-fn tangential(ws: &mut StepWorkspace, a: &mut [Vec3], rhs: &mut [f64]) {
+/// constraints (see `integrators::error_estimate` for why the estimate needs it gone). M holds
+/// the line nodes' axial added-mass correction at the positions `q` (the matrix's own, or
+/// within a step of them: the projection is then M-orthogonal up to O(h)).
+fn tangential(ws: &mut StepWorkspace, a: &mut [Vec3], rhs: &mut [f64], q: &[Vec3]) {
     rhs.fill(0.0);
     let mass_ref = ws.mass_ref;
     for (i, &d) in ws.layout.dof.iter().enumerate() {
@@ -297,6 +299,9 @@ fn tangential(ws: &mut StepWorkspace, a: &mut [Vec3], rhs: &mut [f64]) {
             }
         }
     }
+    // M holds the line nodes' axial added-mass correction, at q as in the matrix.
+    let axial = &ws.axial_added_mass;
+    axial.add_rows(&ws.layout.dof, rhs, (q, 1.0 / mass_ref), |i| a[i]);
     ws.solver.solve_in_place(rhs);
     for (i, &d) in ws.layout.dof.iter().enumerate() {
         for k in 0..3 {

@@ -1,6 +1,7 @@
 //! Consistent initial conditions.
 //!
-//! Both tasks solve saddle-point systems with the mass matrix and the constraint gradients G,
+//! Both tasks solve saddle-point systems with the mass matrix and the constraint gradients G
+//! (M with the line nodes' axial added-mass correction at q, `assembly/axial_added_mass.rs`),
 //! reusing the run's pattern and solver (scaled as in the step: dynamics rows by 1/m_ref,
 //! constraint rows by s_k):
 //!
@@ -41,6 +42,10 @@ fn fill_saddle_rows(
     for (i, m) in ws.inertia.iter().enumerate() {
         layout.add_to_particle_diagonal(values, i, m / ws.mass_ref);
     }
+    // The line nodes' axial added-mass correction at q (`assembly/axial_added_mass.rs`).
+    let blocks = &layout.particle_block[..];
+    let axial = &ws.axial_added_mass;
+    axial.add_mass_blocks(&mut values[..], blocks, q, 1.0 / ws.mass_ref);
     for (c, con) in system.constraints().iter().enumerate() {
         let g = con.gradient(q, t);
         // The saddle matrix has no Hessian term: no blocks.
@@ -382,5 +387,51 @@ mod tests {
         .unwrap();
         assert!((2.0 * lambda[0] * 1.5 - 2.0 * 9.81).abs() < 1e-12);
         assert!(acc[1].iter().all(|x| x.abs() < 1e-12));
+    }
+
+    /// A line node between two fixed neighbours on the x axis, pushed by a force F: its
+    /// consistent acceleration is F_x / (m + CaAx rho V) along the line and
+    /// F_y / (m + Ca rho V) across it (MoorDyn's node mass matrix, Newton's second law).
+    #[test]
+    fn consistent_acceleration_of_a_line_node_has_the_axial_added_mass() {
+        use crate::laws::VectorLaw;
+        use crate::model::LineHydroSpec;
+        let mut s = System::new([0.0; 3]);
+        let a = s
+            .add_particle(1.0, [-1.0, 0.0, 0.0], [0.0; 3], true)
+            .unwrap();
+        let n = s.add_particle(3.0, [0.0; 3], [0.0; 3], false).unwrap();
+        let b = s
+            .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], true)
+            .unwrap();
+        let spec = LineHydroSpec {
+            density: 1025.0,
+            diameter: 0.08,
+            length: 1.0,
+            cd: 0.0,
+            cdax: 0.0,
+            ca: 1.0,
+            caax: 0.25,
+            current: [0.0; 3],
+        };
+        s.add_line_hydrodynamics(n, Some((a, b)), &spec).unwrap();
+        let force = [2.0, -5.0, 0.0];
+        s.add_force(n, VectorLaw::constant(force)).unwrap();
+        let rho_v = 1025.0 * std::f64::consts::PI * 0.08 * 0.08 / 4.0;
+        let mut ws = StepWorkspace::new(&s, 64);
+        let (q, v) = (s.initial_positions(), s.initial_velocities());
+        let (acc, _) = consistent_accelerations(&s, &mut ws, &q, &v, 0.0).unwrap();
+        let expected = [
+            force[0] / (3.0 + 0.25 * rho_v),
+            force[1] / (3.0 + rho_v),
+            0.0,
+        ];
+        for k in 0..3 {
+            assert!(
+                (acc[1][k] - expected[k]).abs() < 1e-14,
+                "{:?} vs {expected:?}",
+                acc[1]
+            );
+        }
     }
 }

@@ -4,11 +4,13 @@
 //!
 //! Unknowns are ordered x = (q of the free particles, 3 each; lambda, one per constraint).
 
+mod axial_added_mass;
 mod elements;
 mod parallel;
 mod pattern;
 mod serial;
 
+pub use axial_added_mass::AxialAddedMass;
 pub use elements::{push_column, push_pair_blocks, push_row, ElementOffsets};
 pub use parallel::{JacobianTerms, ParallelAssembly, ResidualTerms, MIN_TASK};
 pub use pattern::{Pattern, Storage};

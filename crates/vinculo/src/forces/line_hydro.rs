@@ -16,11 +16,17 @@
 //! `Dq = 0.25 rhoW Cdt pi d (l_i + l_{i+1}) |Vq| Vq`; the node length is (l_i + l_{i+1})/2.)
 //!
 //! Added mass: MoorDyn adds rho V (Ca (I - t t^T) + CaAx t t^T) to the node's mass matrix.
-//! The core's inertia is a scalar per particle (constant during a run), so this element adds
-//! the normal part Ca rho V in every direction ([`LineHydro::added_mass`]): exact for motions
-//! normal to the line (the line's transverse dynamics) and when CaAx = Ca; along the line it
-//! overstates the inertia by (Ca - CaAx) rho V. Still water or a uniform current: the fluid's
-//! acceleration is zero, so there is no Froude-Krylov term besides buoyancy.
+//! It is split in two: the isotropic part Ca rho V joins the particle's scalar inertia
+//! ([`LineHydro::added_mass`], constant during a run), and the axial correction
+//!
+//! ```text
+//! C(q) = -(Ca - CaAx) rho V t t^T                  (t at the positions the forces use)
+//! ```
+//!
+//! is added to the node's mass block by the step problems ([`LineHydro::axial_excess`] gives
+//! (Ca - CaAx) rho V; `assembly/axial_added_mass.rs` places it), so that the node's inertia is
+//! m + Ca rho V across the line and m + CaAx rho V along it. Still water or a uniform current:
+//! the fluid's acceleration is zero, so there is no Froude-Krylov term besides buoyancy.
 //!
 //! Jacobian: with D(x) = c (|x| I + x x^T / |x|) the derivative of c |x| x (0 at x = 0),
 //! P = I - t t^T and dr_a/dt = t r^T + (t . r) I:
@@ -93,6 +99,13 @@ impl LineHydro {
         self.ca * self.density * self.volume()
     }
 
+    /// (Ca - CaAx) rho V (kg): by how much the isotropic added mass [`LineHydro::added_mass`]
+    /// overstates the node's inertia along the line (negative when CaAx > Ca). The step
+    /// problems subtract it along the tangent (module documentation).
+    pub fn axial_excess(&self) -> f64 {
+        (self.ca - self.caax) * self.density * self.volume()
+    }
+
     /// 1/2 rho Cd d l and 1/2 rho CdAx pi d l.
     fn drag_factors(&self) -> (f64, f64) {
         let base = 0.5 * self.density * self.diameter * self.length;
@@ -112,6 +125,38 @@ impl LineHydro {
             None => quadratic(cn, r),
         };
         add(buoyancy, drag)
+    }
+
+    /// The axial correction of the node's mass block at positions `q`, C = -e t t^T with
+    /// e = [`LineHydro::axial_excess`] (zero without a tangent).
+    pub(crate) fn axial_correction(&self, q: &[Vec3]) -> Mat3 {
+        match self.node.tangent(q) {
+            Some(tg) => outer(-self.axial_excess(), tg.t, tg.t),
+            None => [[0.0; 3]; 3],
+        }
+    }
+
+    /// The correction's inertia term C(q) a = -e t (t . a) for the node's acceleration `a`.
+    pub(crate) fn axial_inertia(&self, q: &[Vec3], a: Vec3) -> Vec3 {
+        match self.node.tangent(q) {
+            Some(tg) => scale(-self.axial_excess() * dot(tg.t, a), tg.t),
+            None => [0.0; 3],
+        }
+    }
+
+    /// For the node's acceleration `a`: adds into `dq` (the node's row, as a force's Jacobian)
+    /// the derivative of the force-like -C(q) a = e t (t . a) with respect to the positions
+    /// through t at fixed a, e (t a^T + (t . a) I) dt/dq, and returns C(q) (zero without a
+    /// tangent, `dq` then untouched).
+    pub(crate) fn axial_inertia_jacobian(&self, q: &[Vec3], a: Vec3, dq: &mut Jacobian) -> Mat3 {
+        match self.node.tangent(q) {
+            Some(tg) => {
+                let e = self.axial_excess();
+                tg.add_chain(scale_mat(e, axial_part_by_tangent(tg.t, a)), dq);
+                outer(-e, tg.t, tg.t)
+            }
+            None => [[0.0; 3]; 3],
+        }
     }
 
     /// Potential of the buoyancy, rho V g . q (the drag dissipates).

@@ -74,6 +74,49 @@ pub(crate) fn every_kind() -> System {
     s
 }
 
+/// A mooring line in water whose added mass is anisotropic (Ca = 1, CaAx = 0.3 on all nodes
+/// but one, CaAx = 1.6 > Ca there): a fixed anchor and five free nodes off a straight line,
+/// moving, linked by distances, each node with its hydrodynamics in a current (the anchor's
+/// and the free end's tangents from their one segment, the others' from their neighbours).
+pub(crate) fn line_in_water() -> System {
+    use crate::model::LineHydroSpec;
+    let mut s = System::new([0.0, 0.0, -9.81]);
+    let mut ids = vec![s.add_particle(2.0, [0.0; 3], [0.0; 3], true).unwrap()];
+    for i in 1..=5 {
+        let u = i as f64;
+        let x = [0.9 * u, 0.05 * (1.7 * u).sin(), 0.4 * u - 0.06 * u * u];
+        let v = [
+            0.1 * (0.3 * u).cos(),
+            -0.2 + 0.05 * u,
+            0.3 * (0.8 * u).sin(),
+        ];
+        ids.push(s.add_particle(1.5 + 0.1 * u, x, v, false).unwrap());
+    }
+    for w in ids.windows(2) {
+        s.add_distance(w[0], w[1], None).unwrap();
+    }
+    let last = ids.len() - 1;
+    for (i, &p) in ids.iter().enumerate() {
+        let tangent = match i {
+            0 => (ids[0], ids[1]),
+            _ if i == last => (ids[i - 1], ids[i]),
+            _ => (ids[i - 1], ids[i + 1]),
+        };
+        let spec = LineHydroSpec {
+            density: 1025.0,
+            diameter: 0.05,
+            length: 0.9,
+            cd: 1.2,
+            cdax: 0.1,
+            ca: 1.0,
+            caax: if i == 3 { 1.6 } else { 0.3 },
+            current: [0.2, 0.1, 0.0],
+        };
+        s.add_line_hydrodynamics(p, Some(tangent), &spec).unwrap();
+    }
+    s
+}
+
 /// Asserts that the problem's assembled Jacobian equals central finite differences of its
 /// residual, column by column, at the current iterate (which it leaves unchanged).
 pub(crate) fn assert_jacobian_matches(problem: &mut impl NewtonProblem, layout: &Layout) {

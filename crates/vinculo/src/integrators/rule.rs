@@ -89,7 +89,8 @@ impl<'a> StepStart<'a> {
 /// scaling in `docs/theory/formulation.md`), for the step's scale sigma ([`StepPoint`]).
 ///
 /// The residual of the step is, per free particle and coordinate,
-/// `sigma (inertia_row(..) - f(q_e, v_e, t_e) - Phi_q(q_e, t_e)^T lambda)`, and
+/// `sigma (inertia_row(..) - f(q_e, v_e, t_e) - Phi_q(q_e, t_e)^T lambda)` (plus, at a line
+/// node, the axial added-mass term that the step problem adds for every rule), and
 /// `s_k Phi_k(q, t_end)` per constraint; its Jacobian is `mass_diagonal` on the diagonal of the
 /// mass block plus `force_dq df/dq + force_dv df/dv + hessian sum_k lambda_k Phi_k,qq` at the
 /// evaluation point, `-s G(q_e)^T` and `s G(q, t_end)`.

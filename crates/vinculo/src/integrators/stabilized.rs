@@ -43,12 +43,15 @@
 //!
 //! ```text
 //! K   = q - b - kappa v - G(q, t_{n+1})^T mu
-//! D   = M (c + c_v v) - M g - f(q_e, v_e, t_e) - G(q_e, t_e)^T lambda
+//! D   = (M + C(q_e)) (c + c_v v) - m g - f(q_e, v_e, t_e) - G(q_e, t_e)^T lambda
 //! Phi = Phi(q, t_{n+1})
 //! Psi = G(q, t_{n+1}) v + Phi_t(q, t_{n+1})
 //! ```
 //!
-//! Both constraint levels hold at the end of every step, to the Newton tolerance.
+//! Both constraint levels hold at the end of every step, to the Newton tolerance. C(q_e) is the
+//! line nodes' axial added-mass correction (`assembly/axial_added_mass.rs`), zero elsewhere:
+//! its Jacobian is C / m_ref in the scaled v~ columns and, through the tangent, a force's
+//! df/dq weighted as the forces' are.
 //!
 //! # Why v stays an unknown
 //!
@@ -219,6 +222,7 @@ impl StabilizedWorkspace {
             mu: &mut self.mu,
             scales: &ws.scales,
             inertia: &ws.inertia,
+            axial: &ws.axial_added_mass,
             start,
             base_q: &self.base_q,
             base_a: &self.base_a,
@@ -312,6 +316,7 @@ pub struct StabilizedProblem<'a> {
     mu: &'a mut [f64],
     scales: &'a [f64],
     inertia: &'a [f64],
+    axial: &'a crate::assembly::AxialAddedMass,
     start: StepStart<'a>,
     base_q: &'a [Vec3],
     base_a: &'a [Vec3],
@@ -319,6 +324,14 @@ pub struct StabilizedProblem<'a> {
     v_eval: &'a mut [Vec3],
     probe: &'a mut [Vec3],
     rule: StepRule,
+}
+
+impl StabilizedProblem<'_> {
+    /// The acceleration qdd_i = c_i + c_v v_i of the dynamics rows at the iterate.
+    fn acceleration(&self) -> impl Fn(usize) -> Vec3 + '_ {
+        let (c, c_v, v) = (self.base_a, self.rule.c_v, &self.state.v);
+        move |i| std::array::from_fn(|x| c[i][x] + c_v * v[i][x])
+    }
 }
 
 impl NewtonProblem for StabilizedProblem<'_> {
@@ -354,6 +367,13 @@ impl NewtonProblem for StabilizedProblem<'_> {
                     }
                 }
             }
+        }
+        if !self.axial.is_empty() {
+            // The line nodes' axial added-mass correction sigma C(q_e) qdd.
+            let (dynamics, qdd) = (&mut r[n3..2 * n3], self.acceleration());
+            let q_eval = &*self.q_eval;
+            self.axial
+                .add_rows(&layout.dof, dynamics, (q_eval, point.sigma), qdd);
         }
         for (c, con) in system.constraints().iter().enumerate() {
             let grad_e = con.gradient(self.q_eval, point.t_eval);
@@ -408,6 +428,15 @@ impl NewtonProblem for StabilizedProblem<'_> {
             let pairs = layout.force_offsets.pairs(fi);
             let (blocks_q, blocks_v) = (&layout.force_q[pairs.clone()], &layout.force_v[pairs]);
             add_force_blocks(values, (blocks_q, blocks_v), (wq, &dq), (wv, &dv));
+        }
+        if !self.axial.is_empty() {
+            // d(sigma C qdd)/dv~ = sigma c_v C / kappa = C / m_ref; through t, as a force.
+            let blocks = (&layout.dynamic_v[..], |k| {
+                &layout.force_q[layout.force_offsets.pairs(k)]
+            });
+            let weights = (&*self.q_eval, 1.0 / mass_ref, -point.sigma * rule.w);
+            self.axial
+                .add_jacobian(values, blocks, weights, self.acceleration());
         }
         for (c, con) in system.constraints().iter().enumerate() {
             let parts = con.particles();
@@ -484,7 +513,7 @@ impl NewtonProblem for StabilizedProblem<'_> {
 mod tests {
     use super::*;
     use crate::integrators::fixtures::{
-        assert_pattern_jacobian_matches, every_kind, perturbed_iterate,
+        assert_pattern_jacobian_matches, every_kind, line_in_water, perturbed_iterate,
     };
     use crate::integrators::Scheme;
 
@@ -495,7 +524,18 @@ mod tests {
     /// and both storages (sparse, dense).
     #[test]
     fn jacobian_matches_finite_differences_of_the_residual() {
-        let s = every_kind();
+        assert_jacobian_matches_on(&every_kind());
+    }
+
+    /// As above on a line of five free nodes in water whose added mass is anisotropic
+    /// (Ca != CaAx: the axial correction C(q_e) qdd in the dynamics rows).
+    #[test]
+    fn axial_added_mass_jacobian_matches_finite_differences() {
+        assert_jacobian_matches_on(&line_in_water());
+    }
+
+    /// The finite-difference check of the two tests above on the system `s`.
+    fn assert_jacobian_matches_on(s: &System) {
         let q_n = s.initial_positions();
         let v_n = s.initial_velocities();
         let schemes = [
@@ -505,8 +545,8 @@ mod tests {
         ];
         for scheme in schemes {
             for dense_limit in [0, 1000] {
-                let mut ws = StepWorkspace::with_solver(&s, 0, SparseSolver::SparseLu);
-                let mut ggl = StabilizedWorkspace::new(&s, dense_limit);
+                let mut ws = StepWorkspace::with_solver(s, 0, SparseSolver::SparseLu);
+                let mut ggl = StabilizedWorkspace::new(s, dense_limit);
                 let algorithmic: Vec<Vec3> = q_n.iter().map(|x| [0.2, x[2], -x[0]]).collect();
                 let mut alpha = RuleState::new(&algorithmic);
                 alpha.acceleration = q_n.iter().map(|x| [x[1], -x[0], 0.3]).collect();
@@ -524,7 +564,7 @@ mod tests {
                     *mu = 1e-3 * (k as f64 - 1.5);
                 }
                 let pattern = ggl.layout.pattern.clone();
-                let (mut problem, _) = ggl.problem(&s, &mut ws, start, rule);
+                let (mut problem, _) = ggl.problem(s, &mut ws, start, rule);
                 assert_pattern_jacobian_matches(&mut problem, &pattern);
             }
         }

@@ -16,6 +16,10 @@
 //! and the parallel ones ([`ParallelAssembly`]) read the same [`ResidualTerms`] and
 //! [`JacobianTerms`] built here.
 //!
+//! Line nodes whose axial added mass differs from their normal one add C_i(q_e) qdd_i to their
+//! inertia rows, qdd_i the rule's own acceleration (its inertia row with unit inertia and no
+//! gravity), once for every rule (`assembly/axial_added_mass.rs`).
+//!
 //! The equations, their scaling and the Jacobian with its Hessian term are derived in
 //! `docs/theory/formulation.md` and `docs/theory/newton.md`; each rule's module documentation
 //! (`trapezoidal.rs`, `generalized_alpha.rs`, `docs/theory/time-rules.md`) gives its kinematics.
@@ -26,7 +30,7 @@ use super::newton::{self, LinearWork, NewtonFailure, NewtonOptions, NewtonProble
 use super::rule::{Index3Rule, RuleState, StepPoint, StepStart, TimeRule};
 use super::workspace::{StepBuffers, StepWorkspace};
 use crate::assembly::{
-    InertiaRows, JacobianTerms, Layout, ParallelAssembly, ResidualTerms, MIN_TASK,
+    AxialAddedMass, InertiaRows, JacobianTerms, Layout, ParallelAssembly, ResidualTerms, MIN_TASK,
 };
 use crate::math::Vec3;
 use crate::model::Particle;
@@ -39,6 +43,7 @@ pub struct StepProblem<'a, R: Index3Rule> {
     buffers: &'a mut StepBuffers,
     scales: &'a [f64],
     inertia: &'a [f64],
+    axial: &'a AxialAddedMass,
     parallel: Option<&'a mut ParallelAssembly>,
     point: StepPoint,
     rule: R,
@@ -65,6 +70,7 @@ impl<'a, R: Index3Rule> StepProblem<'a, R> {
             buffers: &mut ws.state,
             scales: &ws.scales,
             inertia: &ws.inertia,
+            axial: &ws.axial_added_mass,
             parallel: ws.parallel.as_mut(),
             point,
             rule,
@@ -154,6 +160,13 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
             Some(parallel) => parallel.residual(system, layout, &terms, r, &row),
             None => layout.residual(system, &terms, r, &row),
         }
+        if !self.axial.is_empty() {
+            // sigma C_i(q_e) qdd_i (`assembly/axial_added_mass.rs`), after the elements: the
+            // serial and parallel residuals stay equal bit for bit.
+            let qdd = |i: usize| acceleration(rule, b, i);
+            self.axial
+                .add_rows(&layout.dof, r, (q_eval, point.sigma), qdd);
+        }
     }
 
     fn jacobian(&mut self, values: &mut [f64]) {
@@ -180,6 +193,13 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
         match self.parallel.as_deref() {
             Some(parallel) => parallel.jacobian(self.system, self.layout, &terms, values, mass),
             None => self.layout.jacobian(self.system, &terms, values, mass),
+        }
+        if !self.axial.is_empty() {
+            let layout = self.layout;
+            let blocks = (&layout.particle_block[..], |k| layout.force_blocks(k));
+            let weights = (q_eval, rule.mass_diagonal(point.sigma, 1.0), force_dq);
+            let qdd = |i: usize| acceleration(rule, b, i);
+            self.axial.add_jacobian(values, blocks, weights, qdd);
         }
     }
 
@@ -220,6 +240,13 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
         let largest = rows.iter().fold(0.0f64, |m, r| m.max(*r));
         super::newton::ROUND_OFF_ULPS * f64::EPSILON * largest
     }
+}
+
+/// The acceleration qdd_i(q) of particle i at the iterate in `b` that the rule's inertia row
+/// multiplies by the inertia (the row with unit inertia and no gravity).
+#[inline]
+fn acceleration<R: Index3Rule>(rule: &R, b: &StepBuffers, i: usize) -> Vec3 {
+    rule.inertia_row(i, &b.q[i], &b.v[i], 1.0, 0.0, &[0.0; 3])
 }
 
 /// The scaled inertia and gravity rows of a step of the rule step `R` at the current iterate.
@@ -274,8 +301,8 @@ pub fn index3_step<T: TimeRule>(
 mod tests {
     use super::*;
     use crate::integrators::fixtures::{
-        assert_jacobian_matches, assert_same_assembly, chain, cloth, every_kind, perturbed_iterate,
-        wiggled_iterate,
+        assert_jacobian_matches, assert_same_assembly, chain, cloth, every_kind, line_in_water,
+        perturbed_iterate, wiggled_iterate,
     };
     use crate::integrators::{GeneralizedAlpha, GeneralizedTrapezoidal};
     use crate::linear::SparseSolver;
@@ -470,6 +497,110 @@ mod tests {
                 let (mut problem, _) = problem_at(rule, &s, &mut ws, &mut state, start(&q_n, &v_n));
                 assert_jacobian_matches(&mut problem, &layout);
             }
+        }
+    }
+
+    /// The Jacobian with the line nodes' axial added-mass correction (C_i = -(Ca - CaAx) rho V
+    /// t t^T at the evaluation point, times the rule's acceleration; Ca != CaAx on every node,
+    /// CaAx > Ca on one) equals central finite differences of the residual, on a line of five
+    /// free nodes, for the trapezoidal rule (alpha = 0.6, 1) and generalised-alpha
+    /// (rho_inf = 0, 0.6), with the sparse LU's layout, dense storage and the tree
+    /// elimination's layout; and the parallel assembly gives the serial one.
+    #[test]
+    fn axial_added_mass_jacobian_matches_finite_differences() {
+        let s = line_in_water();
+        assert_eq!(StepWorkspace::new(&s, 48).axial_added_mass.len(), 6);
+        let (q_n, v_n) = (s.initial_positions(), s.initial_velocities());
+        let solvers = [
+            (0, SparseSolver::SparseLu),
+            (1000, SparseSolver::SparseLu),
+            (0, SparseSolver::Auto),
+        ];
+        for (dense_limit, solver) in solvers {
+            let workspace = || {
+                let mut ws = StepWorkspace::with_solver(&s, dense_limit, solver);
+                perturbed_iterate(&mut ws, &q_n);
+                ws
+            };
+            for alpha in [0.6, 1.0] {
+                let mut ws = workspace();
+                let layout = ws.layout.clone();
+                let mut state = RuleState::new(&q_n);
+                let rule = GeneralizedTrapezoidal { alpha };
+                let (mut problem, _) = problem_at(rule, &s, &mut ws, &mut state, start(&q_n, &v_n));
+                assert_jacobian_matches(&mut problem, &layout);
+            }
+            for rho_inf in [0.0, 0.6] {
+                let mut ws = workspace();
+                let layout = ws.layout.clone();
+                let mut state = alpha_state(q_n.len());
+                let rule = GeneralizedAlpha { rho_inf };
+                let (mut problem, _) = problem_at(rule, &s, &mut ws, &mut state, start(&q_n, &v_n));
+                assert_jacobian_matches(&mut problem, &layout);
+            }
+        }
+        let run = |parallel: bool| {
+            let mut ws = StepWorkspace::new(&s, 48);
+            if parallel {
+                ws.assemble_in_parallel_from(&s, 0);
+            }
+            wiggled_iterate(&mut ws, &q_n);
+            let mut state = alpha_state(q_n.len());
+            assemble(GeneralizedAlpha { rho_inf: 0.6 }, &s, &mut ws, &mut state)
+        };
+        assert_same_assembly(&run(false), &run(true));
+    }
+
+    /// Closed form: a node of mass m between two fixed neighbours on the x axis, in water
+    /// without gravity nor drag, displaced by d from rest in one backward-Euler step
+    /// (qdd = d/h^2): its scaled residual is sigma (m + CaAx rho V) d_x / h^2 along the line
+    /// and sigma (m + Ca rho V) d_y / h^2 across it (MoorDyn's node mass matrix
+    /// m I + rho V (Ca (I - t t^T) + CaAx t t^T), t = x).
+    #[test]
+    fn axial_added_mass_makes_the_inertia_along_the_line_m_plus_caax_rho_v() {
+        use crate::model::LineHydroSpec;
+        let mut s = System::new([0.0; 3]);
+        let a = s
+            .add_particle(1.0, [-1.0, 0.0, 0.0], [0.0; 3], true)
+            .unwrap();
+        let n = s.add_particle(3.0, [0.0; 3], [0.0; 3], false).unwrap();
+        let b = s
+            .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], true)
+            .unwrap();
+        let spec = LineHydroSpec {
+            density: 1025.0,
+            diameter: 0.08,
+            length: 1.0,
+            cd: 0.0,
+            cdax: 0.0,
+            ca: 1.0,
+            caax: 0.25,
+            current: [0.0; 3],
+        };
+        s.add_line_hydrodynamics(n, Some((a, b)), &spec).unwrap();
+        let rho_v = 1025.0 * std::f64::consts::PI * 0.08 * 0.08 / 4.0;
+        let (q_n, v_n) = (s.initial_positions(), s.initial_velocities());
+        let mut ws = StepWorkspace::new(&s, 48);
+        let d = [0.002, -0.003, 0.001];
+        ws.state.q = q_n.clone();
+        ws.state.q[1] = d;
+        let mut state = RuleState::new(&q_n);
+        let rule = GeneralizedTrapezoidal { alpha: 1.0 };
+        let h = 0.01;
+        let sigma = h * h / ws.mass_ref;
+        let (mut problem, _) = problem_at(rule, &s, &mut ws, &mut state, start(&q_n, &v_n));
+        let mut r = vec![0.0; 3];
+        problem.residual(&mut r);
+        let expected = [
+            sigma * (3.0 + 0.25 * rho_v) * d[0] / (h * h),
+            sigma * (3.0 + rho_v) * d[1] / (h * h),
+            sigma * (3.0 + rho_v) * d[2] / (h * h),
+        ];
+        for k in 0..3 {
+            assert!(
+                (r[k] - expected[k]).abs() < 1e-13 * expected[k].abs(),
+                "{r:?} vs {expected:?}"
+            );
         }
     }
 }

@@ -1,7 +1,7 @@
 //! The matrices, solver and buffers that every index-3 step of a run reuses, whatever its time
 //! rule (allocated once per run; no allocation per step).
 
-use crate::assembly::{Layout, ParallelAssembly};
+use crate::assembly::{AxialAddedMass, Layout, ParallelAssembly};
 use crate::linear::{for_layout, LinearSolver, SparseSolver, TreeElimination};
 use crate::math::Vec3;
 use crate::model::System;
@@ -31,6 +31,9 @@ pub struct StepWorkspace {
     /// Inertia of each particle's translation: its mass plus any added mass of fluid elements
     /// (the diagonal of M, constant over the run). Gravity acts on the mass alone.
     pub inertia: Vec<f64>,
+    /// The axial correction of the line nodes' added mass (CaAx != Ca), added to the mass
+    /// blocks at each step's evaluation point (`assembly/axial_added_mass.rs`).
+    pub axial_added_mass: AxialAddedMass,
     /// s_k of each constraint.
     pub scales: Vec<f64>,
     /// Colouring and buffers of parallel assembly, when the model is large enough for it to
@@ -112,6 +115,7 @@ impl StepWorkspace {
             scales: system.constraints().iter().map(|c| c.scale()).collect(),
             mass_ref,
             inertia: system.inertia(),
+            axial_added_mass: AxialAddedMass::new(system),
             layout,
             parallel: None,
         }

@@ -436,7 +436,9 @@ impl System {
         self.particles[i].fixed = fixed;
     }
 
-    /// Inertia of each particle's translation: its mass plus the added mass of fluid elements.
+    /// Inertia of each particle's translation: its mass plus the added mass of fluid elements
+    /// (a line node's normal added mass Ca rho V; along the line the step problems correct it
+    /// to CaAx rho V, `assembly/axial_added_mass.rs`).
     pub fn inertia(&self) -> Vec<f64> {
         let mut m: Vec<f64> = self.particles.iter().map(|p| p.mass).collect();
         for f in &self.forces {
