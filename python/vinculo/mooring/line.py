@@ -124,6 +124,8 @@ class Line:
         damping: the dashpot coefficient BA / l of each segment (N s/m; 0: none).
         length_law: the line's unstretched length as a law of time (a winch), or None when it
             is :attr:`unstretched_length` at all times.
+        bending: the stiffness EI / l^3 (N/m) of the bending element at each inner node (0:
+            no bending stiffness).
     """
 
     nodes: list[int]
@@ -136,6 +138,7 @@ class Line:
         default_factory=lambda: (np.zeros(3), np.zeros(3)))
     damping: float = 0.0
     length_law: Any = None
+    bending: float = 0.0
 
     def tensions(self, solution: Any) -> np.ndarray:
         """The segments' tensions: the elastic part from their multipliers, plus the axial
@@ -180,7 +183,10 @@ class Line:
 
     def end_forces(self, solution: Any) -> tuple[np.ndarray, np.ndarray]:
         """The forces of the line on its end particles A and B: the end segments' tensions along
-        them, and the weight and buoyancy of the half segments at the ends.
+        them, the weight and buoyancy of the half segments at the ends, and, for a line with
+        bending stiffness, the force of the bending element next to each end on it (the shear
+        that carries part of the line's weight: the second difference's force
+        ``-EI / l^3 (q_0 - 2 q_1 + q_2)``, ``forces/bending.rs``).
 
         Arguments:
             solution: a :class:`vinculo.Solution` or a static equilibrium.
@@ -195,6 +201,10 @@ class Line:
         last = q[:, self.nodes[-2]] - q[:, self.nodes[-1]]
         on_a = t[:, :1] * first / np.linalg.norm(first, axis=1, keepdims=True)
         on_b = t[:, -1:] * last / np.linalg.norm(last, axis=1, keepdims=True)
+        if self.bending > 0.0 and len(self.nodes) >= 3:
+            n = self.nodes
+            on_a = on_a - self.bending * (q[:, n[0]] - 2.0 * q[:, n[1]] + q[:, n[2]])
+            on_b = on_b - self.bending * (q[:, n[-1]] - 2.0 * q[:, n[-2]] + q[:, n[-3]])
         return on_a + self.end_loads[0], on_b + self.end_loads[1]
 
     def laid_length(self, positions: Any, seabed_z: float) -> float:
@@ -371,4 +381,5 @@ def add_line(system: Any, end_a: int, end_b: int, line_type: LineType,
     load = (line_type.mass_per_length * half - displaced) * gravity
     return Line(nodes=nodes, segments=links, line_type=line_type, unstretched_length=length0,
                 water=water, name=name, end_loads=(load, load.copy()), damping=damping,
-                length_law=unstretched_length if isinstance(unstretched_length, Law) else None)
+                length_law=unstretched_length if isinstance(unstretched_length, Law) else None,
+                bending=line_type.ei / segment**3 if line_type.ei > 0.0 and segments >= 2 else 0.0)

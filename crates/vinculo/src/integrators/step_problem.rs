@@ -188,6 +188,37 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
         self.layout
             .apply_increment(&mut b.q, &mut b.lambda, dx, self.scales, self.point.sigma);
     }
+
+    /// `ROUND_OFF_ULPS eps max_i sum_j |J_ij| |x_j|` over the scaled unknowns: positions (m) and
+    /// multipliers `lambda sigma / s` (0 when the pattern's structure was released).
+    fn round_off(&self, values: &[f64]) -> f64 {
+        let pattern = &self.layout.pattern;
+        if pattern.is_released() || values.len() != pattern.nnz() {
+            return 0.0;
+        }
+        let b = &*self.buffers;
+        let mut x = vec![0.0; pattern.n];
+        for (i, qi) in b.q.iter().enumerate() {
+            let d = self.layout.dof[i];
+            if d != crate::assembly::NONE {
+                for k in 0..3 {
+                    x[d + k] = qi[k].abs();
+                }
+            }
+        }
+        let m3 = 3 * self.layout.free;
+        for (c, l) in b.lambda.iter().enumerate() {
+            x[m3 + c] = (l * self.point.sigma / self.scales[c]).abs();
+        }
+        let mut rows = vec![0.0f64; pattern.n];
+        for (col, xc) in x.iter().enumerate() {
+            for k in pattern.col_ptr[col]..pattern.col_ptr[col + 1] {
+                rows[pattern.row_idx[k]] += values[k].abs() * xc;
+            }
+        }
+        let largest = rows.iter().fold(0.0f64, |m, r| m.max(*r));
+        super::newton::ROUND_OFF_ULPS * f64::EPSILON * largest
+    }
 }
 
 /// The scaled inertia and gravity rows of a step of the rule step `R` at the current iterate.
