@@ -378,7 +378,10 @@ mod tests {
         );
         let x = problem.0.x;
         // |slope (x - 1)| <= residual + noise <= 3 noise.
-        assert!((x - 1.0).abs() <= 3.0 * 4e-9 / 1e-7 * (1.0 + 1e-12), "x = {x}");
+        assert!(
+            (x - 1.0).abs() <= 3.0 * 4e-9 / 1e-7 * (1.0 + 1e-12),
+            "x = {x}"
+        );
     }
 
     fn run(slope: f64, noise: f64) -> (Result<NewtonReport, NewtonFailure>, f64) {

@@ -70,8 +70,8 @@
 //! whole matrix is regular: the end particle of a straight leg whose link to its parent is
 //! parallel to its anchor (a chain hung as a V of two straight legs at rest), where the block
 //! holds two parallel conditions on one particle and only the parent's freedom makes the matrix
-//! regular. A block pivot at round-off ([`NEAR_SINGULAR`] of the block's largest entry, per unknown) stops
-//! the elimination, and that factorisation is made by the general sparse LU (partial pivoting
+//! regular. A block pivot at round-off ([`NEAR_SINGULAR`] of the terms it was computed from,
+//! per unknown: cancellation) stops the elimination, and that factorisation is made by the general sparse LU (partial pivoting
 //! across the whole matrix, analysed on first need); only its failure is reported as a singular
 //! matrix. The next factorisation tries the tree again (the configuration moves on).
 //!
@@ -86,16 +86,21 @@
 use super::{LinearSolver, Singular, SparseLu};
 use crate::assembly::{Pattern, Storage};
 
-/// Smallest pivot of a block, relative to the block's largest entry and per unknown of the
-/// block, that the elimination accepts (a thousand round-offs); below it the factorisation
+/// Smallest pivot of a block that the elimination accepts, relative to the sum of the
+/// magnitudes of the terms it was computed from (the block's entry and the products the
+/// elimination subtracted from it) and per unknown of the block: a thousand round-offs of that
+/// sum. Below it the pivot is cancellation, the block (nearly) singular, and the factorisation
 /// falls back to the general sparse LU.
 ///
-/// The bound is relative to round-off, not to a fixed share of the digits: a block of a
-/// particle and its link is a saddle point whose second pivot, |g|^2 beta h^2 / m against the
-/// largest entry m / (beta h^2), is naturally tiny (6e-12 on a chain of 0.1 kg particles at
-/// dt = 1 ms), so a bound of 1e-8 sent every factorisation of a straight hanging chain to the
-/// sparse LU (3.4 times slower a step on 10^4 particles, measured) although the tree solve was
-/// accurate there.
+/// The bound is relative to the pivot's own terms, not to the block's largest entry nor to a
+/// fixed share of the digits, because a block of a particle and its link is a saddle point
+/// whose second pivot is naturally tiny against its particle part: |g|^2 beta h^2 / m against
+/// m / (beta h^2) (6e-12 on a chain of 0.1 kg particles at dt = 1 ms: a bound of 1e-8 sent every
+/// factorisation of a straight hanging chain to the sparse LU, 3.4 times slower a step on 10^4
+/// particles, measured), and against the bending stiffness EI / l^3 of a line, which grows as
+/// the cube of the number of segments (a bound of a thousand round-offs of the block's largest
+/// entry sent most factorisations of a 500-segment cable with bending to the sparse LU,
+/// although its pivots were accurate).
 pub const NEAR_SINGULAR: f64 = 1e3 * f64::EPSILON;
 
 /// Most ancestors a block may be coupled with (after fill) for the analysis to accept the
@@ -733,16 +738,27 @@ fn schur_product(low: &[f64], w: &[f64], nb: usize, stride: usize, col: usize) -
     s
 }
 
-/// In-place LU with partial pivoting of the n x n row-major matrix `a`; returns the local
-/// column of a pivot below [`NEAR_SINGULAR`] x n of the largest entry. On return the strict lower triangle holds L (unit diagonal),
-/// the strict upper triangle U, and the diagonal the reciprocals of U's pivots, so that the
-/// solves multiply where they would divide.
+/// Largest block: a particle's 3 coordinates and at most 3 conditions on them (the analysis
+/// declines larger ones).
+const MAX_BLOCK: usize = 6;
+
+/// In-place LU with partial pivoting of the n x n row-major matrix `a` (n <= [`MAX_BLOCK`]);
+/// returns the local column of a pivot at round-off: at most [`NEAR_SINGULAR`] x n of the sum
+/// of the magnitudes of the terms it was computed from (the original entry and the products
+/// subtracted from it), which bounds its round-off. On return the strict lower triangle holds L
+/// (unit diagonal), the strict upper triangle U, and the diagonal the reciprocals of U's pivots,
+/// so that the solves multiply where they would divide.
 #[inline(always)]
 fn lu_in_place(a: &mut [f64], n: usize, perm: &mut [u32]) -> Result<(), usize> {
     // Slices of known length let the unrolled copies drop their bounds checks.
     let (a, perm) = (&mut a[..n * n], &mut perm[..n]);
-    let largest = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let tiny = largest * NEAR_SINGULAR * n as f64;
+    // The magnitudes of the terms summed into each entry, updated as the entries are.
+    let mut size = [0.0f64; MAX_BLOCK * MAX_BLOCK];
+    let size = &mut size[..n * n];
+    for (m, x) in size.iter_mut().zip(a.iter()) {
+        *m = x.abs();
+    }
+    let relative = NEAR_SINGULAR * n as f64;
     for k in 0..n {
         let mut p = k;
         for i in k + 1..n {
@@ -754,10 +770,11 @@ fn lu_in_place(a: &mut [f64], n: usize, perm: &mut [u32]) -> Result<(), usize> {
         if p != k {
             for j in 0..n {
                 a.swap(k * n + j, p * n + j);
+                size.swap(k * n + j, p * n + j);
             }
         }
         let pivot = a[k * n + k];
-        if !pivot.is_finite() || pivot.abs() <= tiny {
+        if !pivot.is_finite() || pivot.abs() <= relative * size[k * n + k] {
             return Err(k);
         }
         let inv = 1.0 / pivot;
@@ -767,6 +784,7 @@ fn lu_in_place(a: &mut [f64], n: usize, perm: &mut [u32]) -> Result<(), usize> {
             if l != 0.0 {
                 for j in k + 1..n {
                     a[i * n + j] -= l * a[k * n + j];
+                    size[i * n + j] += l.abs() * size[k * n + j];
                 }
             }
         }
