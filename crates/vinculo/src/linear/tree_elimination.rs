@@ -652,12 +652,13 @@ impl TreeElimination {
         self.gathered[b] = true;
     }
 
-    /// Eliminates block b of `nb` unknowns (its ancestors' storage gathered): factorises D_b,
+    /// Eliminates block b of `nb` unknowns coupled with `k` ancestors (their storage gathered;
+    /// the sizes as arguments, so that callers with constants get unrolled copies): factorises D_b,
     /// forms W_b = D_b^-1 [A_bu for u in U_b] and applies the Schur updates
     /// A_u1u2 -= A_u1b W_b[:, u2] to the ancestors' storage. Returns the local column of a
     /// negligible pivot.
     #[inline(always)]
-    fn eliminate(&mut self, b: usize, nb: usize) -> Result<(), usize> {
+    fn eliminate(&mut self, b: usize, nb: usize, k: usize) -> Result<(), usize> {
         let s = self.start[b];
         let (da, db) = (self.diag_at[b], self.diag_at[b + 1]);
         let (own_diag, rest_diag) = self.diag.split_at_mut(db);
@@ -665,7 +666,7 @@ impl TreeElimination {
         let perm = &mut self.perm[s..s + nb];
         lu_in_place(d, nb, perm)?;
         let set = &self.ancestors[self.coupled_at[b]..self.coupled_at[b + 1]];
-        let k = set.len();
+        let set = &set[..k];
         if k == 0 {
             return Ok(());
         }
@@ -744,19 +745,22 @@ const MAX_BLOCK: usize = 6;
 
 /// In-place LU with partial pivoting of the n x n row-major matrix `a` (n <= [`MAX_BLOCK`]);
 /// returns the local column of a pivot at round-off: at most [`NEAR_SINGULAR`] x n of the sum
-/// of the magnitudes of the terms it was computed from (the original entry and the products
-/// subtracted from it), which bounds its round-off. On return the strict lower triangle holds L
-/// (unit diagonal), the strict upper triangle U, and the diagonal the reciprocals of U's pivots,
-/// so that the solves multiply where they would divide.
+/// of the magnitudes of the terms it was computed from, `|a_pk| + sum_j<k |l_kj| |u_jk|` (p the
+/// pivot's row in `a`: the bound on its round-off of the LU's backward error analysis). On return
+/// the strict lower triangle holds L (unit diagonal), the strict upper triangle U, and the
+/// diagonal the reciprocals of U's pivots, so that the solves multiply where they would divide.
 #[inline(always)]
 fn lu_in_place(a: &mut [f64], n: usize, perm: &mut [u32]) -> Result<(), usize> {
     // Slices of known length let the unrolled copies drop their bounds checks.
     let (a, perm) = (&mut a[..n * n], &mut perm[..n]);
-    // The magnitudes of the terms summed into each entry, updated as the entries are.
-    let mut size = [0.0f64; MAX_BLOCK * MAX_BLOCK];
-    let size = &mut size[..n * n];
-    for (m, x) in size.iter_mut().zip(a.iter()) {
-        *m = x.abs();
+    // The entries as given, and the given row of each row of `a` as rows are interchanged.
+    let mut given = [0.0f64; MAX_BLOCK * MAX_BLOCK];
+    let given = &mut given[..n * n];
+    given.copy_from_slice(a);
+    let mut row = [0usize; MAX_BLOCK];
+    let row = &mut row[..n];
+    for (i, r) in row.iter_mut().enumerate() {
+        *r = i;
     }
     let relative = NEAR_SINGULAR * n as f64;
     for k in 0..n {
@@ -770,11 +774,15 @@ fn lu_in_place(a: &mut [f64], n: usize, perm: &mut [u32]) -> Result<(), usize> {
         if p != k {
             for j in 0..n {
                 a.swap(k * n + j, p * n + j);
-                size.swap(k * n + j, p * n + j);
             }
+            row.swap(k, p);
         }
         let pivot = a[k * n + k];
-        if !pivot.is_finite() || pivot.abs() <= relative * size[k * n + k] {
+        let mut size = given[row[k] * n + k].abs();
+        for j in 0..k {
+            size += (a[k * n + j] * a[j * n + k]).abs();
+        }
+        if !pivot.is_finite() || pivot.abs() <= relative * size {
             return Err(k);
         }
         let inv = 1.0 / pivot;
@@ -784,7 +792,6 @@ fn lu_in_place(a: &mut [f64], n: usize, perm: &mut [u32]) -> Result<(), usize> {
             if l != 0.0 {
                 for j in k + 1..n {
                     a[i * n + j] -= l * a[k * n + j];
-                    size[i * n + j] += l.abs() * size[k * n + j];
                 }
             }
         }
@@ -913,13 +920,17 @@ impl LinearSolver for TreeElimination {
                 }
             }
             let (s, nb) = (self.start[b], self.start[b + 1] - self.start[b]);
-            // Blocks of 3 (a free particle), 4 (a particle and its link) and 5 get unrolled
-            // copies.
-            let result = match nb {
-                3 => self.eliminate(b, 3),
-                4 => self.eliminate(b, 4),
-                5 => self.eliminate(b, 5),
-                _ => self.eliminate(b, nb),
+            let k = self.coupled_at[b + 1] - self.coupled_at[b];
+            // Blocks of 3 (a free particle), 4 (a particle and its link) and 5, coupled with
+            // one ancestor (a chain) or two (a line with bending), get unrolled copies.
+            let result = match (nb, k) {
+                (3, 1) => self.eliminate(b, 3, 1),
+                (4, 1) => self.eliminate(b, 4, 1),
+                (5, 1) => self.eliminate(b, 5, 1),
+                (3, 2) => self.eliminate(b, 3, 2),
+                (4, 2) => self.eliminate(b, 4, 2),
+                (5, 2) => self.eliminate(b, 5, 2),
+                _ => self.eliminate(b, nb, k),
             };
             if let Err(k) = result {
                 // A (nearly) singular block need not mean a singular matrix: the sparse LU
