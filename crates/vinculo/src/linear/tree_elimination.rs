@@ -14,7 +14,10 @@
 //! join a particle and one of its *ancestors* (its parent for an edge of the tree, possibly a
 //! farther one for the others: the bending of a line at node i couples nodes i-1 and i+1, the
 //! grandparent of one of them); an edge between two particles neither of which is an ancestor
-//! of the other (siblings, or cousins) makes the analysis decline. A two-particle multiplier
+//! of the other (siblings, or cousins) makes the analysis decline, except that a force between
+//! them first has the analysis made again with every tree rooted at a leaf (a line's bending
+//! centred on its most constrained node, in the middle of the line, then couples a node with
+//! its grandparent). A two-particle multiplier
 //! joins the block of the edge's lower particle (the descendant). So block b couples only with
 //! itself and with the particle parts of some of its ancestors u:
 //!
@@ -203,19 +206,59 @@ fn compressed(
     (ptr, values)
 }
 
+/// Where the analysis roots each tree.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Rooting {
+    /// At its particle with the most multipliers of its own, else its lowest index.
+    MostConstrained,
+    /// At a leaf (a particle with one neighbour in the tree): the one with the most multipliers
+    /// of its own, else the lowest index.
+    Leaf,
+}
+
+/// Why an analysis declined.
+#[derive(PartialEq, Eq)]
+enum Decline {
+    /// A force couples two particles neither of which is an ancestor of the other.
+    AcrossBranches,
+    /// Anything else (see the module documentation).
+    Other,
+}
+
 impl TreeElimination {
     /// Analyses a sparse pattern whose first `particle_unknowns` unknowns come in groups of 3
     /// (one group per free particle) and whose other unknowns are single multipliers.
     /// Returns `None` when the pattern does not suit the elimination (see the module
     /// documentation; the caller then uses a general sparse LU).
+    ///
+    /// Each tree is rooted at its most constrained particle; when a force then couples two
+    /// branches (a line's bending centred on that particle, in the middle of the line), the
+    /// analysis is made again with every tree rooted at a leaf, which puts the two ends of such
+    /// a coupling on one path when the tree is a path. Loops of constraints (a triangle of
+    /// distances, a ring) are declined as they are.
     pub fn analyse(pattern: &Pattern, particle_unknowns: usize) -> Option<TreeElimination> {
+        match Self::analyse_rooted(pattern, particle_unknowns, Rooting::MostConstrained) {
+            Ok(tree) => Some(tree),
+            Err(Decline::AcrossBranches) => {
+                Self::analyse_rooted(pattern, particle_unknowns, Rooting::Leaf).ok()
+            }
+            Err(Decline::Other) => None,
+        }
+    }
+
+    /// [`TreeElimination::analyse`] with the trees rooted as `rooting` says.
+    fn analyse_rooted(
+        pattern: &Pattern,
+        particle_unknowns: usize,
+        rooting: Rooting,
+    ) -> Result<TreeElimination, Decline> {
         let n = pattern.n;
         if pattern.storage != Storage::Sparse
             || particle_unknowns % 3 != 0
             || particle_unknowns > n
             || pattern.nnz() >= ABSENT as usize
         {
-            return None;
+            return Err(Decline::Other);
         }
         let np = particle_unknowns / 3;
         let nl = n - particle_unknowns;
@@ -239,10 +282,10 @@ impl TreeElimination {
                         } else if t[1] == ABSENT {
                             t[1] = p as u32;
                         } else {
-                            return None; // a multiplier on three particles
+                            return Err(Decline::Other); // a multiplier on three particles
                         }
                     }
-                    (None, None) if row != col => return None, // coupled multipliers
+                    (None, None) if row != col => return Err(Decline::Other), // coupled multipliers
                     (None, None) => {}
                 }
             }
@@ -250,7 +293,7 @@ impl TreeElimination {
         let mut links: Vec<(u32, u32)> = Vec::new();
         for t in &touched {
             match *t {
-                [ABSENT, _] => return None, // a multiplier on no free particle
+                [ABSENT, _] => return Err(Decline::Other), // a multiplier on no free particle
                 [a, b] if b != ABSENT => links.push((a.min(b), a.max(b))),
                 _ => {}
             }
@@ -293,8 +336,15 @@ impl TreeElimination {
             }
         }
         let mut roots: Vec<u32> = (0..np as u32).collect();
-        if own.iter().any(|&k| k > 0) {
-            roots.sort_by_key(|&p| std::cmp::Reverse(own[p as usize]));
+        match rooting {
+            Rooting::MostConstrained if own.iter().any(|&k| k > 0) => {
+                roots.sort_by_key(|&p| std::cmp::Reverse(own[p as usize]));
+            }
+            Rooting::MostConstrained => {}
+            Rooting::Leaf => {
+                let inner = |p: u32| adj_ptr[p as usize + 1] - adj_ptr[p as usize] > 1;
+                roots.sort_by_key(|&p| (inner(p), std::cmp::Reverse(own[p as usize])));
+            }
         }
         drop(own);
         let mut parent_particle = vec![ROOT; np];
@@ -366,13 +416,17 @@ impl TreeElimination {
         // Every edge joins a particle (the descendant) and one of its ancestors: the pairs
         // (descendant's block, ancestor's block), from which the sets U_b grow.
         let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(links.len() + forces.len());
-        for &(a, b) in links.iter().chain(&forces) {
+        for (k, &(a, b)) in links.iter().chain(&forces).enumerate() {
             let (d, u) = if is_ancestor(a, b) {
                 (b, a)
             } else if is_ancestor(b, a) {
                 (a, b)
+            } else if k >= links.len() {
+                // Siblings or cousins coupled by a force: another root may join them.
+                return Err(Decline::AcrossBranches);
             } else {
-                return None; // siblings or cousins: fill outside the ancestors
+                // A loop of constraints (a triangle of distances, a ring).
+                return Err(Decline::Other);
             };
             pairs.push((position[d as usize], position[u as usize]));
         }
@@ -396,7 +450,7 @@ impl TreeElimination {
         // A block with more than three conditions on its particle's three coordinates is
         // singular whatever the values: the general sparse LU pivots across blocks instead.
         if size.iter().any(|&s| s > 6) {
-            return None;
+            return Err(Decline::Other);
         }
         let blocks = np;
         let mut start = vec![0usize; np + 1];
@@ -462,7 +516,7 @@ impl TreeElimination {
             set.sort_unstable();
             set.dedup();
             if set.len() > MAX_COUPLED_ANCESTORS {
-                return None;
+                return Err(Decline::Other);
             }
             ancestors.extend_from_slice(&set);
             coupled_at[b + 1] = ancestors.len();
@@ -479,7 +533,9 @@ impl TreeElimination {
             for (i1, &u1) in set.iter().enumerate() {
                 for &u2 in &set[i1 + 1..] {
                     // Present by construction of the sets (see the module documentation).
-                    let at = coupled(u1 as usize).binary_search(&u2).ok()?;
+                    let at = coupled(u1 as usize)
+                        .binary_search(&u2)
+                        .map_err(|_| Decline::Other)?;
                     fill_index.push(at as u32);
                 }
             }
@@ -522,14 +578,14 @@ impl TreeElimination {
             }
         }
         if covered != pattern.nnz() {
-            return None;
+            return Err(Decline::Other);
         }
         let parents_only = (0..blocks).all(|b| coupled(b).len() <= 1);
         let uniform = match start.windows(2).map(|w| w[1] - w[0]).min() {
             Some(nb) if start[blocks] == nb * blocks && parents_only => nb,
             _ => 0,
         };
-        Some(TreeElimination {
+        Ok(TreeElimination {
             uniform,
             gathered: vec![false; blocks],
             diag: vec![0.0; diag_at[blocks]],
@@ -1374,27 +1430,31 @@ mod tests {
         check_against_dense_lu(17, &couplings, &multipliers, 3);
     }
 
-    /// A coupling between two children of one particle (a bending triple centred on the root:
-    /// the middle node of a 3-node line holds a fixed coordinate, so it is the root, and the
-    /// bending couples its two neighbours), or between cousins, makes the analysis decline.
+    /// A bending triple centred on the most constrained particle, in the middle of a line (the
+    /// middle node of a 3-node line holds a fixed coordinate, so it would be the root, and the
+    /// bending couples its two neighbours, siblings): the analysis roots the line at an end
+    /// instead, and the elimination agrees with the dense LU.
     #[test]
-    fn couplings_between_siblings_are_declined() {
+    fn bending_centred_on_the_most_constrained_particle_is_rooted_at_an_end() {
         let bent = [(0, 1), (1, 2), (0, 2)];
-        let links = [(0, Some(1), false), (1, Some(2), false), (1, None, false)];
-        let (pattern, _, particle_unknowns) = kkt_matrix(3, &bent, &links, 1);
-        assert!(TreeElimination::analyse(&pattern, particle_unknowns).is_none());
-        // Without the bending coupling, the same line is a tree.
-        let (pattern, _, particle_unknowns) = kkt_matrix(3, &bent[..2], &links, 1);
-        assert!(TreeElimination::analyse(&pattern, particle_unknowns).is_some());
-        // Cousins: 3 and 4 below 1 and 2, the children of the root 0.
+        let links = [(0, Some(1), false), (1, Some(2), true), (1, None, false)];
+        check_against_dense_lu(3, &bent, &links, 2);
+    }
+
+    /// Couplings between branches that no root puts on one path (each pair of three legs of a
+    /// star: wherever the root, two legs are siblings) make the analysis decline.
+    #[test]
+    fn couplings_across_branches_are_declined() {
         let links = [
             (0, Some(1), false),
             (0, Some(2), false),
-            (1, Some(3), false),
-            (2, Some(4), false),
+            (0, Some(3), false),
         ];
-        let (pattern, _, particle_unknowns) = kkt_matrix(5, &[(3, 4)], &links, 1);
+        let (pattern, _, particle_unknowns) = kkt_matrix(4, &[(1, 2), (2, 3), (1, 3)], &links, 1);
         assert!(TreeElimination::analyse(&pattern, particle_unknowns).is_none());
+        // Without the couplings between the legs, the same star is a tree.
+        let (pattern, _, particle_unknowns) = kkt_matrix(4, &[], &links, 1);
+        assert!(TreeElimination::analyse(&pattern, particle_unknowns).is_some());
     }
 
     /// Well-posed chains whose tree blocks are singular. `pinned` false: a chain hung from two
