@@ -272,11 +272,11 @@ def test_consistent_start():
 
 def test_tree_scaling():
     # A chain's constraint graph is a tree: the tree elimination, whose cost is linear in N
-    # (docs/theory/tree-elimination.md); a spring closing a loop sends it to the sparse LU. The
+    # (docs/theory/tree-elimination.md); linear_solver="sparse-lu" asks for the sparse LU. The
     # exponent is a timing on a shared machine: the bound only separates linear from quadratic.
     out = run_example("tree_scaling.py")
     assert "chain (a tree): linear solver tree elimination;" in out
-    assert "closed by a spring: linear solver sparse LU;" in out
+    assert "chain by the sparse LU: linear solver sparse LU;" in out
     assert number_after("chain (a tree): linear solver tree elimination; time per step grows as N^",
                         out) < 1.5
 

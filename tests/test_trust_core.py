@@ -73,11 +73,11 @@ def test_n_four_bar_passes_every_singular_configuration(scheme):
     # are not determined and Newton's increments bounce at round-off; or with a singular block
     # of the tree elimination.
     system, top = _four_bars(40)
-    if scheme == "trapezoidal":
-        # A zero-stiffness spring closes a loop: no force, but the general sparse LU.
-        system.add_spring_damper(top[0], top[-1], stiffness=0.0)
+    # The trapezoidal rule with the general sparse LU, generalised-alpha with the tree elimination.
+    linear_solver = "sparse-lu" if scheme == "trapezoidal" else "auto"
     solution = vinculo.simulate(
-        system, t_end=10.0, dt=1e-3, scheme=scheme, tolerance=1e-12, save_every=10
+        system, t_end=10.0, dt=1e-3, scheme=scheme, tolerance=1e-12, save_every=10,
+        linear_solver=linear_solver,
     )
     assert solution.success
     xy = solution.particle(top[0])[:, :2]
@@ -103,13 +103,11 @@ def test_n_four_bar_passes_every_singular_configuration(scheme):
 # --- Tree elimination: singular blocks of regular matrices ----------------------------------------
 
 
-def _v_chain(links_per_leg: int, closed: bool = False) -> tuple[vinculo.System, list]:
+def _v_chain(links_per_leg: int) -> tuple[vinculo.System, list]:
     """A chain hung from two anchors 2 m apart as a V of two straight legs, at rest.
 
     The end particle of a leg holds two parallel conditions (its anchor and its link) in the
-    tree elimination's block: the block is singular though the matrix is not. ``closed`` adds a
-    spring of zero stiffness between the two ends of the chain: no force, but a loop in the
-    graph, so that the run uses the general sparse LU (the reference).
+    tree elimination's block: the block is singular though the matrix is not.
     """
     system = vinculo.System(gravity=(0.0, 0.0, -G))
     left = system.add_particle(mass=1.0, position=(-1.0, 0.0, 0.0), fixed=True)
@@ -122,16 +120,14 @@ def _v_chain(links_per_leg: int, closed: bool = False) -> tuple[vinculo.System, 
         previous = joint
         chain.append(joint)
     system.add_distance(previous, right)
-    if closed:
-        system.add_spring_damper(chain[0], chain[-1], stiffness=0.0)
     return system, chain
 
 
-def _pinned_chain(links: int, pinned: bool, closed: bool = False) -> tuple[vinculo.System, list]:
+def _pinned_chain(links: int, pinned: bool) -> tuple[vinculo.System, list]:
     """A chain of 1 m hanging straight down, released with a sideways speed growing along it.
 
     Its top is a free particle whose three coordinates are prescribed (``pinned``) or a fixed
-    particle: the same mechanics. ``closed``: a zero-stiffness spring closes a loop (sparse LU).
+    particle: the same mechanics.
     """
     system = vinculo.System(gravity=(0.0, 0.0, -G))
     # The tip first and the top last: the top is not the first particle (the tree elimination
@@ -148,8 +144,6 @@ def _pinned_chain(links: int, pinned: bool, closed: bool = False) -> tuple[vincu
             system.add_fixed_coordinate(top, axis)
     for above, below in zip([top, *chain[:-1]], chain, strict=True):
         system.add_distance(above, below)
-    if closed:
-        system.add_spring_damper(chain[0], chain[-1], stiffness=0.0)
     return system, chain
 
 
@@ -160,11 +154,12 @@ def _positions(solution: vinculo.Solution, chain: list) -> np.ndarray:
 def test_v_chain_runs_with_the_tree_elimination_and_agrees_with_sparse_lu():
     # Used to stop at t = 0: "singular iteration matrix, the constraints may be redundant".
     runs = {}
-    for closed in (False, True):
-        system, chain = _v_chain(12, closed=closed)
-        solution = vinculo.simulate(system, t_end=0.5, dt=1e-3, save_every=10)
+    for general in (False, True):
+        system, chain = _v_chain(12)
+        solution = vinculo.simulate(system, t_end=0.5, dt=1e-3, save_every=10,
+                                    linear_solver="sparse-lu" if general else "auto")
         assert solution.success
-        runs[closed] = (solution, _positions(solution, chain))
+        runs[general] = (solution, _positions(solution, chain))
     assert runs[False][0].linear_solver == "tree elimination"
     assert runs[True][0].linear_solver == "sparse LU"
     # The reference: the same steps solved with partial pivoting across the whole matrix.
@@ -185,11 +180,12 @@ def test_chain_from_a_pinned_particle_runs_and_matches_the_fixed_anchor():
     assert solution.linear_solver == "tree elimination"
     # References: the same chain hung from a fixed particle (the same mechanics), and the
     # pinned chain solved by the general sparse LU.
-    for reference_system, reference_chain in (
-        _pinned_chain(20, pinned=False),
-        _pinned_chain(20, pinned=True, closed=True),
+    for (reference_system, reference_chain), linear_solver in (
+        (_pinned_chain(20, pinned=False), "auto"),
+        (_pinned_chain(20, pinned=True), "sparse-lu"),
     ):
-        reference = vinculo.simulate(reference_system, t_end=0.5, dt=1e-3, save_every=10)
+        reference = vinculo.simulate(reference_system, t_end=0.5, dt=1e-3, save_every=10,
+                                     linear_solver=linear_solver)
         gap = np.max(np.abs(_positions(solution, chain) - _positions(reference, reference_chain)))
         assert gap < 1e-9, gap
     assert np.max(np.abs(solution.particle(chain[-1])[-1, 0])) > 0.05  # the tip swung out
@@ -247,7 +243,7 @@ def test_a_halving_below_the_resolution_of_t_stops_with_a_typed_error():
 # --- Mass ratios ------------------------------------------------------------------------------
 
 
-def _alternating_chain(links: int, scale: float, closed: bool = False):
+def _alternating_chain(links: int, scale: float):
     """A chain of 0.1 m links released horizontally from a fixed anchor, its particles'
     masses alternating between 1e-9 kg and 1e3 kg (times ``scale``)."""
     system = vinculo.System(gravity=(0.0, 0.0, -G))
@@ -259,21 +255,23 @@ def _alternating_chain(links: int, scale: float, closed: bool = False):
         system.add_distance(previous, joint)
         previous = joint
         chain.append(joint)
-    if closed:
-        system.add_spring_damper(chain[0], chain[-1], stiffness=0.0)
     return system, chain
 
 
 def test_mass_ratio_of_a_trillion_runs_and_is_scale_invariant():
     # Used to stop at t = 0: "singular iteration matrix ... the constraints may be redundant".
     runs = {}
-    for scale, closed in ((1.0, False), (1e-3, False), (1.0, True)):
-        system, chain = _alternating_chain(10, scale, closed)
-        solution = vinculo.simulate(system, t_end=0.3, dt=1e-3, save_every=10)
+    for scale, general in ((1.0, False), (1e-3, False), (1.0, True)):
+        system, chain = _alternating_chain(10, scale)
+        solution = vinculo.simulate(system, t_end=0.3, dt=1e-3, save_every=10,
+                                    linear_solver="sparse-lu" if general else "auto")
         assert solution.success
-        runs[scale, closed] = _positions(solution, chain)
+        # linear_solver="sparse-lu" on 40 unknowns: the dense LU (at most 48).
+        assert solution.linear_solver == ("dense LU" if general else "tree elimination")
+        runs[scale, general] = _positions(solution, chain)
     # References: the motion under gravity alone does not depend on the unit of mass (every
-    # mass times 1e-3), and the general sparse LU gives the same steps.
+    # mass times 1e-3), and an LU with partial pivoting across the whole matrix gives the same
+    # steps.
     assert np.max(np.abs(runs[1.0, False] - runs[1e-3, False])) < 1e-9
     assert np.max(np.abs(runs[1.0, False] - runs[1.0, True])) < 1e-9
     assert np.max(np.abs(runs[1.0, False][-1] - runs[1.0, False][0])) > 0.1  # it fell

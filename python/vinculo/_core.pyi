@@ -628,7 +628,8 @@ class RunSettings:
                  adaptive: bool = False, rtol: float = 1e-6, atol: float = 1e-6,
                  h_min: float = 1e-10, h_max: float | None = None,
                  t_eval: list[float] | None = None,
-                 max_output_bytes: float | None = None) -> None: ...
+                 max_output_bytes: float | None = None,
+                 linear_solver: str = "auto") -> None: ...
 
 class RunResult:
     """A run as the compiled core returns it (``simulate``, ``Simulation.solution``): the stored

@@ -97,6 +97,13 @@ class RunOptions:
             per step) is refused before it starts with :class:`OutputTooLargeError`; an
             error-controlled run, whose number of steps is known only as it goes, stops with
             that error when its output reaches the limit (``solution`` keeps what it stored).
+        linear_solver: how the Newton iteration matrix is factorised. 'auto' (default): the
+            block elimination along the particle graph's tree (linear cost: chains, branched
+            strings, lines with bending stiffness, whose couplings join a particle and its
+            ancestors in a spanning tree of the constraints) where the matrix's pattern allows
+            it, else a dense LU up to 48 unknowns and the general sparse LU (faer) above.
+            'sparse-lu': never the tree elimination (the dense LU up to 48 unknowns, the general
+            sparse LU above), to compare the two. ``Solution.linear_solver`` names the one used.
     """
 
     scheme: str = "trapezoidal"
@@ -116,6 +123,7 @@ class RunOptions:
     h_max: float | None = None
     t_eval: Sequence[float] | np.ndarray | None = None
     max_output_bytes: float | None = None
+    linear_solver: str = "auto"
 
     @classmethod
     def of(cls, caller: str, options: dict[str, Any]) -> RunOptions:
@@ -157,8 +165,9 @@ class RunOptions:
             The core's ``RunSettings``, taken by ``_core.simulate`` and ``_core.Simulation``.
 
         Raises:
-            InvalidInputError: ``scheme`` or ``formulation`` is not a string, ``t_eval`` is not a
-                1-D sequence of times, or a value is out of its range (checked by the core).
+            InvalidInputError: ``scheme``, ``formulation`` or ``linear_solver`` is not a string,
+                ``t_eval`` is not a 1-D sequence of times, or a value is out of its range (checked
+                by the core).
         """
         if not isinstance(self.scheme, str):
             raise errors.InvalidInputError(
@@ -172,6 +181,12 @@ class RunOptions:
                 f"formulation must be a name ('index-3' or 'ggl'), got {self.formulation!r}",
                 name="formulation",
                 value=self.formulation,
+            )
+        if not isinstance(self.linear_solver, str):
+            raise errors.InvalidInputError(
+                f"linear_solver must be a name ('auto' or 'sparse-lu'), got {self.linear_solver!r}",
+                name="linear_solver",
+                value=self.linear_solver,
             )
         times = None
         if self.t_eval is not None:

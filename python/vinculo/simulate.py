@@ -84,7 +84,7 @@ def simulate(
             ``scheme``, ``rho_inf``, ``formulation``, ``t_start``, ``tolerance``,
             ``max_iterations``, ``max_halvings``, ``initial_tolerance``, ``save_every``,
             ``jacobian_reuse``, ``adaptive``, ``rtol``, ``atol``, ``h_min``, ``h_max``,
-            ``t_eval`` and ``max_output_bytes``.
+            ``t_eval``, ``max_output_bytes`` and ``linear_solver``.
 
     Returns:
         The :class:`Solution`.

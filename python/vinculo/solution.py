@@ -82,8 +82,9 @@ class Solution:
         system: a copy of the :class:`vinculo.System` that was simulated, taken when the run
             ended (:meth:`vinculo.System.copy`): later edits of the original do not reach it.
         linear_solver: the linear solver the run used: 'dense LU' (small systems),
-            'tree elimination' (tree-shaped constraint graphs: chains, ropes, branched strings)
-            or 'sparse LU' (graphs with loops; and every GGL run above the dense size).
+            'tree elimination' (tree-shaped constraint graphs: chains, ropes, branched strings,
+            lines with bending stiffness) or 'sparse LU' (graphs with loops across branches;
+            every GGL run above the dense size; ``linear_solver='sparse-lu'``).
         factorisations: number of Newton iteration matrices factorised over the run (one per
             Newton iteration in full Newton, fewer with ``jacobian_reuse=True``).
         scheme: the time discretisation: 'trapezoidal', 'backward-euler' or 'generalized-alpha'.

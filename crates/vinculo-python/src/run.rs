@@ -8,7 +8,9 @@ use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
 use std::time::{Duration, Instant};
 use vinculo::integrators::{Formulation, NewtonOptions, Scheme};
-use vinculo::{simulate_with_observer, AdaptiveOptions, Observer, SimulationOptions, StepControl};
+use vinculo::{
+    simulate_with_observer, AdaptiveOptions, Observer, SimulationOptions, SparseSolver, StepControl,
+};
 
 /// Looks for Ctrl-C (SIGINT) about ten times a second of wall time and calls the Python progress
 /// callback about twice a second; an exception of either stops the run after the step just
@@ -151,6 +153,19 @@ pub(crate) fn default_rho_inf(formulation: Formulation) -> f64 {
     }
 }
 
+/// The choice of sparse solver a name selects.
+fn sparse_solver_by_name(name: &str) -> PyResult<SparseSolver> {
+    match name {
+        "auto" => Ok(SparseSolver::Auto),
+        "sparse-lu" => Ok(SparseSolver::SparseLu),
+        other => Err(invalid(
+            "linear_solver",
+            format!("'{other}'"),
+            "expected 'auto' or 'sparse-lu'",
+        )),
+    }
+}
+
 /// The formulation a name selects.
 fn formulation_by_name(name: &str) -> PyResult<Formulation> {
     match name {
@@ -212,7 +227,8 @@ impl PyRunSettings {
                         max_halvings=4, initial_tolerance=1e-8, save_every=1,
                         jacobian_reuse=false, scheme="trapezoidal", rho_inf=None,
                         formulation="index-3", adaptive=false, rtol=1e-6, atol=1e-6, h_min=1e-10,
-                        h_max=None, t_eval=None, max_output_bytes=None))]
+                        h_max=None, t_eval=None, max_output_bytes=None,
+                        linear_solver="auto"))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         t_end: f64,
@@ -235,6 +251,7 @@ impl PyRunSettings {
         h_max: Option<f64>,
         t_eval: Option<Vec<f64>>,
         max_output_bytes: Option<f64>,
+        linear_solver: &str,
     ) -> PyResult<Self> {
         let count = |name: &str, v: i64, min: i64| -> PyResult<usize> {
             if v < min {
@@ -270,6 +287,7 @@ impl PyRunSettings {
             },
             output_times: t_eval,
             max_output_bytes,
+            sparse_solver: sparse_solver_by_name(linear_solver)?,
             ..Default::default()
         };
         Ok(Self { options })

@@ -11,9 +11,10 @@
 //!   the two rows minus one residual. The `parallel` rows are the same on rayon's thread pool
 //!   (`StepWorkspace::assemble_in_parallel_from` with threshold 0).
 //! - `factor+solve`: factorisation of the step's iteration matrix and one solve, with the values
-//!   of a real first Newton iteration: tree elimination (chains of 1,000 and 100,000), dense LU
-//!   (a ring of 10 particles hung from a fixed point: a loop, 41 unknowns) and the general sparse
-//!   LU (the same chains forced to `SparseSolver::SparseLu`).
+//!   of a real first Newton iteration: tree elimination (chains of 1,000 and 100,000, and a chain
+//!   of 1,000 with bending stiffness, `bent chain`), dense LU (a ring of 10 particles hung from a
+//!   fixed point: a loop, 41 unknowns) and the general sparse LU (the same chains forced to
+//!   `SparseSolver::SparseLu`).
 //! - `step`: one whole step (Newton loop to convergence with the automatically chosen solver) of
 //!   a pendulum released horizontally and of a 1,000-link chain released horizontally, taken from
 //!   the state after one step so that the predictor carries the previous multipliers.
@@ -41,6 +42,18 @@ fn pendulum() -> System {
         .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], false)
         .unwrap();
     s.add_distance(a, b, None).unwrap();
+    s
+}
+
+/// The chain of [`chain`] with bending stiffness (0.05 N m^2) at every interior particle: each
+/// particle is also coupled with its second neighbours.
+fn bent_chain(n: usize) -> System {
+    let mut s = chain(n);
+    let ids: Vec<_> = (0..=n).map(|i| s.particle_id(i).unwrap()).collect();
+    for i in 1..n {
+        s.add_bending(ids[i - 1], ids[i], ids[i + 1], 0.05, None)
+            .unwrap();
+    }
     s
 }
 
@@ -195,12 +208,18 @@ fn factor_and_solve(c: &mut Criterion) {
     let cases = [
         ("tree elimination", "chain", 1_000, SparseSolver::Auto),
         ("tree elimination", "chain", 100_000, SparseSolver::Auto),
+        ("tree elimination", "bent chain", 1_000, SparseSolver::Auto),
         ("dense LU", "ring", 10, SparseSolver::Auto),
         ("sparse LU", "chain", 1_000, SparseSolver::SparseLu),
         ("sparse LU", "chain", 100_000, SparseSolver::SparseLu),
+        ("sparse LU", "bent chain", 1_000, SparseSolver::SparseLu),
     ];
     for (label, shape, n, choice) in cases {
-        let system = if shape == "ring" { ring(n) } else { chain(n) };
+        let system = match shape {
+            "ring" => ring(n),
+            "bent chain" => bent_chain(n),
+            _ => chain(n),
+        };
         let (_, recorded) = recording_workspace(&system, choice);
         let (values, rhs) = (recorded.values.unwrap(), recorded.rhs.unwrap());
         let mut solver = StepWorkspace::with_solver(&system, dense_limit(), choice).solver;

@@ -37,8 +37,9 @@ pub struct SimulationOptions {
     /// Systems with at most this many unknowns whose constraint graph has loops use a dense
     /// LU (tree-shaped graphs always get the tree elimination with `SparseSolver::Auto`).
     pub dense_limit: usize,
-    /// Solver for larger systems: tree elimination when the constraint graph is a forest
-    /// (`Auto`), or always the general sparse LU. [`crate::Solution::linear_solver`] names the one used.
+    /// Solver for larger systems: tree elimination when the pattern allows it (`Auto`: a tree
+    /// of constraints whose other couplings join particles to their ancestors, see
+    /// [`crate::linear::TreeElimination`]), or always the general sparse LU. [`crate::Solution::linear_solver`] names the one used.
     pub sparse_solver: SparseSolver,
     /// Largest memory the stored output may take, in bytes (None: a third of the memory
     /// available when the run starts, no limit where it cannot be read): a run whose output

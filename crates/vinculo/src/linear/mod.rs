@@ -39,8 +39,8 @@ pub trait LinearSolver: Send {
 /// Which solver a sparse pattern gets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum SparseSolver {
-    /// Tree elimination when the constraint graph is a forest (linear cost), otherwise the
-    /// general sparse LU.
+    /// Tree elimination when the pattern allows it (a tree of constraints whose other couplings
+    /// join particles to their ancestors: linear cost), otherwise the general sparse LU.
     #[default]
     Auto,
     /// Always the general sparse LU.

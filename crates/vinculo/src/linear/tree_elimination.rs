@@ -1,52 +1,116 @@
-//! Block elimination along a tree: linear cost for chains, ropes, tethers and branched strings.
+//! Block elimination along a tree: linear cost for chains, ropes, tethers, branched strings and
+//! lines with bending stiffness.
 //!
-//! The unknowns are grouped into blocks: one per free particle (its 3 coordinates), to which
-//! are added the multipliers of the constraints that touch only that particle. A constraint
-//! between two particles is an edge of the particle graph; so is a force with a Jacobian
-//! between two particles. When that graph is a forest, every tree is rooted and each
-//! two-particle multiplier joins the block of the edge's child particle. Then block b couples
-//! only with itself and with the 3 coordinates of its parent particle P:
+//! # Blocks and the tree
+//!
+//! The unknowns are grouped into blocks: one per free particle (its 3 coordinates, the block's
+//! *particle part*), to which are added the multipliers of the constraints that touch only that
+//! particle. A constraint between two particles is an edge of the particle graph; so is a force
+//! with a Jacobian between two particles. A spanning forest of that graph is built from the
+//! constraints' edges first, then from the forces' edges that join particles not yet connected
+//! (nearest particle indices first: a line's neighbours before the nodes two apart that its
+//! bending couples). Each tree is rooted at its particle with the most multipliers of its own,
+//! else at its lowest index (a line's first node, an end of the path). Every edge must then
+//! join a particle and one of its *ancestors* (its parent for an edge of the tree, possibly a
+//! farther one for the others: the bending of a line at node i couples nodes i-1 and i+1, the
+//! grandparent of one of them); an edge between two particles neither of which is an ancestor
+//! of the other (siblings, or cousins) makes the analysis decline, except that a force between
+//! them first has the analysis made again with every tree rooted at a leaf (a line's bending
+//! centred on its most constrained node, in the middle of the line, then couples a node with
+//! its grandparent). A two-particle multiplier
+//! joins the block of the edge's lower particle (the descendant). So block b couples only with
+//! itself and with the particle parts of some of its ancestors u:
 //!
 //! ```text
-//! [ D_b   A_bP ] [x_b]   [r_b]
-//! [ A_Pb  D_P  ] [x_P] = [r_P]
+//! A_bb = D_b (n_b x n_b),    A_bu (n_b x 3),    A_ub (3 x n_b)
 //! ```
 //!
-//! and eliminating the leaves first never creates fill outside the blocks: with
-//! `W_b = D_b^-1 A_bP`, the parent's block becomes the Schur complement `D_P - A_Pb W_b`
-//! (only its 3x3 particle part changes). Each D_b is factorised by a dense LU with partial
-//! pivoting inside the block (a KKT block such as `[M, -s g^T; s g, 0]` has a zero diagonal
-//! entry). The solve is a forward sweep (leaves to roots, `z_b = D_b^-1 r_b`,
-//! `r_P -= A_Pb z_b`) and a backward sweep (roots to leaves, `x_b = z_b - W_b x_P`).
+//! The blocks are eliminated leaves first (the reverse of a breadth-first order from the roots),
+//! so every block comes before all its ancestors.
+//!
+//! # Fill
+//!
+//! Let U_b be the ancestors that block b is coupled with when it is eliminated. Eliminating b
+//! (block Gaussian elimination) changes the rows and columns of U_b alone:
+//!
+//! ```text
+//! W_b = D_b^-1 [A_bu  for u in U_b]             (n_b x 3|U_b|)
+//! A_u1u2 <- A_u1u2 - A_u1b W_b[:, u2]           for u1, u2 in U_b
+//! ```
+//!
+//! where u1 = u2 updates the particle part of D_u, and u1 != u2 the coupling between two
+//! ancestors of b, one an ancestor of the other (they lie on the path from b to its root). If
+//! that coupling was not in the matrix, it is *fill*: the farther one becomes coupled with the
+//! nearer. The sets are therefore computed symbolically, leaves first:
+//!
+//! ```text
+//! U_b = {ancestors u with an entry A_bu or A_ub} (the parent always)
+//!       + union over the children c of b of (U_c - {b})
+//! ```
+//!
+//! and then every coupling an elimination updates exists in storage (for u1 nearer than u2 in
+//! U_b, u2 is in U_u1: by induction down the path from b to u1). This is the classic
+//! elimination-tree rule of sparse factorisation, with the blocks as the nodes. The sets are
+//! small: {parent} for a chain (no fill at all), {parent, grandparent} for a line with bending
+//! (the fill is the coupling of i+1 with i-1 left by the elimination of i+2, which was already
+//! there). A set of more than [`MAX_COUPLED_ANCESTORS`] ancestors (long-range couplings that
+//! fill a chain densely) makes the analysis decline.
+//!
+//! # Factorisation and solve
+//!
+//! Each D_b (including the updates of its descendants) is factorised by a dense LU with
+//! partial pivoting inside the block (a KKT block such as `[M, -s g^T; s g, 0]` has a zero
+//! diagonal entry), W_b is solved from the factors, and the updates above are applied to the
+//! blocks of U_b. The solve of A x = r is a forward sweep (leaves to roots: `z_b = D_b^-1 r_b`,
+//! then `r_u -= A_ub z_b` for u in U_b, with the updated A_ub) and a backward sweep (roots to
+//! leaves: `x_b = z_b - sum over u in U_b of W_b[:, u] x_u`), which is the block LU
+//! factorisation `A = L D U` with `L_ub = A_ub D_b^-1` and `U_bu = W_b[:, u]`. The work is
+//! proportional to the number of blocks times |U_b|^2.
+//!
+//! # Singular blocks
 //!
 //! The elimination pivots only inside a block, so a block may be singular or nearly so while the
 //! whole matrix is regular: the end particle of a straight leg whose link to its parent is
 //! parallel to its anchor (a chain hung as a V of two straight legs at rest), where the block
 //! holds two parallel conditions on one particle and only the parent's freedom makes the matrix
-//! regular. A block pivot at round-off ([`NEAR_SINGULAR`] of the block's largest entry, per unknown) stops
-//! the elimination, and that factorisation is made by the general sparse LU (partial pivoting
+//! regular. A block pivot at round-off ([`NEAR_SINGULAR`] of the terms it was computed from,
+//! per unknown: cancellation) stops the elimination, and that factorisation is made by the general sparse LU (partial pivoting
 //! across the whole matrix, analysed on first need); only its failure is reported as a singular
 //! matrix. The next factorisation tries the tree again (the configuration moves on).
 //!
+//! # Declining
+//!
 //! The analysis works on the matrix pattern alone and checks that every structural entry lies
-//! inside a block or between a block and its parent's particle part; otherwise (a loop, a
-//! constraint on three particles, coupled multipliers) it declines and the caller falls back to
-//! the general sparse LU.
+//! inside a block or between a block and the particle part of an ancestor; otherwise (an edge
+//! between siblings, a constraint on three particles, coupled multipliers, more than three
+//! conditions on a particle's block) it declines and the caller falls back to the general sparse
+//! LU.
 
 use super::{LinearSolver, Singular, SparseLu};
 use crate::assembly::{Pattern, Storage};
 
-/// Smallest pivot of a block, relative to the block's largest entry and per unknown of the
-/// block, that the elimination accepts (a thousand round-offs); below it the factorisation
+/// Smallest pivot of a block that the elimination accepts, relative to the sum of the
+/// magnitudes of the terms it was computed from (the block's entry and the products the
+/// elimination subtracted from it) and per unknown of the block: a thousand round-offs of that
+/// sum. Below it the pivot is cancellation, the block (nearly) singular, and the factorisation
 /// falls back to the general sparse LU.
 ///
-/// The bound is relative to round-off, not to a fixed share of the digits: a block of a
-/// particle and its link is a saddle point whose second pivot, |g|^2 beta h^2 / m against the
-/// largest entry m / (beta h^2), is naturally tiny (6e-12 on a chain of 0.1 kg particles at
-/// dt = 1 ms), so a bound of 1e-8 sent every factorisation of a straight hanging chain to the
-/// sparse LU (3.4 times slower a step on 10^4 particles, measured) although the tree solve was
-/// accurate there.
+/// The bound is relative to the pivot's own terms, not to the block's largest entry nor to a
+/// fixed share of the digits, because a block of a particle and its link is a saddle point
+/// whose second pivot is naturally tiny against its particle part: |g|^2 beta h^2 / m against
+/// m / (beta h^2) (6e-12 on a chain of 0.1 kg particles at dt = 1 ms: a bound of 1e-8 sent every
+/// factorisation of a straight hanging chain to the sparse LU, 3.4 times slower a step on 10^4
+/// particles, measured), and against the bending stiffness EI / l^3 of a line, which grows as
+/// the cube of the number of segments (a bound of a thousand round-offs of the block's largest
+/// entry sent most factorisations of a 500-segment cable with bending to the sparse LU,
+/// although its pivots were accurate).
 pub const NEAR_SINGULAR: f64 = 1e3 * f64::EPSILON;
+
+/// Most ancestors a block may be coupled with (after fill) for the analysis to accept the
+/// pattern: the work per block grows as their square, and a pattern that needs more (couplings
+/// that reach far up a chain from many particles) is better served by the general sparse LU
+/// with its fill-reducing ordering. A line with bending needs 2.
+pub const MAX_COUPLED_ANCESTORS: usize = 8;
 
 const ABSENT: u32 = u32::MAX;
 const ROOT: u32 = u32::MAX;
@@ -59,13 +123,27 @@ pub struct TreeElimination {
     diag_at: Vec<usize>,
     /// Position of each block's parent block in the elimination order (ROOT for roots).
     parent: Vec<u32>,
+    /// The ancestors U_b each block is coupled with, fill included (positions in the
+    /// elimination order, nearest first; the parent first): `ancestors[coupled_at[b]..
+    /// coupled_at[b + 1]]`.
+    coupled_at: Vec<usize>,
+    ancestors: Vec<u32>,
+    /// For each pair i1 < i2 of a block's ancestors (in the order (0, 1), (0, 2), ..., (1, 2),
+    /// ...), the index of the farther one (i2) among the nearer one's (i1) ancestors: where the
+    /// Schur update of their coupling goes. `fill_index[pairs_at[b]..pairs_at[b + 1]]`.
+    pairs_at: Vec<usize>,
+    fill_index: Vec<u32>,
+    /// First entry of each block's coupling storage: 3 n_b max(|U_b|, 1) entries in `low` and
+    /// in `w` (a root keeps an unused share, so that a chain's blocks are evenly spaced).
+    coupling_at: Vec<usize>,
     /// Global unknown of each local unknown.
     unknowns: Vec<u32>,
-    /// Slots of D_b (row-major), A_Pb (3 x n_b, row-major) and A_bP (n_b x 3, row-major).
+    /// Slots of D_b (row-major), of A_ub for the ancestors u of U_b in turn (3 x n_b each,
+    /// row-major) and of [A_bu for u in U_b] (n_b x 3|U_b|, row-major).
     diag_slots: Vec<u32>,
     low_slots: Vec<u32>,
     up_slots: Vec<u32>,
-    /// LU factors of D_b, A_Pb, and W_b = D_b^-1 A_bP.
+    /// LU factors of D_b, the A_ub, and W_b = D_b^-1 [A_bu for u in U_b], in the slots' layout.
     diag: Vec<f64>,
     low: Vec<f64>,
     w: Vec<f64>,
@@ -73,9 +151,10 @@ pub struct TreeElimination {
     perm: Vec<u32>,
     /// Work vector in local (block) order.
     z: Vec<f64>,
-    /// The common size of every block, or 0 when the sizes differ.
+    /// The common size of every block when each block is coupled with its parent alone (a
+    /// chain, a branched string), or 0.
     uniform: usize,
-    /// Per block: its diagonal block was gathered in the current factorisation.
+    /// Per block: its storage (D_b, A_ub, A_bu) was gathered in the current factorisation.
     gathered: Vec<bool>,
     factored: bool,
     /// The general sparse LU that factorises the matrices whose blocks are (nearly) singular,
@@ -105,19 +184,81 @@ fn slot(pattern: &Pattern, row: usize, col: usize) -> u32 {
     }
 }
 
+/// Compressed rows: for each key in 0..n, the values of the (key, value) pairs with that key,
+/// in the pairs' order (`(pointers, values)`).
+fn compressed(
+    n: usize,
+    pairs: impl Iterator<Item = (usize, u32)> + Clone,
+) -> (Vec<usize>, Vec<u32>) {
+    let mut ptr = vec![0usize; n + 1];
+    for (key, _) in pairs.clone() {
+        ptr[key + 1] += 1;
+    }
+    for i in 0..n {
+        ptr[i + 1] += ptr[i];
+    }
+    let mut fill = ptr.clone();
+    let mut values = vec![0u32; ptr[n]];
+    for (key, value) in pairs {
+        values[fill[key]] = value;
+        fill[key] += 1;
+    }
+    (ptr, values)
+}
+
+/// Where the analysis roots each tree.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Rooting {
+    /// At its particle with the most multipliers of its own, else its lowest index.
+    MostConstrained,
+    /// At a leaf (a particle with one neighbour in the tree): the one with the most multipliers
+    /// of its own, else the lowest index.
+    Leaf,
+}
+
+/// Why an analysis declined.
+#[derive(PartialEq, Eq)]
+enum Decline {
+    /// A force couples two particles neither of which is an ancestor of the other.
+    AcrossBranches,
+    /// Anything else (see the module documentation).
+    Other,
+}
+
 impl TreeElimination {
     /// Analyses a sparse pattern whose first `particle_unknowns` unknowns come in groups of 3
     /// (one group per free particle) and whose other unknowns are single multipliers.
-    /// Returns `None` when the block graph is not a forest (the caller then uses a general
-    /// sparse LU).
+    /// Returns `None` when the pattern does not suit the elimination (see the module
+    /// documentation; the caller then uses a general sparse LU).
+    ///
+    /// Each tree is rooted at its most constrained particle; when a force then couples two
+    /// branches (a line's bending centred on that particle, in the middle of the line), the
+    /// analysis is made again with every tree rooted at a leaf, which puts the two ends of such
+    /// a coupling on one path when the tree is a path. Loops of constraints (a triangle of
+    /// distances, a ring) are declined as they are.
     pub fn analyse(pattern: &Pattern, particle_unknowns: usize) -> Option<TreeElimination> {
+        match Self::analyse_rooted(pattern, particle_unknowns, Rooting::MostConstrained) {
+            Ok(tree) => Some(tree),
+            Err(Decline::AcrossBranches) => {
+                Self::analyse_rooted(pattern, particle_unknowns, Rooting::Leaf).ok()
+            }
+            Err(Decline::Other) => None,
+        }
+    }
+
+    /// [`TreeElimination::analyse`] with the trees rooted as `rooting` says.
+    fn analyse_rooted(
+        pattern: &Pattern,
+        particle_unknowns: usize,
+        rooting: Rooting,
+    ) -> Result<TreeElimination, Decline> {
         let n = pattern.n;
         if pattern.storage != Storage::Sparse
             || particle_unknowns % 3 != 0
             || particle_unknowns > n
             || pattern.nnz() >= ABSENT as usize
         {
-            return None;
+            return Err(Decline::Other);
         }
         let np = particle_unknowns / 3;
         let nl = n - particle_unknowns;
@@ -125,11 +266,11 @@ impl TreeElimination {
 
         // Particles touched by each multiplier (at most 2), and particle-particle couplings.
         let mut touched = vec![[ABSENT; 2]; nl];
-        let mut edges: Vec<(u32, u32)> = Vec::new();
+        let mut forces: Vec<(u32, u32)> = Vec::new();
         for col in 0..n {
             for &row in &pattern.row_idx[pattern.col_ptr[col]..pattern.col_ptr[col + 1]] {
                 match (particle(row), particle(col)) {
-                    (Some(a), Some(b)) if a < b => edges.push((a as u32, b as u32)),
+                    (Some(a), Some(b)) if a < b => forces.push((a as u32, b as u32)),
                     (Some(_), Some(_)) => {}
                     (Some(p), None) | (None, Some(p)) => {
                         let k =
@@ -141,53 +282,49 @@ impl TreeElimination {
                         } else if t[1] == ABSENT {
                             t[1] = p as u32;
                         } else {
-                            return None; // a multiplier on three particles
+                            return Err(Decline::Other); // a multiplier on three particles
                         }
                     }
-                    (None, None) if row != col => return None, // coupled multipliers
+                    (None, None) if row != col => return Err(Decline::Other), // coupled multipliers
                     (None, None) => {}
                 }
             }
         }
+        let mut links: Vec<(u32, u32)> = Vec::new();
         for t in &touched {
             match *t {
-                [ABSENT, _] => return None, // a multiplier on no free particle
-                [a, b] if b != ABSENT => edges.push((a.min(b), a.max(b))),
+                [ABSENT, _] => return Err(Decline::Other), // a multiplier on no free particle
+                [a, b] if b != ABSENT => links.push((a.min(b), a.max(b))),
                 _ => {}
             }
         }
-        edges.sort_unstable();
-        edges.dedup();
-        // A forest has no edge joining two particles already connected.
+        links.sort_unstable();
+        links.dedup();
+        forces.sort_unstable();
+        forces.dedup();
+        // Forces by span (nearest indices first), for the spanning forest.
+        forces.sort_by_key(|&(a, b)| (b - a, a));
+
+        // Spanning forest: the constraints' edges, then the forces' that join two trees.
         let mut set: Vec<usize> = (0..np).collect();
-        for &(a, b) in &edges {
+        let mut tree_edges: Vec<(u32, u32)> = Vec::with_capacity(np);
+        for &(a, b) in links.iter().chain(&forces) {
             let (ra, rb) = (find(&mut set, a as usize), find(&mut set, b as usize));
-            if ra == rb {
-                return None;
+            if ra != rb {
+                set[ra] = rb;
+                tree_edges.push((a, b));
             }
-            set[ra] = rb;
         }
         drop(set);
 
-        // Adjacency (CSR), then breadth-first order from the lowest particle of each tree.
-        let mut adj_ptr = vec![0usize; np + 1];
-        for &(a, b) in &edges {
-            adj_ptr[a as usize + 1] += 1;
-            adj_ptr[b as usize + 1] += 1;
-        }
-        for i in 0..np {
-            adj_ptr[i + 1] += adj_ptr[i];
-        }
-        let mut fill = adj_ptr.clone();
-        let mut adj = vec![0u32; 2 * edges.len()];
-        for &(a, b) in &edges {
-            adj[fill[a as usize]] = b;
-            fill[a as usize] += 1;
-            adj[fill[b as usize]] = a;
-            fill[b as usize] += 1;
-        }
-        drop(fill);
-        drop(edges);
+        // Adjacency (CSR) of the forest, then breadth-first order from each tree's root.
+        let (adj_ptr, adj) = compressed(
+            np,
+            tree_edges
+                .iter()
+                .flat_map(|&(a, b)| [(a as usize, b), (b as usize, a)]),
+        );
+        drop(tree_edges);
         // Each tree is rooted at its particle with the most multipliers of its own (fixed
         // coordinates, planes, anchors): a particle whose three coordinates are prescribed then
         // keeps the links to its neighbours out of its block, which would otherwise hold four
@@ -199,8 +336,15 @@ impl TreeElimination {
             }
         }
         let mut roots: Vec<u32> = (0..np as u32).collect();
-        if own.iter().any(|&k| k > 0) {
-            roots.sort_by_key(|&p| std::cmp::Reverse(own[p as usize]));
+        match rooting {
+            Rooting::MostConstrained if own.iter().any(|&k| k > 0) => {
+                roots.sort_by_key(|&p| std::cmp::Reverse(own[p as usize]));
+            }
+            Rooting::MostConstrained => {}
+            Rooting::Leaf => {
+                let inner = |p: u32| adj_ptr[p as usize + 1] - adj_ptr[p as usize] > 1;
+                roots.sort_by_key(|&p| (inner(p), std::cmp::Reverse(own[p as usize])));
+            }
         }
         drop(own);
         let mut parent_particle = vec![ROOT; np];
@@ -226,7 +370,42 @@ impl TreeElimination {
             }
         }
         drop(adj);
+        drop(adj_ptr);
         drop(seen);
+
+        // Preorder numbers and subtree sizes: u is an ancestor of v when v's number lies in
+        // u's subtree range. Sizes leaves first (reverse breadth-first order), numbers roots
+        // first, each child taking the next range of its parent's.
+        let mut subtree = vec![1u32; np];
+        for &p in order.iter().rev() {
+            let q = parent_particle[p as usize];
+            if q != ROOT {
+                subtree[q as usize] += subtree[p as usize];
+            }
+        }
+        let mut preorder = vec![0u32; np];
+        let mut next = vec![0u32; np];
+        let mut numbered = 0u32;
+        for &p in &order {
+            let p = p as usize;
+            preorder[p] = match parent_particle[p] {
+                ROOT => {
+                    numbered += subtree[p];
+                    numbered - subtree[p]
+                }
+                q => {
+                    next[q as usize] += subtree[p];
+                    next[q as usize] - subtree[p]
+                }
+            };
+            next[p] = preorder[p] + 1;
+        }
+        drop(next);
+        let is_ancestor = |u: u32, v: u32| {
+            let (u, v) = (u as usize, v as usize);
+            preorder[u] < preorder[v] && preorder[v] < preorder[u] + subtree[u]
+        };
+
         // Leaves first: the reverse breadth-first order puts every child before its parent.
         order.reverse();
         let mut position = vec![0u32; np];
@@ -234,9 +413,31 @@ impl TreeElimination {
             position[p as usize] = b as u32;
         }
 
-        // Each multiplier joins its particle, or the child of its edge.
+        // Every edge joins a particle (the descendant) and one of its ancestors: the pairs
+        // (descendant's block, ancestor's block), from which the sets U_b grow.
+        let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(links.len() + forces.len());
+        for (k, &(a, b)) in links.iter().chain(&forces).enumerate() {
+            let (d, u) = if is_ancestor(a, b) {
+                (b, a)
+            } else if is_ancestor(b, a) {
+                (a, b)
+            } else if k >= links.len() {
+                // Siblings or cousins coupled by a force: another root may join them.
+                return Err(Decline::AcrossBranches);
+            } else {
+                // A loop of constraints (a triangle of distances, a ring).
+                return Err(Decline::Other);
+            };
+            pairs.push((position[d as usize], position[u as usize]));
+        }
+        drop(links);
+        drop(forces);
+        pairs.sort_unstable();
+        pairs.dedup();
+
+        // Each multiplier joins its particle, or the descendant of its edge.
         let owner = |t: [u32; 2]| -> usize {
-            if t[1] == ABSENT || parent_particle[t[0] as usize] == t[1] {
+            if t[1] == ABSENT || is_ancestor(t[1], t[0]) {
                 t[0] as usize
             } else {
                 t[1] as usize
@@ -249,8 +450,9 @@ impl TreeElimination {
         // A block with more than three conditions on its particle's three coordinates is
         // singular whatever the values: the general sparse LU pivots across blocks instead.
         if size.iter().any(|&s| s > 6) {
-            return None;
+            return Err(Decline::Other);
         }
+        let blocks = np;
         let mut start = vec![0usize; np + 1];
         let mut diag_at = vec![0usize; np + 1];
         for (b, &p) in order.iter().enumerate() {
@@ -258,6 +460,7 @@ impl TreeElimination {
             start[b + 1] = start[b] + s;
             diag_at[b + 1] = diag_at[b] + s * s;
         }
+        drop(size);
         let mut unknowns = vec![0u32; n];
         let mut next: Vec<usize> = (0..np).map(|b| start[b] + 3).collect();
         for (b, &p) in order.iter().enumerate() {
@@ -272,6 +475,8 @@ impl TreeElimination {
         }
         drop(next);
         drop(touched);
+        drop(preorder);
+        drop(subtree);
         let parent: Vec<u32> = order
             .iter()
             .map(|&p| match parent_particle[p as usize] {
@@ -283,11 +488,69 @@ impl TreeElimination {
         drop(position);
         drop(parent_particle);
 
+        // The sets U_b, leaves first: b's own couplings (its parent among them) and its
+        // children's sets less b itself.
+        let (children_at, children) = compressed(
+            blocks,
+            parent
+                .iter()
+                .enumerate()
+                .filter(|&(_, &p)| p != ROOT)
+                .map(|(b, &p)| (p as usize, b as u32)),
+        );
+        let mut coupled_at = vec![0usize; blocks + 1];
+        let mut ancestors: Vec<u32> = Vec::with_capacity(pairs.len());
+        let mut set: Vec<u32> = Vec::new();
+        let mut k = 0;
+        for b in 0..blocks {
+            set.clear();
+            while k < pairs.len() && pairs[k].0 as usize == b {
+                set.push(pairs[k].1);
+                k += 1;
+            }
+            for &c in &children[children_at[b]..children_at[b + 1]] {
+                let c = c as usize;
+                let of_child = &ancestors[coupled_at[c]..coupled_at[c + 1]];
+                set.extend(of_child.iter().filter(|&&u| u as usize != b));
+            }
+            set.sort_unstable();
+            set.dedup();
+            if set.len() > MAX_COUPLED_ANCESTORS {
+                return Err(Decline::Other);
+            }
+            ancestors.extend_from_slice(&set);
+            coupled_at[b + 1] = ancestors.len();
+        }
+        drop(pairs);
+        drop(children);
+        drop(children_at);
+        let coupled = |b: usize| &ancestors[coupled_at[b]..coupled_at[b + 1]];
+        // Where the Schur updates between two ancestors of a block go.
+        let mut pairs_at = vec![0usize; blocks + 1];
+        let mut fill_index: Vec<u32> = Vec::new();
+        for b in 0..blocks {
+            let set = coupled(b);
+            for (i1, &u1) in set.iter().enumerate() {
+                for &u2 in &set[i1 + 1..] {
+                    // Present by construction of the sets (see the module documentation).
+                    let at = coupled(u1 as usize)
+                        .binary_search(&u2)
+                        .map_err(|_| Decline::Other)?;
+                    fill_index.push(at as u32);
+                }
+            }
+            pairs_at[b + 1] = fill_index.len();
+        }
+        let mut coupling_at = vec![0usize; blocks + 1];
+        for b in 0..blocks {
+            let nb = start[b + 1] - start[b];
+            coupling_at[b + 1] = coupling_at[b] + 3 * nb * coupled(b).len().max(1);
+        }
+
         // Slots of every block and coupling; the entries they cover must be the whole pattern.
-        let blocks = np;
         let mut diag_slots = vec![ABSENT; diag_at[blocks]];
-        let mut low_slots = vec![ABSENT; 3 * n];
-        let mut up_slots = vec![ABSENT; 3 * n];
+        let mut low_slots = vec![ABSENT; coupling_at[blocks]];
+        let mut up_slots = vec![ABSENT; coupling_at[blocks]];
         let mut covered = 0usize;
         for b in 0..blocks {
             let local = &unknowns[start[b]..start[b + 1]];
@@ -299,38 +562,45 @@ impl TreeElimination {
                     diag_slots[diag_at[b] + i * nb + j] = s;
                 }
             }
-            if parent[b] != ROOT {
-                let pb = parent[b] as usize;
+            let set = coupled(b);
+            let k = set.len();
+            for (i, &u) in set.iter().enumerate() {
                 for r in 0..3 {
-                    let up = unknowns[start[pb] + r] as usize;
+                    let up = unknowns[start[u as usize] + r] as usize;
                     for (j, &uj) in local.iter().enumerate() {
                         let lo = slot(pattern, up, uj as usize);
                         let hi = slot(pattern, uj as usize, up);
                         covered += (lo != ABSENT) as usize + (hi != ABSENT) as usize;
-                        low_slots[3 * start[b] + r * nb + j] = lo;
-                        up_slots[3 * start[b] + j * 3 + r] = hi;
+                        low_slots[coupling_at[b] + 3 * nb * i + r * nb + j] = lo;
+                        up_slots[coupling_at[b] + j * 3 * k + 3 * i + r] = hi;
                     }
                 }
             }
         }
         if covered != pattern.nnz() {
-            return None;
+            return Err(Decline::Other);
         }
+        let parents_only = (0..blocks).all(|b| coupled(b).len() <= 1);
         let uniform = match start.windows(2).map(|w| w[1] - w[0]).min() {
-            Some(nb) if start[blocks] == nb * blocks => nb,
+            Some(nb) if start[blocks] == nb * blocks && parents_only => nb,
             _ => 0,
         };
-        Some(TreeElimination {
+        Ok(TreeElimination {
             uniform,
             gathered: vec![false; blocks],
             diag: vec![0.0; diag_at[blocks]],
-            low: vec![0.0; 3 * n],
-            w: vec![0.0; 3 * n],
+            low: vec![0.0; coupling_at[blocks]],
+            w: vec![0.0; coupling_at[blocks]],
             perm: vec![0; n],
             z: vec![0.0; n],
             start,
             diag_at,
             parent,
+            coupled_at,
+            ancestors,
+            pairs_at,
+            fill_index,
+            coupling_at,
             unknowns,
             diag_slots,
             low_slots,
@@ -345,6 +615,16 @@ impl TreeElimination {
     /// Number of blocks (free particles).
     pub fn blocks(&self) -> usize {
         self.parent.len()
+    }
+
+    /// The largest number of ancestors a block is coupled with (1 for a chain, 2 for a line
+    /// with bending; 0 when no block has a parent).
+    pub fn coupled_ancestors(&self) -> usize {
+        self.coupled_at
+            .windows(2)
+            .map(|w| w[1] - w[0])
+            .max()
+            .unwrap_or(0)
     }
 
     /// The matrix pattern, rebuilt from the slots of the blocks and couplings (which cover it
@@ -362,15 +642,16 @@ impl TreeElimination {
                     }
                 }
             }
-            if self.parent[b] != ROOT {
-                let pb = self.parent[b] as usize;
+            let set = &self.ancestors[self.coupled_at[b]..self.coupled_at[b + 1]];
+            let (k, at) = (set.len(), self.coupling_at[b]);
+            for (i, &u) in set.iter().enumerate() {
                 for r in 0..3 {
-                    let up = self.unknowns[self.start[pb] + r] as usize;
+                    let up = self.unknowns[self.start[u as usize] + r] as usize;
                     for (j, &uj) in local.iter().enumerate() {
-                        if self.low_slots[3 * self.start[b] + r * nb + j] != ABSENT {
+                        if self.low_slots[at + 3 * nb * i + r * nb + j] != ABSENT {
                             entries.push((up, uj as usize));
                         }
-                        if self.up_slots[3 * self.start[b] + j * 3 + r] != ABSENT {
+                        if self.up_slots[at + j * 3 * k + 3 * i + r] != ABSENT {
                             entries.push((uj as usize, up));
                         }
                     }
@@ -415,6 +696,78 @@ impl TreeElimination {
         self.factored = true;
         Ok(())
     }
+
+    /// Gathers the matrix entries of block b's storage: D_b, the A_ub and the A_bu (fill
+    /// entries are zero).
+    fn gather_block(&mut self, b: usize, values: &[f64]) {
+        let (da, db) = (self.diag_at[b], self.diag_at[b + 1]);
+        let (ca, cb) = (self.coupling_at[b], self.coupling_at[b + 1]);
+        gather(&mut self.diag[da..db], &self.diag_slots[da..db], values);
+        gather(&mut self.low[ca..cb], &self.low_slots[ca..cb], values);
+        gather(&mut self.w[ca..cb], &self.up_slots[ca..cb], values);
+        self.gathered[b] = true;
+    }
+
+    /// Eliminates block b of `nb` unknowns coupled with `k` ancestors (their storage gathered;
+    /// the sizes as arguments, so that callers with constants get unrolled copies): factorises D_b,
+    /// forms W_b = D_b^-1 [A_bu for u in U_b] and applies the Schur updates
+    /// A_u1u2 -= A_u1b W_b[:, u2] to the ancestors' storage. Returns the local column of a
+    /// negligible pivot.
+    #[inline(always)]
+    fn eliminate(&mut self, b: usize, nb: usize, k: usize) -> Result<(), usize> {
+        let s = self.start[b];
+        let (da, db) = (self.diag_at[b], self.diag_at[b + 1]);
+        let (own_diag, rest_diag) = self.diag.split_at_mut(db);
+        let d = &mut own_diag[da..];
+        let perm = &mut self.perm[s..s + nb];
+        lu_in_place(d, nb, perm)?;
+        let set = &self.ancestors[self.coupled_at[b]..self.coupled_at[b + 1]];
+        let set = &set[..k];
+        if k == 0 {
+            return Ok(());
+        }
+        let (ca, cb) = (self.coupling_at[b], self.coupling_at[b + 1]);
+        let (own_w, rest_w) = self.w.split_at_mut(cb);
+        let (own_low, rest_low) = self.low.split_at_mut(cb);
+        let (w, low) = (
+            &mut own_w[ca..ca + 3 * nb * k],
+            &own_low[ca..ca + 3 * nb * k],
+        );
+        lu_solve(d, nb, perm, w, 3 * k);
+        let fill = &self.fill_index[self.pairs_at[b]..self.pairs_at[b + 1]];
+        let mut pair = 0;
+        for (i1, &u1) in set.iter().enumerate() {
+            let u1 = u1 as usize;
+            let n1 = self.start[u1 + 1] - self.start[u1];
+            let low1 = &low[3 * nb * i1..3 * nb * (i1 + 1)];
+            // The particle part of D_u1.
+            let update = schur_product(low1, w, nb, 3 * k, 3 * i1);
+            let du = &mut rest_diag[self.diag_at[u1] - db..];
+            for r in 0..3 {
+                for c in 0..3 {
+                    du[r * n1 + c] -= update[r][c];
+                }
+            }
+            // The couplings of u1 with the farther ancestors u2: A_u1u2 (the first three rows
+            // of u1's [A_u1u for u in U_u1]) and A_u2u1 (the first three columns of its A_u2u1).
+            let k1 = self.coupled_at[u1 + 1] - self.coupled_at[u1];
+            let at = self.coupling_at[u1] - cb;
+            for i2 in i1 + 1..k {
+                let at2 = fill[pair] as usize;
+                pair += 1;
+                let up = schur_product(low1, w, nb, 3 * k, 3 * i2);
+                let low2 = &low[3 * nb * i2..3 * nb * (i2 + 1)];
+                let lo = schur_product(low2, w, nb, 3 * k, 3 * i1);
+                for r in 0..3 {
+                    for c in 0..3 {
+                        rest_w[at + r * 3 * k1 + 3 * at2 + c] -= up[r][c];
+                        rest_low[at + 3 * n1 * at2 + r * n1 + c] -= lo[r][c];
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Gathers `values` at `slots` into `out` (absent entries are zero).
@@ -424,16 +777,48 @@ fn gather(out: &mut [f64], slots: &[u32], values: &[f64]) {
     }
 }
 
-/// In-place LU with partial pivoting of the n x n row-major matrix `a`; returns the local
-/// column of a pivot below [`NEAR_SINGULAR`] x n of the largest entry. On return the strict lower triangle holds L (unit diagonal),
-/// the strict upper triangle U, and the diagonal the reciprocals of U's pivots, so that the
-/// solves multiply where they would divide.
+/// The 3x3 product of `low` (3 x nb, row-major) and the columns `col..col + 3` of `w` (nb rows
+/// of `stride` entries): one Schur update A_u1b W_b[:, u2].
+#[inline(always)]
+fn schur_product(low: &[f64], w: &[f64], nb: usize, stride: usize, col: usize) -> [[f64; 3]; 3] {
+    let low = &low[..3 * nb];
+    let mut s = [[0.0; 3]; 3];
+    for j in 0..nb {
+        let wj = &w[j * stride + col..j * stride + col + 3];
+        for r in 0..3 {
+            let l = low[r * nb + j];
+            for c in 0..3 {
+                s[r][c] += l * wj[c];
+            }
+        }
+    }
+    s
+}
+
+/// Largest block: a particle's 3 coordinates and at most 3 conditions on them (the analysis
+/// declines larger ones).
+const MAX_BLOCK: usize = 6;
+
+/// In-place LU with partial pivoting of the n x n row-major matrix `a` (n <= [`MAX_BLOCK`]);
+/// returns the local column of a pivot at round-off: at most [`NEAR_SINGULAR`] x n of the sum
+/// of the magnitudes of the terms it was computed from, `|a_pk| + sum_j<k |l_kj| |u_jk|` (p the
+/// pivot's row in `a`: the bound on its round-off of the LU's backward error analysis). On return
+/// the strict lower triangle holds L (unit diagonal), the strict upper triangle U, and the
+/// diagonal the reciprocals of U's pivots, so that the solves multiply where they would divide.
 #[inline(always)]
 fn lu_in_place(a: &mut [f64], n: usize, perm: &mut [u32]) -> Result<(), usize> {
     // Slices of known length let the unrolled copies drop their bounds checks.
     let (a, perm) = (&mut a[..n * n], &mut perm[..n]);
-    let largest = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let tiny = largest * NEAR_SINGULAR * n as f64;
+    // The entries as given, and the given row of each row of `a` as rows are interchanged.
+    let mut given = [0.0f64; MAX_BLOCK * MAX_BLOCK];
+    let given = &mut given[..n * n];
+    given.copy_from_slice(a);
+    let mut row = [0usize; MAX_BLOCK];
+    let row = &mut row[..n];
+    for (i, r) in row.iter_mut().enumerate() {
+        *r = i;
+    }
+    let relative = NEAR_SINGULAR * n as f64;
     for k in 0..n {
         let mut p = k;
         for i in k + 1..n {
@@ -446,9 +831,14 @@ fn lu_in_place(a: &mut [f64], n: usize, perm: &mut [u32]) -> Result<(), usize> {
             for j in 0..n {
                 a.swap(k * n + j, p * n + j);
             }
+            row.swap(k, p);
         }
         let pivot = a[k * n + k];
-        if !pivot.is_finite() || pivot.abs() <= tiny {
+        let mut size = given[row[k] * n + k].abs();
+        for j in 0..k {
+            size += (a[k * n + j] * a[j * n + k]).abs();
+        }
+        if !pivot.is_finite() || pivot.abs() <= relative * size {
             return Err(k);
         }
         let inv = 1.0 / pivot;
@@ -467,8 +857,8 @@ fn lu_in_place(a: &mut [f64], n: usize, perm: &mut [u32]) -> Result<(), usize> {
 }
 
 /// Solves with the factors of `lu_in_place` for the n x m row-major right-hand side `x` (the
-/// factorisation's W = D^-1 A with m = 3, and the solve of blocks larger than 5). Zero entries
-/// of L are skipped: a KKT block's mass part gives many.
+/// factorisation's W = D^-1 [A_bu ...] with m = 3 |U_b|, and the solve of blocks larger than
+/// 5). Zero entries of L are skipped: a KKT block's mass part gives many.
 #[inline(always)]
 fn lu_solve(a: &[f64], n: usize, perm: &[u32], x: &mut [f64], m: usize) {
     let (a, perm, x) = (&a[..n * n], &perm[..n], &mut x[..n * m]);
@@ -502,63 +892,10 @@ fn lu_solve(a: &[f64], n: usize, perm: &[u32], x: &mut [f64], m: usize) {
     }
 }
 
-/// A block's coupling to its parent during factorisation: W_b (holding A_bP on entry), A_Pb,
-/// the parent's diagonal storage and the parent's block size.
-type Coupling<'a> = Option<(&'a mut [f64], &'a [f64], &'a mut [f64], usize)>;
-
-/// Factorises D_b and, for a block with a parent, forms W_b = D_b^-1 A_bP and applies the
-/// Schur complement to the parent's particle part: D_P[0..3, 0..3] -= A_Pb W_b.
+/// Solves D z = z in place with the factors of `lu_in_place`, for a block of N unknowns known
+/// at compile time: unrolled, with the running sums kept in registers.
 #[inline(always)]
-fn eliminate(d: &mut [f64], nb: usize, perm: &mut [u32], coupling: Coupling) -> Result<(), usize> {
-    lu_in_place(d, nb, perm)?;
-    if let Some((w, low, dp, np)) = coupling {
-        let (w, low, dp) = (&mut w[..3 * nb], &low[..3 * nb], &mut dp[..2 * np + 3]);
-        lu_solve(d, nb, perm, w, 3);
-        for r in 0..3 {
-            for c in 0..3 {
-                let mut acc = 0.0;
-                for j in 0..nb {
-                    acc += low[r * nb + j] * w[j * 3 + c];
-                }
-                dp[r * np + c] -= acc;
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Forward step of the solve for one block: z_b = D_b^-1 z_b, then z_P -= A_Pb z_b.
-#[inline(always)]
-fn forward(
-    d: &[f64],
-    nb: usize,
-    perm: &[u32],
-    zb: &mut [f64],
-    coupling: Option<(&[f64], &mut [f64])>,
-) {
-    let zb = &mut zb[..nb];
-    lu_solve(d, nb, perm, zb, 1);
-    if let Some((low, zp)) = coupling {
-        let (low, zp) = (&low[..3 * nb], &mut zp[..3]);
-        for r in 0..3 {
-            let mut acc = 0.0;
-            for j in 0..nb {
-                acc += low[r * nb + j] * zb[j];
-            }
-            zp[r] -= acc;
-        }
-    }
-}
-
-/// [`forward`] for a block of N unknowns known at compile time: the same operations on
-/// fixed-size arrays, unrolled, with the running sums kept in registers.
-#[inline(always)]
-fn forward_fixed<const N: usize>(
-    d: &[f64],
-    perm: &[u32],
-    zb: &mut [f64],
-    coupling: Option<(&[f64], &mut [f64])>,
-) {
+fn block_solve_fixed<const N: usize>(d: &[f64], perm: &[u32], zb: &mut [f64]) {
     let z: &mut [f64; N] = (&mut zb[..N]).try_into().expect("block of N unknowns");
     let (d, perm) = (&d[..N * N], &perm[..N]);
     for k in 0..N {
@@ -578,27 +915,39 @@ fn forward_fixed<const N: usize>(
         }
         z[i] = s * d[i * N + i];
     }
-    if let Some((low, zp)) = coupling {
-        let (low, zp) = (&low[..3 * N], &mut zp[..3]);
-        for r in 0..3 {
-            let mut acc = 0.0;
-            for j in 0..N {
-                acc += low[r * N + j] * z[j];
-            }
-            zp[r] -= acc;
-        }
-    }
 }
 
-/// Backward step of the solve for one block: x_b = z_b - W_b x_P.
+/// z_u -= A_ub z_b for one ancestor u: `low` is A_ub (3 x nb, row-major), `zu` the particle
+/// part of z_u.
 #[inline(always)]
-fn backward(w: &[f64], xp: [f64; 3], zb: &mut [f64]) {
-    for (x, wj) in zb.iter_mut().zip(w.chunks_exact(3)) {
-        *x -= wj[0] * xp[0] + wj[1] * xp[1] + wj[2] * xp[2];
+fn subtract_coupling(low: &[f64], zb: &[f64], zu: &mut [f64]) {
+    let nb = zb.len();
+    let (low, zu) = (&low[..3 * nb], &mut zu[..3]);
+    for r in 0..3 {
+        let mut acc = 0.0;
+        for j in 0..nb {
+            acc += low[r * nb + j] * zb[j];
+        }
+        zu[r] -= acc;
     }
 }
 
-/// [`backward`] for a block of N unknowns known at compile time.
+/// Forward step of the solve for one block coupled with its parent at most: z_b = D_b^-1 z_b,
+/// then z_P -= A_Pb z_b.
+#[inline(always)]
+fn forward_fixed<const N: usize>(
+    d: &[f64],
+    perm: &[u32],
+    zb: &mut [f64],
+    coupling: Option<(&[f64], &mut [f64])>,
+) {
+    block_solve_fixed::<N>(d, perm, zb);
+    if let Some((low, zp)) = coupling {
+        subtract_coupling(low, &zb[..N], zp);
+    }
+}
+
+/// Backward step of the solve for one block coupled with its parent alone: x_b = z_b - W_b x_P.
 #[inline(always)]
 fn backward_fixed<const N: usize>(w: &[f64], xp: [f64; 3], zb: &mut [f64]) {
     let (w, zb) = (&w[..3 * N], &mut zb[..N]);
@@ -611,47 +960,33 @@ impl LinearSolver for TreeElimination {
     fn factor(&mut self, values: &[f64]) -> Result<(), Singular> {
         self.factored = false;
         self.on_fallback = false;
-        // The matrix's entries are gathered block by block as the elimination reaches them (a
-        // parent's diagonal block when its first child updates it), so that each block's numbers
-        // are used while they are in cache: on a 10^6-particle chain the three separate passes
-        // over 40 values per block cost as much as the elimination itself.
+        // The matrix's entries are gathered block by block as the elimination reaches them (an
+        // ancestor's storage when the first of its descendants updates it), so that each
+        // block's numbers are used while they are in cache: on a 10^6-particle chain the three
+        // separate passes over 40 values per block cost as much as the elimination itself.
         self.gathered.fill(false);
         for b in 0..self.blocks() {
-            let (s, nb) = (self.start[b], self.start[b + 1] - self.start[b]);
-            let (da, db) = (self.diag_at[b], self.diag_at[b + 1]);
             if !self.gathered[b] {
-                gather(&mut self.diag[da..db], &self.diag_slots[da..db], values);
+                self.gather_block(b, values);
             }
-            let (ls, le) = (3 * s, 3 * s + 3 * nb);
-            gather(&mut self.low[ls..le], &self.low_slots[ls..le], values);
-            gather(&mut self.w[ls..le], &self.up_slots[ls..le], values);
-            let pb = self.parent[b];
-            if pb != ROOT && !self.gathered[pb as usize] {
-                let (pa, pe) = (self.diag_at[pb as usize], self.diag_at[pb as usize + 1]);
-                gather(&mut self.diag[pa..pe], &self.diag_slots[pa..pe], values);
-                self.gathered[pb as usize] = true;
+            for i in self.coupled_at[b]..self.coupled_at[b + 1] {
+                let u = self.ancestors[i] as usize;
+                if !self.gathered[u] {
+                    self.gather_block(u, values);
+                }
             }
-            let (own, rest) = self.diag.split_at_mut(db);
-            let d = &mut own[da..];
-            let perm = &mut self.perm[s..s + nb];
-            let coupling = if pb == ROOT {
-                None
-            } else {
-                let pb = pb as usize;
-                let np = self.start[pb + 1] - self.start[pb];
-                Some((
-                    &mut self.w[ls..le],
-                    &self.low[ls..le],
-                    &mut rest[self.diag_at[pb] - db..],
-                    np,
-                ))
-            };
-            // Blocks of 3 (a free particle) and 4 (a particle and its link) get unrolled copies.
-            let result = match nb {
-                3 => eliminate(d, 3, perm, coupling),
-                4 => eliminate(d, 4, perm, coupling),
-                5 => eliminate(d, 5, perm, coupling),
-                _ => eliminate(d, nb, perm, coupling),
+            let (s, nb) = (self.start[b], self.start[b + 1] - self.start[b]);
+            let k = self.coupled_at[b + 1] - self.coupled_at[b];
+            // Blocks of 3 (a free particle), 4 (a particle and its link) and 5, coupled with
+            // one ancestor (a chain) or two (a line with bending), get unrolled copies.
+            let result = match (nb, k) {
+                (3, 1) => self.eliminate(b, 3, 1),
+                (4, 1) => self.eliminate(b, 4, 1),
+                (5, 1) => self.eliminate(b, 5, 1),
+                (3, 2) => self.eliminate(b, 3, 2),
+                (4, 2) => self.eliminate(b, 4, 2),
+                (5, 2) => self.eliminate(b, 5, 2),
+                _ => self.eliminate(b, nb, k),
             };
             if let Err(k) = result {
                 // A (nearly) singular block need not mean a singular matrix: the sparse LU
@@ -694,54 +1029,54 @@ impl LinearSolver for TreeElimination {
 }
 
 impl TreeElimination {
-    /// The forward and backward sweeps of the solve on the work vector `z` (blocks of any size).
+    /// The forward and backward sweeps of the solve on the work vector `z` (blocks of any size,
+    /// any number of coupled ancestors).
     fn sweeps(&mut self) {
         for b in 0..self.blocks() {
             let (s, e) = (self.start[b], self.start[b + 1]);
-            let nb = e - s;
             let d = &self.diag[self.diag_at[b]..self.diag_at[b + 1]];
             let (head, tail) = self.z.split_at_mut(e);
             let zb = &mut head[s..];
             let perm = &self.perm[s..e];
-            let pb = self.parent[b];
-            let coupling = if pb == ROOT {
-                None
-            } else {
-                Some((
-                    &self.low[3 * s..3 * e],
-                    &mut tail[self.start[pb as usize] - e..],
-                ))
-            };
             // Blocks of 3 (a free particle), 4 (a particle and its link) and 5 get unrolled copies.
-            match nb {
-                3 => forward_fixed::<3>(d, perm, zb, coupling),
-                4 => forward_fixed::<4>(d, perm, zb, coupling),
-                5 => forward_fixed::<5>(d, perm, zb, coupling),
-                _ => forward(d, nb, perm, zb, coupling),
+            match e - s {
+                3 => block_solve_fixed::<3>(d, perm, zb),
+                4 => block_solve_fixed::<4>(d, perm, zb),
+                5 => block_solve_fixed::<5>(d, perm, zb),
+                nb => lu_solve(d, nb, perm, zb, 1),
+            }
+            let nb = e - s;
+            let low = &self.low[self.coupling_at[b]..self.coupling_at[b + 1]];
+            let set = &self.ancestors[self.coupled_at[b]..self.coupled_at[b + 1]];
+            for (i, &u) in set.iter().enumerate() {
+                let zu = &mut tail[self.start[u as usize] - e..];
+                subtract_coupling(&low[3 * nb * i..], zb, zu);
             }
         }
         for b in (0..self.blocks()).rev() {
-            let pb = self.parent[b];
-            if pb == ROOT {
+            let set = &self.ancestors[self.coupled_at[b]..self.coupled_at[b + 1]];
+            let k = set.len();
+            if k == 0 {
                 continue;
             }
             let (s, e) = (self.start[b], self.start[b + 1]);
             let (head, tail) = self.z.split_at_mut(e);
-            let zp = &tail[self.start[pb as usize] - e..];
-            let xp = [zp[0], zp[1], zp[2]];
-            let (w, zb) = (&self.w[3 * s..3 * e], &mut head[s..]);
-            match e - s {
-                3 => backward_fixed::<3>(w, xp, zb),
-                4 => backward_fixed::<4>(w, xp, zb),
-                5 => backward_fixed::<5>(w, xp, zb),
-                _ => backward(w, xp, zb),
+            let zb = &mut head[s..];
+            let w = &self.w[self.coupling_at[b]..self.coupling_at[b] + 3 * k * (e - s)];
+            for (i, &u) in set.iter().enumerate() {
+                let at = self.start[u as usize] - e;
+                let xu = [tail[at], tail[at + 1], tail[at + 2]];
+                for (x, wj) in zb.iter_mut().zip(w.chunks_exact(3 * k)) {
+                    let wj = &wj[3 * i..3 * i + 3];
+                    *x -= wj[0] * xu[0] + wj[1] * xu[1] + wj[2] * xu[2];
+                }
             }
         }
     }
 
-    /// [`TreeElimination::sweeps`] when every block has N unknowns (a chain whose links each
-    /// join a particle's block): block b starts at N b and its factors at N^2 b, so the loops
-    /// walk the arrays in chunks of fixed size.
+    /// [`TreeElimination::sweeps`] when every block has N unknowns and is coupled with its
+    /// parent alone (a chain whose links each join a particle's block): block b starts at N b
+    /// and its factors at N^2 b and 3 N b, so the loops walk the arrays in chunks of fixed size.
     fn sweeps_uniform<const N: usize>(&mut self) {
         let z = &mut self.z;
         let blocks = self
@@ -778,7 +1113,7 @@ mod tests {
     use super::*;
     use crate::assembly::Layout;
     use crate::laws::VectorLaw;
-    use crate::linear::{for_layout, SparseLu, SparseSolver};
+    use crate::linear::{for_layout, DenseLu, SparseLu, SparseSolver};
     use crate::model::System;
 
     /// Deterministic pseudo-random numbers in [-1, 1) (a 64-bit linear congruential generator).
@@ -894,20 +1229,34 @@ mod tests {
         }
     }
 
-    /// Closing a loop (a spring from the tip back to the first particle, or a triangle of
-    /// distances) makes the solver fall back to the general sparse LU; a chain gets the tree.
+    /// A loop between particles neither of which is an ancestor of the other (a spring from the
+    /// tip of the main chain to the end of the side branch, or a triangle of distances) makes
+    /// the solver fall back to the general sparse LU; a chain gets the tree, and so does a loop
+    /// that joins a particle to an ancestor (a spring from the tip back to the first particle,
+    /// the root), which couples every particle of the path with the root (fill).
     #[test]
-    fn loops_fall_back_to_sparse_lu() {
+    fn loops_between_siblings_fall_back_to_sparse_lu() {
         let name = |s: &System| {
             let layout = Layout::new(s, 0);
             for_layout(&layout.pattern, 3 * layout.free, SparseSolver::Auto).name()
         };
         let mut s = branched_string(10);
         assert_eq!(name(&s), "tree elimination");
-        let first = s.particle_id(1).unwrap();
         let tip = s.particle_id(10).unwrap();
+        let branch_end = s.particle_id(13).unwrap();
+        let mut cousins = s.clone();
+        cousins
+            .add_spring_damper(tip, branch_end, 1.0, 0.0, None)
+            .unwrap();
+        assert_eq!(name(&cousins), "sparse LU");
+        let first = s.particle_id(1).unwrap();
         s.add_spring_damper(first, tip, 1.0, 0.0, None).unwrap();
-        assert_eq!(name(&s), "sparse LU");
+        let layout = Layout::new(&s, 0);
+        let tree = TreeElimination::analyse(&layout.pattern, 3 * layout.free)
+            .expect("a loop through the root is an ancestor coupling");
+        // The particles between the tip and the root are coupled with their parent and the
+        // root.
+        assert_eq!(tree.coupled_ancestors(), 2);
 
         let mut t = System::new([0.0, 0.0, -9.81]);
         let p: Vec<_> = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
@@ -919,6 +1268,193 @@ mod tests {
         assert_eq!(name(&t), "tree elimination");
         t.add_distance(p[2], p[0], None).unwrap();
         assert_eq!(name(&t), "sparse LU");
+    }
+
+    /// A KKT-like matrix on `particles` particles (3 unknowns each): a dense 3x3 diagonal block
+    /// per particle (dominant), dense 3x3 blocks both ways for each particle pair of
+    /// `couplings`, and one multiplier per entry of `multipliers` (its particles: one, or two
+    /// for a link), with a row and a column on each of its particles' coordinates and a
+    /// diagonal entry when it is compliant (`true`), none otherwise (a saddle point). Returns
+    /// the sparse pattern, the entries (row, column, value) and the number of particle
+    /// unknowns.
+    #[allow(clippy::type_complexity)]
+    fn kkt_matrix(
+        particles: usize,
+        couplings: &[(usize, usize)],
+        multipliers: &[(usize, Option<usize>, bool)],
+        seed: u64,
+    ) -> (Pattern, Vec<(usize, usize, f64)>, usize) {
+        let mut rng = Lcg(seed);
+        let mut entries = Vec::new();
+        let mut block = |entries: &mut Vec<(usize, usize, f64)>, a: usize, b: usize| {
+            for r in 0..3 {
+                for c in 0..3 {
+                    let dominant = if a == b && r == c { 20.0 } else { 0.0 };
+                    entries.push((3 * a + r, 3 * b + c, dominant + rng.next()));
+                }
+            }
+        };
+        for p in 0..particles {
+            block(&mut entries, p, p);
+        }
+        for &(a, b) in couplings {
+            block(&mut entries, a, b);
+            block(&mut entries, b, a);
+        }
+        let mut rng = Lcg(seed + 1);
+        for (k, &(a, b, compliant)) in multipliers.iter().enumerate() {
+            let m = 3 * particles + k;
+            for p in std::iter::once(a).chain(b) {
+                for r in 0..3 {
+                    let g = rng.next();
+                    // A constraint's gradient as a row, and (scaled) as a column.
+                    entries.push((m, 3 * p + r, g));
+                    entries.push((3 * p + r, m, -0.5 * g + 0.1 * rng.next()));
+                }
+            }
+            if compliant {
+                entries.push((m, m, -0.05 - 0.05 * rng.next().abs()));
+            }
+        }
+        let n = 3 * particles + multipliers.len();
+        let pattern = Pattern::new(n, entries.iter().map(|&(i, j, _)| (i, j)).collect(), false);
+        (pattern, entries, 3 * particles)
+    }
+
+    /// Solves A x = b with `solver` for the entries of `kkt_matrix`; returns x and the residual
+    /// |b - A x|_inf relative to |A|_inf |x|_inf.
+    fn kkt_solve(
+        solver: &mut dyn LinearSolver,
+        pattern: &Pattern,
+        entries: &[(usize, usize, f64)],
+        b: &[f64],
+    ) -> (Vec<f64>, f64) {
+        let mut values = vec![0.0; pattern.nnz()];
+        for &(i, j, v) in entries {
+            values[pattern.slot(i, j)] += v;
+        }
+        let x = solve(solver, &values, b);
+        let mut r = b.to_vec();
+        let mut row_sums = vec![0.0; b.len()];
+        for &(i, j, v) in entries {
+            r[i] -= v * x[j];
+            row_sums[i] += v.abs();
+        }
+        let norm = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let residual = norm(&r) / (norm(&row_sums) * norm(&x));
+        (x, residual)
+    }
+
+    /// The tree elimination of `kkt_matrix` agrees with the dense LU (faer, partial pivoting on
+    /// the whole matrix: the reference) to 1e-12 relative, and both residuals are at round-off.
+    fn check_against_dense_lu(
+        particles: usize,
+        couplings: &[(usize, usize)],
+        multipliers: &[(usize, Option<usize>, bool)],
+        ancestors: usize,
+    ) {
+        for seed in [3, 11, 29] {
+            let (pattern, entries, particle_unknowns) =
+                kkt_matrix(particles, couplings, multipliers, seed);
+            let mut tree = TreeElimination::analyse(&pattern, particle_unknowns)
+                .expect("couplings to ancestors only");
+            assert_eq!(tree.coupled_ancestors(), ancestors);
+            let n = pattern.n;
+            let dense = Pattern::new(n, entries.iter().map(|&(i, j, _)| (i, j)).collect(), true);
+            let mut lu = DenseLu::new(n);
+            let mut rng = Lcg(seed + 7);
+            let b: Vec<f64> = (0..n).map(|_| rng.next()).collect();
+            let (x, rx) = kkt_solve(&mut tree, &pattern, &entries, &b);
+            let (y, ry) = kkt_solve(&mut lu, &dense, &entries, &b);
+            assert_eq!(tree.fallbacks(), 0, "the tree elimination made the solve");
+            assert!(
+                rx < 1e-14 && ry < 1e-14,
+                "residuals {rx:.2e} (tree), {ry:.2e} (LU)"
+            );
+            let scale = y.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            for i in 0..n {
+                assert!(
+                    (x[i] - y[i]).abs() <= 1e-12 * scale,
+                    "seed {seed}, unknown {i}: tree {} vs dense LU {}",
+                    x[i],
+                    y[i]
+                );
+            }
+        }
+    }
+
+    /// A line of 30 nodes with bending (couplings of nodes i and i + 2 besides neighbours), the
+    /// first node anchored by a distance to a fixed point (a multiplier on it alone), links
+    /// between neighbours every other one compliant, and a fixed coordinate on the last node:
+    /// each node is coupled with its parent and grandparent.
+    #[test]
+    fn line_with_bending_matches_dense_lu() {
+        let n = 30;
+        let couplings: Vec<_> = (0..n - 1)
+            .map(|i| (i, i + 1))
+            .chain((0..n - 2).map(|i| (i, i + 2)))
+            .collect();
+        let mut multipliers = vec![(0, None, false)];
+        multipliers.extend((0..n - 1).map(|i| (i, Some(i + 1), i % 2 == 1)));
+        multipliers.push((n - 1, None, false));
+        check_against_dense_lu(n, &couplings, &multipliers, 2);
+    }
+
+    /// A branched tree (a main line 0-1-...-11 with branches 12-13-14 from node 4 and 15-16
+    /// from node 8, in links, some compliant) with every node coupled with its grandparent,
+    /// and the end of a branch coupled with the main line's first node (its great-great-...
+    /// grandparent), which couples the whole path with that node.
+    #[test]
+    fn branched_tree_with_couplings_to_ancestors_matches_dense_lu() {
+        let parent: Vec<Option<usize>> = (0..17)
+            .map(|p| match p {
+                0 => None,
+                12 => Some(4),
+                15 => Some(8),
+                p => Some(p - 1),
+            })
+            .collect();
+        let mut couplings: Vec<(usize, usize)> = Vec::new();
+        let mut multipliers = vec![(0, None, false), (13, None, true)];
+        for (p, q) in parent.iter().enumerate() {
+            if let Some(q) = *q {
+                multipliers.push((q, Some(p), p % 3 == 0));
+                if let Some(g) = parent[q] {
+                    couplings.push((g, p));
+                }
+            }
+        }
+        couplings.push((16, 0));
+        // Node 16's path to the root: 15, 8, 7, ..., 0; after fill its blocks are coupled
+        // with their parent, grandparent and the root (3 ancestors).
+        check_against_dense_lu(17, &couplings, &multipliers, 3);
+    }
+
+    /// A bending triple centred on the most constrained particle, in the middle of a line (the
+    /// middle node of a 3-node line holds a fixed coordinate, so it would be the root, and the
+    /// bending couples its two neighbours, siblings): the analysis roots the line at an end
+    /// instead, and the elimination agrees with the dense LU.
+    #[test]
+    fn bending_centred_on_the_most_constrained_particle_is_rooted_at_an_end() {
+        let bent = [(0, 1), (1, 2), (0, 2)];
+        let links = [(0, Some(1), false), (1, Some(2), true), (1, None, false)];
+        check_against_dense_lu(3, &bent, &links, 2);
+    }
+
+    /// Couplings between branches that no root puts on one path (each pair of three legs of a
+    /// star: wherever the root, two legs are siblings) make the analysis decline.
+    #[test]
+    fn couplings_across_branches_are_declined() {
+        let links = [
+            (0, Some(1), false),
+            (0, Some(2), false),
+            (0, Some(3), false),
+        ];
+        let (pattern, _, particle_unknowns) = kkt_matrix(4, &[(1, 2), (2, 3), (1, 3)], &links, 1);
+        assert!(TreeElimination::analyse(&pattern, particle_unknowns).is_none());
+        // Without the couplings between the legs, the same star is a tree.
+        let (pattern, _, particle_unknowns) = kkt_matrix(4, &[], &links, 1);
+        assert!(TreeElimination::analyse(&pattern, particle_unknowns).is_some());
     }
 
     /// Well-posed chains whose tree blocks are singular. `pinned` false: a chain hung from two
