@@ -22,6 +22,7 @@ are below 2e-3 of the result.
 
 import math
 
+import numpy as np
 import pytest
 from scipy.integrate import quad
 from scipy.optimize import brentq
@@ -93,3 +94,17 @@ def test_line_with_bending_stiffness_matches_the_tensioned_beam():
     assert h_err < 2e-3 and middle_err < 1e-3, errors
     # The discretisation error shrinks as the segments do.
     assert errors[0][1] > 10.0 * errors[-1][1], errors
+
+
+def test_a_finely_divided_cable_steps_without_halving():
+    # 500 segments of 6 cm with EI = 2e4 N m^2: the bending stiffness EI / l^3 = 9e7 N/m times the
+    # rounding of 30 m positions puts each step's residual round-off (about 3e-10 of the scaled
+    # residual at 0.1 s steps) above Newton's tolerance 1e-10. Newton stops at that round-off
+    # (integrators/newton.rs) instead of failing, so no step is halved; before, every 0.1 s step
+    # was halved down to a few milliseconds (50 times more factorisations).
+    from vinculo.mooring.analysis import run
+    from vinculo.mooring.bench import bending_line, motion_for
+
+    model = bending_line(500)
+    result = run(model, motion_for(model), 1.0, dt=0.1)
+    assert np.diff(result.times).min() == pytest.approx(0.1, rel=1e-9)

@@ -99,11 +99,9 @@ pub trait Index3Rule: Sync {
     /// v_e = v_{n+1}, t_e = t_{n+1}); false: at a point of their own (stored by the step problem
     /// in its evaluation buffers).
     const AT_END: bool;
-    /// True when Newton may stop at the residual's own round-off above the tolerance
-    /// ([`NewtonProblem::round_off`](super::newton::NewtonProblem::round_off)): the static
-    /// equilibrium, whose residual has no step size to make it small. False for the time rules:
-    /// a step's tolerance is the user's, and one below round-off fails rather than passes.
-    const STOPS_AT_ROUND_OFF: bool = false;
+    /// The largest ratio of the residual's round-off to the tolerance at which Newton stops at
+    /// that round-off ([`NewtonProblem::round_off_reach`](super::newton::NewtonProblem::round_off_reach)).
+    const ROUND_OFF_REACH: f64 = super::newton::ROUND_OFF_REACH;
     /// (v_{n+1}, q_e, v_e) of particle `i` at the iterate `q` (q_e and v_e unused when
     /// [`Index3Rule::AT_END`]).
     fn kinematics(&self, i: usize, q: &Vec3) -> (Vec3, Vec3, Vec3);

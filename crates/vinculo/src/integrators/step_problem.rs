@@ -210,11 +210,10 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
     }
 
     /// `ROUND_OFF_ULPS eps max_i sum_j |J_ij| |x_j|` over the scaled unknowns: positions (m) and
-    /// multipliers `lambda sigma / s` (0 for the time rules, see
-    /// [`Index3Rule::STOPS_AT_ROUND_OFF`], and when the pattern's structure was released).
+    /// multipliers `lambda sigma / s` (0 when the pattern's structure was released).
     fn round_off(&self, values: &[f64]) -> f64 {
         let pattern = &self.layout.pattern;
-        if !R::STOPS_AT_ROUND_OFF || pattern.is_released() || values.len() != pattern.nnz() {
+        if pattern.is_released() || values.len() != pattern.nnz() {
             return 0.0;
         }
         let b = &*self.buffers;
@@ -239,6 +238,10 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
         }
         let largest = rows.iter().fold(0.0f64, |m, r| m.max(*r));
         super::newton::ROUND_OFF_ULPS * f64::EPSILON * largest
+    }
+
+    fn round_off_reach(&self) -> f64 {
+        R::ROUND_OFF_REACH
     }
 }
 
