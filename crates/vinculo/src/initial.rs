@@ -395,29 +395,9 @@ mod tests {
     #[test]
     fn consistent_acceleration_of_a_line_node_has_the_axial_added_mass() {
         use crate::laws::VectorLaw;
-        use crate::model::LineHydroSpec;
-        let mut s = System::new([0.0; 3]);
-        let a = s
-            .add_particle(1.0, [-1.0, 0.0, 0.0], [0.0; 3], true)
-            .unwrap();
-        let n = s.add_particle(3.0, [0.0; 3], [0.0; 3], false).unwrap();
-        let b = s
-            .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], true)
-            .unwrap();
-        let spec = LineHydroSpec {
-            density: 1025.0,
-            diameter: 0.08,
-            length: 1.0,
-            cd: 0.0,
-            cdax: 0.0,
-            ca: 1.0,
-            caax: 0.25,
-            current: [0.0; 3],
-        };
-        s.add_line_hydrodynamics(n, Some((a, b)), &spec).unwrap();
+        let (mut s, n, rho_v) = crate::integrators::fixtures::line_node_between_fixed_neighbours();
         let force = [2.0, -5.0, 0.0];
         s.add_force(n, VectorLaw::constant(force)).unwrap();
-        let rho_v = 1025.0 * std::f64::consts::PI * 0.08 * 0.08 / 4.0;
         let mut ws = StepWorkspace::new(&s, 64);
         let (q, v) = (s.initial_positions(), s.initial_velocities());
         let (acc, _) = consistent_accelerations(&s, &mut ws, &q, &v, 0.0).unwrap();

@@ -8,6 +8,33 @@ use crate::laws::{Law, VectorLaw};
 use crate::math::Vec3;
 use crate::model::System;
 
+/// A line node of mass 3 kg at the origin between two fixed neighbours at x = -1 and 1 m, in
+/// water without gravity nor drag, with Ca = 1 and CaAx = 0.25 (diameter 0.08 m, length 1 m);
+/// returns the system, the node and its displaced mass rho V (kg).
+pub(crate) fn line_node_between_fixed_neighbours() -> (System, crate::model::ParticleId, f64) {
+    use crate::model::LineHydroSpec;
+    let mut s = System::new([0.0; 3]);
+    let a = s
+        .add_particle(1.0, [-1.0, 0.0, 0.0], [0.0; 3], true)
+        .unwrap();
+    let n = s.add_particle(3.0, [0.0; 3], [0.0; 3], false).unwrap();
+    let b = s
+        .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], true)
+        .unwrap();
+    let spec = LineHydroSpec {
+        density: 1025.0,
+        diameter: 0.08,
+        length: 1.0,
+        cd: 0.0,
+        cdax: 0.0,
+        ca: 1.0,
+        caax: 0.25,
+        current: [0.0; 3],
+    };
+    s.add_line_hydrodynamics(n, Some((a, b)), &spec).unwrap();
+    (s, n, 1025.0 * std::f64::consts::PI * 0.08 * 0.08 / 4.0)
+}
+
 /// A system with every constraint and force kind (a bending force among them, over three
 /// particles), fixed particles, added mass and time-dependent laws.
 pub(crate) fn every_kind() -> System {

@@ -561,27 +561,7 @@ mod tests {
     /// m I + rho V (Ca (I - t t^T) + CaAx t t^T), t = x).
     #[test]
     fn axial_added_mass_makes_the_inertia_along_the_line_m_plus_caax_rho_v() {
-        use crate::model::LineHydroSpec;
-        let mut s = System::new([0.0; 3]);
-        let a = s
-            .add_particle(1.0, [-1.0, 0.0, 0.0], [0.0; 3], true)
-            .unwrap();
-        let n = s.add_particle(3.0, [0.0; 3], [0.0; 3], false).unwrap();
-        let b = s
-            .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], true)
-            .unwrap();
-        let spec = LineHydroSpec {
-            density: 1025.0,
-            diameter: 0.08,
-            length: 1.0,
-            cd: 0.0,
-            cdax: 0.0,
-            ca: 1.0,
-            caax: 0.25,
-            current: [0.0; 3],
-        };
-        s.add_line_hydrodynamics(n, Some((a, b)), &spec).unwrap();
-        let rho_v = 1025.0 * std::f64::consts::PI * 0.08 * 0.08 / 4.0;
+        let (s, _, rho_v) = crate::integrators::fixtures::line_node_between_fixed_neighbours();
         let (q_n, v_n) = (s.initial_positions(), s.initial_velocities());
         let mut ws = StepWorkspace::new(&s, 48);
         let d = [0.002, -0.003, 0.001];
