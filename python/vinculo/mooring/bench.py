@@ -21,11 +21,11 @@ For each case and number of segments, both codes run the same MoorDyn file:
   tension, whichever is larger): equal accuracy in end tension.
 
 Each row reports the step, the CPU time of the time integration (``time.process_time``, the
-initial equilibrium excluded; the least of :data:`REPEATS` runs), the real-time factor (CPU time over simulated time), the error
-against the code's own reference, and the difference in end tension between the two codes. The
-end tensions compared are those of each line's first and last segments: the force on an end
-point also holds the loads the two codes lump differently on the end node (MoorDyn adds the
-drag and added mass of the half segment at a moving fairlead).
+initial equilibrium excluded; the least of :data:`REPEATS` runs), the real-time factor (CPU time
+over simulated time), the error against the code's own reference, and the difference in end
+tension between the two codes. The end tensions compared are those of each line's first and
+last segments: the force on an end point also holds the loads the two codes lump differently on
+the end node (MoorDyn adds the drag and added mass of the half segment at a moving fairlead).
 
 Run it with ``python -m vinculo.mooring.bench [--segments 20,100] [--t-end 60]``; it writes
 ``bench.csv`` and ``bench.md`` (the README's table) into ``--output``.
