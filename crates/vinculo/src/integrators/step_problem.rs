@@ -312,6 +312,22 @@ mod tests {
 
     /// The residual and Jacobian of a step of `rule` (h = 0.01 from t_n = 0.3) at the
     /// workspace's iterate.
+    /// The parallel assembly of `rule`'s step gives the serial one's residual and Jacobian at a
+    /// wiggled iterate.
+    fn assert_parallel_assembly_is_serial<T: TimeRule + Copy>(s: &System, rule: T) {
+        let q_n = s.initial_positions();
+        let run = |parallel: bool| {
+            let mut ws = StepWorkspace::new(s, 48);
+            if parallel {
+                ws.assemble_in_parallel_from(s, 0);
+            }
+            wiggled_iterate(&mut ws, &q_n);
+            let mut state = alpha_state(q_n.len());
+            assemble(rule, s, &mut ws, &mut state)
+        };
+        assert_same_assembly(&run(false), &run(true));
+    }
+
     fn assemble<T: TimeRule>(
         rule: T,
         s: &System,
@@ -447,21 +463,7 @@ mod tests {
             let (mut problem, _) = problem_at(rule, &s, &mut ws, &mut state, start(&q_n, &v_n));
             assert_jacobian_matches(&mut problem, &layout);
         }
-        let run = |parallel: bool| {
-            let mut ws = StepWorkspace::new(&s, 48);
-            if parallel {
-                ws.assemble_in_parallel_from(&s, 0);
-            }
-            wiggled_iterate(&mut ws, &q_n);
-            let mut state = alpha_state(q_n.len());
-            assemble(
-                GeneralizedTrapezoidal { alpha: 0.6 },
-                &s,
-                &mut ws,
-                &mut state,
-            )
-        };
-        assert_same_assembly(&run(false), &run(true));
+        assert_parallel_assembly_is_serial(&s, GeneralizedTrapezoidal { alpha: 0.6 });
     }
 
     /// The assembled Jacobian equals finite differences of the assembled residual, for a system
@@ -542,16 +544,7 @@ mod tests {
                 assert_jacobian_matches(&mut problem, &layout);
             }
         }
-        let run = |parallel: bool| {
-            let mut ws = StepWorkspace::new(&s, 48);
-            if parallel {
-                ws.assemble_in_parallel_from(&s, 0);
-            }
-            wiggled_iterate(&mut ws, &q_n);
-            let mut state = alpha_state(q_n.len());
-            assemble(GeneralizedAlpha { rho_inf: 0.6 }, &s, &mut ws, &mut state)
-        };
-        assert_same_assembly(&run(false), &run(true));
+        assert_parallel_assembly_is_serial(&s, GeneralizedAlpha { rho_inf: 0.6 });
     }
 
     /// Closed form: a node of mass m between two fixed neighbours on the x axis, in water
