@@ -392,6 +392,30 @@ impl Layout {
         }
     }
 
+    /// The magnitudes of the scaled unknowns of [`Layout::apply_increment`]: |q| of each free
+    /// particle's coordinates and |lambda_k sigma / s_k| of each multiplier, into `out`.
+    pub fn unknown_magnitudes(
+        &self,
+        q: &[crate::math::Vec3],
+        lambda: &[f64],
+        scales: &[f64],
+        sigma: f64,
+        out: &mut [f64],
+    ) {
+        for (i, qi) in q.iter().enumerate() {
+            let d = self.dof[i];
+            if d != NONE {
+                for k in 0..3 {
+                    out[d + k] = qi[k].abs();
+                }
+            }
+        }
+        let m3 = 3 * self.free;
+        for (c, l) in lambda.iter().enumerate() {
+            out[m3 + c] = (l * sigma / scales[c]).abs();
+        }
+    }
+
     /// Applies a Newton increment `dx` (in scaled unknowns) to the positions of the free
     /// particles and to the multipliers, whose unknowns are lambda_k sigma / s_k.
     #[inline]

@@ -94,6 +94,14 @@ impl Pattern {
     pub fn is_released(&self) -> bool {
         self.col_ptr.is_empty()
     }
+
+    /// Every structural entry as (row, column, slot), column by column (none once released).
+    pub fn entries(&self) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
+        self.col_ptr
+            .windows(2)
+            .enumerate()
+            .flat_map(move |(col, w)| (w[0]..w[1]).map(move |k| (self.row_idx[k], col, k)))
+    }
     /// [`Pattern::slot`] as the layouts' 32-bit [`Slot`] ([`Pattern::new`] checks that every
     /// slot fits).
     pub fn slot32(&self, row: usize, col: usize) -> Slot {

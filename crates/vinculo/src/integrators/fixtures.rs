@@ -161,10 +161,8 @@ pub(crate) fn assert_pattern_jacobian_matches(
     let mut values = vec![0.0; pattern.nnz()];
     problem.jacobian(&mut values);
     let mut dense = vec![vec![0.0; n]; n];
-    for col in 0..n {
-        for k in pattern.col_ptr[col]..pattern.col_ptr[col + 1] {
-            dense[pattern.row_idx[k]][col] += values[k];
-        }
+    for (row, col, k) in pattern.entries() {
+        dense[row][col] += values[k];
     }
     let eps = 1e-7;
     for col in 0..n {

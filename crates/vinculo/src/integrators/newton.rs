@@ -269,13 +269,13 @@ pub fn solve(
         }
         let at_floor = fresh && increment > FLOOR_CONTRACTION * increment_before;
         // At the floor, a residual the evaluation cannot resolve is as good as zero.
-        let reachable = if at_floor && residual > options.tolerance {
-            let floor = problem.round_off(values);
-            if floor <= problem.round_off_reach() * options.tolerance {
-                options.tolerance.max(floor)
-            } else {
-                options.tolerance
-            }
+        let floor = if at_floor && residual > options.tolerance {
+            problem.round_off(values)
+        } else {
+            0.0
+        };
+        let reachable = if floor <= problem.round_off_reach() * options.tolerance {
+            options.tolerance.max(floor)
         } else {
             options.tolerance
         };

@@ -218,23 +218,12 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
         }
         let b = &*self.buffers;
         let mut x = vec![0.0; pattern.n];
-        for (i, qi) in b.q.iter().enumerate() {
-            let d = self.layout.dof[i];
-            if d != crate::assembly::NONE {
-                for k in 0..3 {
-                    x[d + k] = qi[k].abs();
-                }
-            }
-        }
-        let m3 = 3 * self.layout.free;
-        for (c, l) in b.lambda.iter().enumerate() {
-            x[m3 + c] = (l * self.point.sigma / self.scales[c]).abs();
-        }
+        let (scales, sigma) = (self.scales, self.point.sigma);
+        self.layout
+            .unknown_magnitudes(&b.q, &b.lambda, scales, sigma, &mut x);
         let mut rows = vec![0.0f64; pattern.n];
-        for (col, xc) in x.iter().enumerate() {
-            for k in pattern.col_ptr[col]..pattern.col_ptr[col + 1] {
-                rows[pattern.row_idx[k]] += values[k].abs() * xc;
-            }
+        for (row, col, k) in pattern.entries() {
+            rows[row] += values[k].abs() * x[col];
         }
         let largest = rows.iter().fold(0.0f64, |m, r| m.max(*r));
         super::newton::ROUND_OFF_ULPS * f64::EPSILON * largest

@@ -1172,13 +1172,10 @@ mod tests {
         let p = &layout.pattern;
         let mut rng = Lcg(seed);
         let mut v = vec![0.0; p.nnz()];
-        for col in 0..p.n {
-            for k in p.col_ptr[col]..p.col_ptr[col + 1] {
-                let row = p.row_idx[k];
-                v[k] = rng.next();
-                if row == col && row < 3 * layout.free {
-                    v[k] += 6.0;
-                }
+        for (row, col, k) in p.entries() {
+            v[k] = rng.next();
+            if row == col && row < 3 * layout.free {
+                v[k] += 6.0;
             }
         }
         v
@@ -1219,10 +1216,8 @@ mod tests {
                 }
                 let p = &layout.pattern;
                 let mut r = b.clone();
-                for col in 0..n {
-                    for k in p.col_ptr[col]..p.col_ptr[col + 1] {
-                        r[p.row_idx[k]] -= v[k] * x[col];
-                    }
+                for (row, col, k) in p.entries() {
+                    r[row] -= v[k] * x[col];
                 }
                 assert!(r.iter().all(|e| e.abs() < 1e-12), "residual {r:?}");
             }
