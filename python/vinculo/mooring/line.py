@@ -141,8 +141,10 @@ class Line:
     bending: float = 0.0
 
     def tensions(self, solution: Any) -> np.ndarray:
-        """The segments' tensions: the elastic part from their multipliers, plus the axial
-        damping's ``(BA / l) u . (v_i - v_j)`` where the source has velocities (a run).
+        """The segments' tensions: the elastic part, plus the axial damping's
+        ``(BA / l) u . (v_i - v_j)`` where the source has velocities (a run). The elastic part of
+        a run is Hooke's law at the stored positions; of an equilibrium (or an inextensible
+        line), the segments' multipliers.
 
         Arguments:
             solution: a :class:`vinculo.Solution` of the line's system, or a static equilibrium
@@ -151,8 +153,6 @@ class Line:
         Returns:
             ``(times, segments)`` tensions (N); one row for an equilibrium.
         """
-        multipliers = np.atleast_2d(np.asarray(solution.multipliers, dtype=float))
-        tension = multipliers[:, [c.index for c in self.segments]]
         velocities = getattr(solution, "velocities", None)
         times = getattr(solution, "times", None)
         if times is not None and math.isfinite(self.line_type.ea):
@@ -162,6 +162,9 @@ class Line:
             # tension there, to the rule's order (docs/theory/moorings.md).
             tension = self._elastic_tensions(np.asarray(solution.positions, dtype=float),
                                              np.asarray(times, dtype=float))
+        else:
+            multipliers = np.atleast_2d(np.asarray(solution.multipliers, dtype=float))
+            tension = multipliers[:, [c.index for c in self.segments]]
         if self.damping > 0.0 and velocities is not None:
             q = np.asarray(solution.positions, dtype=float)[:, self.nodes]
             v = np.asarray(velocities, dtype=float)[:, self.nodes]
