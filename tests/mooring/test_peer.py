@@ -93,3 +93,29 @@ def test_largest_stable_step_of_the_hanging_chain():
     bad = run_moordyn(path, motion, 10.0, time_step=1.5 * step)
     assert bad.error is not None or np.max(np.abs(bad.end_tensions - reference.end_tensions)) \
         > 0.05 * np.max(reference.end_tensions)
+
+
+def test_a_run_from_the_saved_initial_state_is_the_run_from_moordyns_own(tmp_path):
+    # MoorDyn's initial-condition solve saved once (SaveState) and loaded by a later run
+    # (LoadState) gives that run the state its own solve gives: the same end forces, at t = 0
+    # (saved beside the state) and after the fairlead has moved, bit for bit at the same dtM.
+    from vinculo.mooring.peer import moordyn_initial_state
+
+    path = DATA / "hanging_line.txt"
+    model = read_moordyn(path)
+    motion = Motion.harmonic([model.points[1].position], (1.0, 0.0, 0.0), period=10.0,
+                             ramp_time=5.0)
+    state = moordyn_initial_state(path, motion, tmp_path / "hanging.state", time_step=1e-3)
+    own = run_moordyn(path, motion, 2.0, time_step=1e-3)
+    loaded = run_moordyn(path, motion, 2.0, time_step=1e-3, initial_state=state)
+    assert loaded.error is None and own.error is None
+    np.testing.assert_array_equal(loaded.end_forces, own.end_forces)
+    np.testing.assert_array_equal(loaded.segment_tensions, own.segment_tensions)
+    # The fairlead moved: the forces at the end differ from those at the start.
+    assert abs(own.end_tensions[-1, 0, 1] / own.end_tensions[0, 0, 1] - 1.0) > 1e-3
+    assert loaded.initial_cpu_time < own.initial_cpu_time
+
+
+def test_a_missing_initial_state_is_named():
+    with pytest.raises(InvalidInputError, match=r"no\.such\.state: no such file"):
+        run_moordyn(DATA / "hanging_line.txt", None, 1.0, initial_state="no.such.state")

@@ -9,13 +9,15 @@ start) from the static equilibrium:
 
 For each case and number of segments, both codes run the same MoorDyn file:
 
-- MoorDyn (explicit RK2): the range of its stable steps (no blow-up) by bisection on ``dtM``
-  from the axial-wave estimate ``l / sqrt(EA / m)`` of a segment of length ``l``, a reference
-  run at an eighth of it, its largest stable step by bisection (tensions within 5 % of the
-  reference), and a run at 0.9 of that step, whose end-tension error against the reference is
-  MoorDyn's accuracy. These runs call MoorDyn's Step at every step, so that the fairlead follows
-  the motion exactly (as vinculo's does). MoorDyn's CPU time is that of the same steps with a
-  call every 0.01 s, without the Python call at each step;
+- MoorDyn (explicit RK2), every run from one initial state (its own initial-condition solve,
+  saved once: :func:`vinculo.mooring.peer.moordyn_initial_state`): the range of its stable
+  steps (no blow-up) by bisection on ``dtM`` from the axial-wave estimate ``l / sqrt(EA / m)``
+  of a segment of length ``l``, a reference run at an eighth of it, its largest stable step
+  by bisection (tensions within 5 % of the reference), and a run at 0.9 of that step, whose
+  end-tension error against the reference is MoorDyn's accuracy. These runs call MoorDyn's
+  Step at every step, so that the fairlead follows the motion exactly (as vinculo's does).
+  MoorDyn's CPU time is that of the same steps with a call every 0.01 s, without the Python
+  call at each step;
 - vinculo (implicit): a reference run at a small step, then the largest step of a list whose
   end-tension error against that reference is within MoorDyn's accuracy (or 0.1 % of the peak
   tension, whichever is larger): equal accuracy in end tension.
@@ -38,6 +40,7 @@ import csv
 import dataclasses
 import math
 import sys
+import tempfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -53,6 +56,7 @@ from vinculo.mooring.moordyn_file import (
     MoorDynFile,
 )
 from vinculo.mooring.motion import Motion
+from vinculo.mooring.peer import PeerRun
 
 __all__ = ["CASES", "BenchRow", "bench_case", "main", "motion_for", "table"]
 
@@ -223,28 +227,36 @@ def bench_moordyn(model: MoorDynFile, motion: Motion, t_end: float, dt_output: f
     Returns:
         ``(row, times, reference end tensions)``.
     """
-    from vinculo.mooring.peer import largest_stable_step, run_moordyn
+    from vinculo.mooring.peer import largest_stable_step, moordyn_initial_state, run_moordyn
 
     estimate = wave_step(model)
-    # The stable range without a reference (no blow-up), then the reference at an eighth of
-    # it, then the largest step that keeps the tensions within 5 % of the reference.
-    rough, _ = largest_stable_step(model, motion, t_end, low=estimate / 2, high=estimate,
-                                   ratio=1.5, dt_output=dt_output)
-    # The accuracy runs call MoorDyn at each of its steps, so that the fairlead follows the
-    # motion exactly as vinculo's does (peer.run_moordyn: a call every 0.01 s moves it at a
-    # piecewise-constant velocity, whose jumps change the tensions by about 1 %).
-    reference = run_moordyn(model, motion, t_end, dt_output=dt_output, time_step=rough / 8,
-                            coupling_step=rough / 8)
-    stable, _ = largest_stable_step(model, motion, t_end, reference, low=rough / 2,
-                                    high=rough * 1.5, dt_output=dt_output, exact_motion=True)
-    step = 0.9 * stable
-    accurate = run_moordyn(model, motion, t_end, dt_output=dt_output, time_step=step,
-                           coupling_step=step)
-    error = _relative(accurate.end_tensions, reference.end_tensions)
-    # The CPU time of the same steps with a call every 0.01 s: the Python call at each step
-    # (about 5 us) would otherwise count against MoorDyn (half its time at 20 segments).
-    cpu = min(run_moordyn(model, motion, t_end, dt_output=dt_output, time_step=step).cpu_time
-              for _ in range(REPEATS))
+    with tempfile.TemporaryDirectory(prefix="vinculo-bench-") as folder:
+        # MoorDyn's initial condition once (a dynamic relaxation at half the axial-wave step,
+        # minutes at 1,000 segments), the start of every run below.
+        state = moordyn_initial_state(model, motion, Path(folder) / "initial.state",
+                                      time_step=estimate / 2)
+
+        def moordyn(step: float, exact: bool) -> PeerRun:
+            return run_moordyn(model, motion, t_end, dt_output=dt_output, time_step=step,
+                               coupling_step=step if exact else None, initial_state=state)
+
+        # The stable range without a reference (no blow-up), then the reference at an eighth
+        # of it, then the largest step that keeps the tensions within 5 % of the reference.
+        rough, _ = largest_stable_step(model, motion, t_end, low=estimate / 2, high=estimate,
+                                       ratio=1.5, dt_output=dt_output, initial_state=state)
+        # The accuracy runs call MoorDyn at each of its steps, so that the fairlead follows the
+        # motion exactly as vinculo's does (peer.run_moordyn: a call every 0.01 s moves it at a
+        # piecewise-constant velocity, whose jumps change the tensions by about 1 %).
+        reference = moordyn(rough / 8, exact=True)
+        stable, _ = largest_stable_step(model, motion, t_end, reference, low=rough / 2,
+                                        high=rough * 1.5, dt_output=dt_output,
+                                        exact_motion=True, initial_state=state)
+        step = 0.9 * stable
+        error = _relative(moordyn(step, exact=True).end_tensions, reference.end_tensions)
+        # The CPU time of the same steps with a call every 0.01 s: the Python call at each
+        # step (about 5 us) would otherwise count against MoorDyn (half its time at 20
+        # segments).
+        cpu = min(moordyn(step, exact=False).cpu_time for _ in range(REPEATS))
     row = BenchRow(case="", segments=model.lines[0].segments, code="moordyn", step=step,
                    cpu_time=cpu, t_end=t_end, error=error, stable_step=stable)
     return row, reference.times, reference.segment_tensions

@@ -2,9 +2,16 @@
 
 MoorDyn-C's Python package (``moordyn`` on PyPI, an optional dependency) reads the same MoorDyn
 v2 input file. :func:`run_moordyn` computes MoorDyn's initial state (its own initial-condition
-solve), then moves the coupled points by a :class:`~vinculo.mooring.motion.Motion` and records
-the force of each line on each of its end points and, if asked, the lines' node positions.
-:func:`largest_stable_step` finds MoorDyn's largest stable time step on a case by bisection.
+solve, or loads one that :func:`moordyn_initial_state` saved), then moves the coupled points by
+a :class:`~vinculo.mooring.motion.Motion` and records the force of each line on each of its end
+points and, if asked, the lines' node positions. :func:`largest_stable_step` finds MoorDyn's
+largest stable time step on a case by bisection.
+
+MoorDyn's initial-condition solve is a dynamic relaxation in its own time step (up to the
+file's ``TmaxIC`` of simulated time): on a 1,000-segment line it costs minutes, more than the run
+after it. A study that runs one file many times (the bisection on the step, the benchmark)
+computes it once with :func:`moordyn_initial_state` and starts every run from the saved state
+(MoorDyn's ``SaveState`` and ``LoadState``): the equilibrium does not depend on the step.
 
 MoorDyn writes a main output file next to its input file, so each run works on a copy of the
 file in a temporary folder; its console messages are silenced.
@@ -40,6 +47,7 @@ __all__ = [
     "PeerRun",
     "largest_stable_step",
     "moordyn_available",
+    "moordyn_initial_state",
     "run_moordyn",
 ]
 
@@ -166,7 +174,8 @@ def _end_forces(md, lines: list, sizes: list[int]) -> tuple[np.ndarray, np.ndarr
 
 def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: float, *,
                 dt_output: float = 0.1, coupling_step: float | None = None,
-                time_step: float | None = None, store_shapes: bool = False) -> PeerRun:
+                time_step: float | None = None, store_shapes: bool = False,
+                initial_state: str | Path | None = None) -> PeerRun:
     """Run MoorDyn on a mooring file with the coupled points moved by ``motion``.
 
     Arguments:
@@ -184,6 +193,8 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
             coupling step equal to ``time_step``) follow the motion exactly.
         time_step: MoorDyn's time step dtM (s; default: the file's).
         store_shapes: also store every line's node positions at each output time.
+        initial_state: a state file of :func:`moordyn_initial_state` for the same file and
+            motion to start from (None: MoorDyn's own initial-condition solve).
 
     Returns:
         What the run recorded; a run that blew up (NaN) stops there with ``error`` set.
@@ -226,8 +237,7 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
                 x = motion.positions(0.0).ravel().tolist()
                 v = motion.velocities(0.0).ravel().tolist()
                 started = time.process_time()
-                if md.Init(system, x, v) != 0:
-                    raise PeerError("MoorDyn's initial condition failed", time=0.0)
+                _initialise(md, system, x, v, initial_state)
                 initial_cpu = time.process_time() - started
                 outputs = math.floor(t_end / dt_output + 1e-9) + 1
                 times = np.arange(outputs) * dt_output
@@ -242,9 +252,13 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
                         if store_shapes:
                             shapes[k][i] = [md.GetLineNodePos(line, j) for j in range(n + 1)]
 
-                if coupled:
-                    md.Step(system, x, v, 0.0, 0.0)  # the forces at t = 0
-                record(0)
+                if initial_state is not None:
+                    # A loaded state has no forces until a step: those saved with it.
+                    forces[0], segment[0] = _saved_forces(initial_state, forces[0].shape)
+                else:
+                    if coupled:
+                        md.Step(system, x, v, 0.0, 0.0)  # the forces at t = 0
+                    record(0)
                 error = None
                 cpu = 0.0
                 t = 0.0
@@ -286,11 +300,89 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
                    steps=steps, error=error)
 
 
+def _initialise(md, system, x: list[float], v: list[float],
+                initial_state: str | Path | None) -> None:
+    """MoorDyn's initial state: its own solve, or the saved ``initial_state``."""
+    if initial_state is None:
+        if md.Init(system, x, v) != 0:
+            raise PeerError("MoorDyn's initial condition failed", time=0.0)
+        return
+    state = Path(initial_state)
+    if not state.is_file():
+        raise InvalidInputError(f"initial_state {state}: no such file (make it with "
+                                f"moordyn_initial_state)", name="initial_state", value=str(state))
+    if md.Init_NoIC(system, x, v) != 0:
+        raise PeerError("MoorDyn did not initialise", time=0.0)
+    md.LoadState(system, str(state))
+
+
+def _forces_file(state: str | Path) -> Path:
+    """The file beside a saved state that holds the end forces at t = 0."""
+    return Path(f"{state}.forces.npz")
+
+
+def _saved_forces(state: str | Path, shape: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
+    with np.load(_forces_file(state)) as saved:
+        forces, tensions = saved["end_forces"], saved["segment_tensions"]
+    if forces.shape != shape:
+        raise InvalidInputError(f"initial_state {state} holds {forces.shape[0]} lines, the "
+                                f"file {shape[0]}: make it from the same file",
+                                name="initial_state", value=str(state))
+    return forces, tensions
+
+
+def moordyn_initial_state(source: str | Path | MoorDynFile, motion: Motion | None,
+                          path: str | Path, *, time_step: float | None = None) -> Path:
+    """Compute MoorDyn's initial state of a file once and save it, for :func:`run_moordyn`'s
+    ``initial_state``.
+
+    Arguments:
+        source: the MoorDyn input file, or a model to write to one.
+        motion: the coupled points' motion (its position and velocity at t = 0 are used;
+            None: the file's positions, at rest).
+        path: the state file to write.
+        time_step: MoorDyn's time step dtM for the solve (s; default: the file's); its
+            dynamic relaxation needs a stable one.
+
+    Returns:
+        ``path``. The end forces at t = 0 go beside it, into ``<path>.forces.npz`` (MoorDyn
+        computes none for a loaded state until its first step).
+
+    Raises:
+        PeerError: when MoorDyn is not installed, rejects the file or its solve fails.
+    """
+    md = _moordyn()
+    path = Path(path).resolve()
+    with tempfile.TemporaryDirectory(prefix="vinculo-moordyn-") as folder:
+        model, file = _model_and_file(source, Path(folder), time_step)
+        coupled = model.coupled_points()
+        if motion is None:
+            motion = Motion.still([p.position for p in coupled])
+        x = motion.positions(0.0).ravel().tolist()
+        v = motion.velocities(0.0).ravel().tolist()
+        with _silenced():
+            try:
+                system = md.Create(str(file))
+            except Exception as exc:  # MoorDyn raises a bare RuntimeError
+                raise PeerError(f"MoorDyn rejected {file.name}: {exc}") from None
+            try:
+                _initialise(md, system, x, v, None)
+                md.SaveState(system, str(path))
+                lines = [md.GetLine(system, k + 1) for k in range(len(model.lines))]
+                if coupled:
+                    md.Step(system, x, v, 0.0, 0.0)  # the forces at t = 0
+                forces, tensions = _end_forces(md, lines, [md.GetLineN(a) for a in lines])
+            finally:
+                md.Close(system)
+    np.savez(_forces_file(path), end_forces=forces, segment_tensions=tensions)
+    return path
+
+
 def largest_stable_step(source: str | Path | MoorDynFile, motion: Motion | None, t_end: float,
                         reference: PeerRun | None = None, *, low: float, high: float,
                         tolerance: float = 0.05, ratio: float = 1.1,
-                        dt_output: float = 0.1, exact_motion: bool = False
-                        ) -> tuple[float, int]:
+                        dt_output: float = 0.1, exact_motion: bool = False,
+                        initial_state: str | Path | None = None) -> tuple[float, int]:
     """MoorDyn's largest stable time step on a case, by bisection on dtM.
 
     With a ``reference`` (a run at a small step with the same ``dt_output``), a step is stable
@@ -311,6 +403,8 @@ def largest_stable_step(source: str | Path | MoorDynFile, motion: Motion | None,
         dt_output: the output interval (s), the same as the reference's.
         exact_motion: call MoorDyn's Step at every one of its steps, so that the coupled points
             follow the motion exactly (False: every :data:`COUPLING_STEP`).
+        initial_state: a saved initial state to start every run from (see
+            :func:`moordyn_initial_state`; None: each run computes its own).
 
     Returns:
         ``(step, runs)``: the largest stable step found (s) and the number of MoorDyn runs.
@@ -325,7 +419,8 @@ def largest_stable_step(source: str | Path | MoorDynFile, motion: Motion | None,
         nonlocal runs
         runs += 1
         run = run_moordyn(source, motion, t_end, dt_output=dt_output, time_step=dt,
-                          coupling_step=dt if exact_motion else None)
+                          coupling_step=dt if exact_motion else None,
+                          initial_state=initial_state)
         if run.error is not None or run.times.size < round(t_end / dt_output) + 1:
             return False
         tensions = run.end_tensions
