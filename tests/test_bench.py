@@ -92,3 +92,26 @@ def test_agreement_tolerance_is_a_share_of_the_schemes_own_error():
     modified = run_vinculo(pendulum, dataclasses.replace(COMPARISON, jacobian_reuse=True))
     assert np.linalg.norm(modified.tip - full.tip) > 10.0 * tolerance
     assert not COMPARISON.jacobian_reuse  # the headline runs vinculo's default, full Newton
+
+
+def test_python_overhead_times_the_same_run_in_rust_alone():
+    # The core's timing function runs the same integration as vinculo.simulate: a run that
+    # fails in one fails in the other (a step far too large for Newton, with no halving), and
+    # a bad number of repeats is named.
+    from vinculo import _core
+    from vinculo.bench import python_overhead
+    from vinculo.errors import ConvergenceError, InvalidInputError
+    from vinculo.run_options import RunOptions
+
+    system = python_overhead.pendulum()
+    options = {"max_halvings": 0, "max_iterations": 2}
+    settings = RunOptions.of("simulate", dict(options)).settings(1.0, 0.5, None)
+    with pytest.raises(ConvergenceError):
+        vinculo.simulate(system, 1.0, 0.5, **options)
+    with pytest.raises(RuntimeError, match="Newton"):
+        _core.time_simulate(system, settings, 1)
+    with pytest.raises(InvalidInputError, match="repeats"):
+        _core.time_simulate(system, settings, 0)
+    rows = python_overhead.measure(steps=20, repeat=2)
+    assert [r.label for r in rows] == list(python_overhead.SCHEMES)
+    assert all(r.steps == 20 and r.rust > 0.0 for r in rows)

@@ -748,6 +748,24 @@ def simulate(system: System, settings: RunSettings,
             reported as the run's ``error``), with the partial solution as its ``solution``.
     """
 
+def time_simulate(system: System, settings: RunSettings, repeats: int = 1) -> float:
+    """The least wall-clock time of ``repeats`` runs of the core's integration, in Rust alone
+    (no conversion of the solution to Python objects): the reference of the Python overhead
+    benchmark (``python -m vinculo.bench python-overhead``).
+
+    Arguments:
+        system: the model.
+        settings: the run's settings.
+        repeats: the number of runs (>= 1).
+
+    Returns:
+        The least time of one run, in s.
+
+    Raises:
+        InvalidInputError: ``repeats`` below 1.
+        RuntimeError: a run failed (its message).
+    """
+
 class Snapshot:
     """A copy of a running simulation's state (``Simulation.snapshot``), restored by
     ``Simulation.restore``."""

@@ -26,6 +26,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<run::PyRunSettings>()?;
     m.add_class::<run_result::PyRunResult>()?;
     m.add_function(wrap_pyfunction!(run::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(run::time_simulate, m)?)?;
     m.add_function(wrap_pyfunction!(statics::solve_statics, m)?)?;
     m.add_function(wrap_pyfunction!(statics::point_stiffness, m)?)?;
     m.add_function(wrap_pyfunction!(statics::point_force, m)?)?;

@@ -297,3 +297,36 @@ impl PyRunSettings {
         format!("RunSettings({:?})", self.options)
     }
 }
+
+/// The least wall-clock time (s) of `repeats` runs of the core's `simulate` on `system` with
+/// `settings`, in Rust alone: no conversion of the solution to Python objects. The Python
+/// overhead benchmark (`python -m vinculo.bench python-overhead`) sets `vinculo.simulate`'s
+/// time against it, on the same model in the same process.
+#[pyfunction]
+#[pyo3(signature = (system, settings, repeats=1))]
+pub fn time_simulate(
+    py: Python<'_>,
+    system: PyRef<'_, PySystem>,
+    settings: PyRef<'_, PyRunSettings>,
+    repeats: i64,
+) -> PyResult<f64> {
+    if repeats < 1 {
+        return Err(invalid("repeats", repeats, "must be an integer >= 1"));
+    }
+    let (model, options) = (&system.inner, &settings.options);
+    let best = py.detach(|| {
+        let mut best = f64::INFINITY;
+        for _ in 0..repeats {
+            let start = Instant::now();
+            let run = vinculo::simulate(model, options);
+            let elapsed = start.elapsed().as_secs_f64();
+            // An error before the first step, or one that stopped the run part-way.
+            run.map_err(|e| e.to_string())?
+                .status
+                .map_err(|e| e.to_string())?;
+            best = best.min(elapsed);
+        }
+        Ok::<f64, String>(best)
+    });
+    best.map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e))
+}

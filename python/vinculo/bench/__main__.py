@@ -9,7 +9,9 @@ at t_end, within a tolerance derived from the scheme's own error on that model
 (:func:`agreement_tolerance`), and gives steps per second (best of a few runs, wall time of the
 integration, model building excluded). The last row is the buoy of the case study
 (``vinculo.bench.buoy``). ``python -m vinculo.bench work-precision`` prints the work-precision
-table of error-controlled runs instead (:mod:`vinculo.bench.work_precision`).
+table of error-controlled runs instead (:mod:`vinculo.bench.work_precision`), and
+``python -m vinculo.bench python-overhead`` the cost of the Python layer
+(:mod:`vinculo.bench.python_overhead`).
 """
 
 from __future__ import annotations
@@ -189,12 +191,17 @@ def compare(quick: bool = False, repeat: int = 3, out=print) -> bool:
 
 def main(argv: list[str] | None = None) -> int:
     """Command line entry point (``work-precision`` as the first argument: the work-precision
-    table of :mod:`vinculo.bench.work_precision`)."""
+    table of :mod:`vinculo.bench.work_precision`; ``python-overhead``:
+    :mod:`vinculo.bench.python_overhead`)."""
     argv = sys.argv[1:] if argv is None else argv
     if argv[:1] == ["work-precision"]:
         from vinculo.bench import work_precision
 
         return work_precision.main(argv[1:])
+    if argv[:1] == ["python-overhead"]:
+        from vinculo.bench import python_overhead
+
+        return python_overhead.main(argv[1:])
     parser = argparse.ArgumentParser(prog="python -m vinculo.bench", description=__doc__)
     parser.add_argument("--quick", action="store_true", help="small models only (smoke run)")
     parser.add_argument("--no-scaling", action="store_true", help="skip the scaling run")
