@@ -36,7 +36,7 @@
 //! df/dt = -D_n(r_n) dr_a/dt + D_a(r_a) dr_a/dt       (then dt/dq from line_node)
 //! ```
 
-use super::line_node::{axial_part_by_tangent, mul, LineNode};
+use super::line_node::{axial_part_by_tangent, LineNode};
 use super::Jacobian;
 use crate::local::Rows;
 use crate::math::{add, add_mat, diag, dot, norm, outer, scale, scale_mat, sub, Mat3, Vec3};
@@ -64,6 +64,12 @@ pub struct LineHydro {
     pub current: Vec3,
     /// Gravity of the system (m/s^2).
     pub gravity: Vec3,
+}
+
+/// The product m x.
+#[inline]
+fn mat_vec(m: &Mat3, x: Vec3) -> Vec3 {
+    [dot(m[0], x), dot(m[1], x), dot(m[2], x)]
 }
 
 /// c |x| x.
@@ -180,17 +186,20 @@ impl LineHydro {
         let (cn, ca) = self.drag_factors();
         match self.node.tangent(q) {
             Some(tg) => {
+                // The products with P = I - t t^T and t t^T as products with t (module
+                // documentation): D_n P + D_a t t^T = D_n + (D_a t - D_n t) t^T, and with
+                // M = D_a - D_n, M (t r^T + (t . r) I) = (M t) r^T + (t . r) M.
                 let t = tg.t;
-                let ra = scale(dot(t, r), t);
+                let along = dot(t, r);
+                let ra = scale(along, t);
                 let dn = quadratic_derivative(cn, sub(r, ra));
                 let da = quadratic_derivative(ca, ra);
-                let tt = outer(1.0, t, t);
-                let p = add_mat(diag(1.0), scale_mat(-1.0, tt));
+                let m = add_mat(da, scale_mat(-1.0, dn));
+                let mt = mat_vec(&m, t);
                 // dr/dv = -I
-                let df_dv = scale_mat(-1.0, add_mat(mul(dn, p), mul(da, tt)));
+                let df_dv = add_mat(scale_mat(-1.0, dn), outer(-1.0, mt, t));
                 dv[0][0] = add_mat(dv[0][0], df_dv);
-                let dra_dt = axial_part_by_tangent(t, r);
-                let df_dt = mul(add_mat(da, scale_mat(-1.0, dn)), dra_dt);
+                let df_dt = add_mat(outer(1.0, mt, r), scale_mat(along, m));
                 tg.add_chain(df_dt, dq);
             }
             None => {

@@ -32,13 +32,14 @@ pub struct LineNode {
     pub tangent: Option<[usize; 2]>,
 }
 
-/// A node's tangent at a configuration: t, and the projector P / |d| of its derivative.
+/// A node's tangent at a configuration: t, and 1/|d|, the scale of its derivative
+/// dt/dq_b = (I - t t^T) / |d|.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Tangent {
     /// Unit tangent t.
     pub t: Vec3,
-    /// dt/dq_b = (I - t t^T) / |d| (and dt/dq_a = minus it).
-    pub dt_db: Mat3,
+    /// 1 / |d|.
+    pub inv_len: f64,
     /// Local indices (a, b) of the particles the tangent depends on.
     pub ends: [usize; 2],
 }
@@ -81,6 +82,7 @@ impl LineNode {
 
     /// The unit tangent at positions `q` (None without a tangent, or where its two particles
     /// coincide).
+    #[inline]
     pub(crate) fn tangent(&self, q: &[Vec3]) -> Option<Tangent> {
         let [a, b] = self.tangent?;
         let d = sub(q[self.particles[b]], q[self.particles[a]]);
@@ -88,12 +90,10 @@ impl LineNode {
         if len == 0.0 {
             return None;
         }
-        let t = scale(1.0 / len, d);
-        let dt_db = outer(-1.0 / len, t, t);
-        let dt_db = crate::math::add_mat(diag(1.0 / len), dt_db);
+        let inv_len = 1.0 / len;
         Some(Tangent {
-            t,
-            dt_db,
+            t: scale(inv_len, d),
+            inv_len,
             ends: [a, b],
         })
     }
@@ -112,14 +112,30 @@ impl LineNode {
 /// The matrix product a b.
 #[inline]
 pub(crate) fn mul(a: Mat3, b: Mat3) -> Mat3 {
-    std::array::from_fn(|r| std::array::from_fn(|c| (0..3).map(|k| a[r][k] * b[k][c]).sum()))
+    let mut m = [[0.0; 3]; 3];
+    for (row, a_row) in m.iter_mut().zip(&a) {
+        for (c, x) in row.iter_mut().enumerate() {
+            *x = a_row[0] * b[0][c] + a_row[1] * b[1][c] + a_row[2] * b[2][c];
+        }
+    }
+    m
 }
 
 impl Tangent {
     /// Adds (df/dt) (dt/dq) into the node's row of `dq`, for a force f on the node whose
-    /// derivative with respect to the tangent is `df_dt`.
+    /// derivative with respect to the tangent is `df_dt`: with dt/dq_b = (I - t t^T) / |d|,
+    /// J = (df/dt - (df/dt t) t^T) / |d| (a product with a vector, not a matrix) goes to the
+    /// block of b, -J to the block of a.
+    #[inline]
     pub(crate) fn add_chain(&self, df_dt: Mat3, dq: &mut crate::local::Blocks) {
-        let j = mul(df_dt, self.dt_db);
+        let t = self.t;
+        let mut j = [[0.0; 3]; 3];
+        for (row, d) in j.iter_mut().zip(&df_dt) {
+            let along = crate::math::dot(*d, t);
+            for c in 0..3 {
+                row[c] = (d[c] - along * t[c]) * self.inv_len;
+            }
+        }
         let [a, b] = self.ends;
         dq[0][b] = crate::math::add_mat(dq[0][b], j);
         dq[0][a] = crate::math::add_mat(dq[0][a], crate::math::scale_mat(-1.0, j));

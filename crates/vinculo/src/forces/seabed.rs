@@ -164,15 +164,15 @@ impl SeabedContact {
         }
     }
 
-    /// The friction of one part under normal force `n`: f, and whether it is on the kinetic
-    /// branch.
-    fn friction_of(&self, part: &Part, n: f64) -> (Vec3, bool) {
+    /// The friction of a part of coefficient `mu` sliding at `w` under normal force `n`: f, and
+    /// whether it is on the kinetic branch.
+    fn friction_of(&self, mu: f64, w: Vec3, n: f64) -> (Vec3, bool) {
         let fr = &self.friction;
-        let s = norm(part.w);
+        let s = norm(w);
         if fr.damping * s > fr.static_scale * n.abs() {
-            (scale(-part.mu * n.abs() / s, part.w), true)
+            (scale(-mu * n.abs() / s, w), true)
         } else {
-            (scale(-part.mu * fr.damping, part.w), false)
+            (scale(-mu * fr.damping, w), false)
         }
     }
 
@@ -185,11 +185,28 @@ impl SeabedContact {
         let mut f = [0.0, 0.0, n];
         if self.friction.acts() {
             let tangent = self.node.tangent(q);
-            for part in self.parts(v[i], tangent.as_ref()).iter().flatten() {
-                f = add(f, self.friction_of(part, n).0);
+            for (mu, w) in self.sliding(v[i], tangent.as_ref()).iter().flatten() {
+                f = add(f, self.friction_of(*mu, *w, n).0);
             }
         }
         f
+    }
+
+    /// The friction parts' coefficients and sliding velocities (mu, w) at velocity v and
+    /// tangent t: [`SeabedContact::parts`] without the derivatives, for the force alone.
+    fn sliding(&self, v: Vec3, tangent: Option<&Tangent>) -> [Option<(f64, Vec3)>; 2] {
+        let fr = &self.friction;
+        let vs = [v[0], v[1], 0.0];
+        match tangent.zip(fr.axial) {
+            None => [(fr.transverse > 0.0).then_some((fr.transverse, vs)), None],
+            Some((tg, axial)) => {
+                let va = scale(dot(tg.t, vs), tg.t);
+                [
+                    (fr.transverse > 0.0).then(|| (fr.transverse, sub(vs, va))),
+                    (axial > 0.0).then_some((axial, va)),
+                ]
+            }
+        }
     }
 
     /// Energy of the seabed's spring, A kBot p^2 / 2 while the node penetrates (the damping
@@ -223,7 +240,7 @@ impl SeabedContact {
         let tangent = self.node.tangent(q);
         let fr = &self.friction;
         for part in self.parts(v[i], tangent.as_ref()).iter().flatten() {
-            let (f, kinetic) = self.friction_of(part, n);
+            let (f, kinetic) = self.friction_of(part.mu, part.w, n);
             // df/dw
             let df_dw = if kinetic {
                 let s = norm(part.w);
@@ -303,7 +320,7 @@ mod tests {
             let c = contact(None, friction(1.0));
             let n = c.normal(q[1], vel).unwrap().0;
             let part = c.parts(vel, None)[0].take().unwrap();
-            assert_eq!(c.friction_of(&part, n).1, kinetic, "branch at {vel:?}");
+            assert_eq!(c.friction_of(part.mu, part.w, n).1, kinetic, "branch at {vel:?}");
             for tangent in [Some([0, 2]), None, Some([1, 0]), Some([2, 1])] {
                 for mc in [1.0, 1.5] {
                     let f = Force::SeabedContact(Box::new(contact(tangent, friction(mc))));
