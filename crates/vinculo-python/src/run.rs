@@ -328,5 +328,5 @@ pub fn time_simulate(
         }
         Ok::<f64, String>(best)
     });
-    best.map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e))
+    best.map_err(pyo3::exceptions::PyRuntimeError::new_err)
 }

@@ -32,6 +32,25 @@
 //! an intermediate time on the grid does not change the steps, so a run stepped to t1 and then
 //! to t2 is bit for bit the run straight to t2. A stop between grid points shortens the step
 //! to land on it and starts the grid afresh there.
+//!
+//! Contact events: a converged fixed step during which a force jumps
+//! ([`Force::switch_time`]: a line node that touches the seabed or leaves it, where the
+//! seabed's damping force jumps by A cBot |v_z|) is rejected, and the run steps to the event
+//! instead (the earliest over the elements, from each node's Taylor polynomial at the step's
+//! start), then on from there on a grid started afresh, as after a stop between grid points.
+//! For [`SETTLING_SPANS`] of the event's settling time ([`Force::settling_time`]: the seabed's
+//! damping stops a node within m / (A cBot), a few milliseconds) the steps stay at
+//! dt / 2^[`EVENT_HALVINGS`], then grow back one level per step: the trapezoidal rule, not
+//! L-stable, would turn that fast transient into a ringing that decays slowly at large steps. A
+//! step that straddles the jump resolves it only to first order in its size; stepping to it and
+//! through its transient keeps the run second order (the error of the particle dropped onto the
+//! seabed of `tests/test_contact_events.py` shrinks fourfold when dt halves, against a closed
+//! form). A step that ends at an event, or whose event is within a millionth of the step from
+//! either end, is accepted as it is. Error-controlled steps need no such rule: their error
+//! estimate sees the jump.
+//!
+//! [`Force::switch_time`]: crate::forces::Force::switch_time
+//! [`Force::settling_time`]: crate::forces::Force::settling_time
 
 use crate::adaptive::ErrorControl;
 use crate::assembly::Layout;
@@ -81,6 +100,21 @@ enum StepEnd {
     /// At this time exactly (the stop or the end of the run).
     At(f64),
 }
+
+/// Events closer than this share of a step to either end of it are not stepped to (the jump
+/// straddles at most this share of the step).
+const EVENT_MARGIN: f64 = 1e-6;
+
+/// Levels of the fixed-step grid below dt for the steps through the transient of a contact event
+/// (module documentation): dt / 16. The grid of a run with elements
+/// that can switch holds these levels besides the `max_halvings` of Newton failures, so that
+/// such a run can halve a failing step up to `max_halvings + EVENT_HALVINGS` times.
+pub const EVENT_HALVINGS: u32 = 4;
+
+/// The steps after a contact event stay short for this many of the event's settling time
+/// ([`crate::forces::Force::settling_time`]): what remains of the transient, e^-10 of it, is
+/// then below what a full step's error on it can matter.
+const SETTLING_SPANS: f64 = 10.0;
 
 /// Most halvings the fixed-step grid holds: a step that fails at dt / 2^30 (a billionth of dt)
 /// has no step-size problem that further halving would solve, and the grid's count of units of
@@ -178,8 +212,14 @@ impl FixedSteps {
         t
     }
 
+    /// During the transient of a contact event: the next step is at most
+    /// dt / 2^[`EVENT_HALVINGS`] (it grows back one level per step after the transient).
+    fn after_event(&mut self) {
+        self.level = self.level.min(self.top.saturating_sub(EVENT_HALVINGS));
+    }
+
     /// After a Newton failure: true (and a halved step) while halvings remain.
-    fn newton_failed(&mut self) -> bool {
+    fn halve(&mut self) -> bool {
         if self.level > 0 {
             self.level -= 1;
             true
@@ -319,6 +359,13 @@ pub struct Simulation<'a> {
     output_limit: Option<OutputLimit>,
     /// The growth guard of index-3 generalised-alpha (`integrators/energy_guard.rs`).
     guard: Option<EnergyGuard>,
+    /// The forces that can switch within a step (contact events, module documentation).
+    event_forces: Vec<usize>,
+    /// The time of the contact event the next fixed step goes to, once a step found one.
+    event_stop: Option<f64>,
+    /// The fixed steps stay at dt / 2^[`EVENT_HALVINGS`] until this time, through the transient
+    /// of the last contact event ([`SETTLING_SPANS`] of its settling time).
+    settle_until: f64,
 }
 
 impl<'a> Simulation<'a> {
@@ -459,7 +506,15 @@ impl<'a> Simulation<'a> {
         }
         let controller = match options.step_control {
             StepControl::Fixed => {
-                Controller::Fixed(FixedSteps::new(options.dt, options.max_halvings, t0))
+                // The steps after a contact event take levels of their own below dt, so that a
+                // Newton failure there still has its max_halvings.
+                let events = system.forces().iter().any(|f| f.has_events());
+                let extra = if events { EVENT_HALVINGS as usize } else { 0 };
+                Controller::Fixed(FixedSteps::new(
+                    options.dt,
+                    options.max_halvings + extra,
+                    t0,
+                ))
             }
             StepControl::Adaptive(control) => {
                 let weights = ErrorWeights {
@@ -498,6 +553,10 @@ impl<'a> Simulation<'a> {
         // Buffers of what only some runs do (allocated empty otherwise: at 10^6 particles each
         // array of 3-vectors is 24 MB).
         let adaptive = matches!(controller, Controller::Adaptive(_));
+        let event_forces: Vec<usize> = (system.forces().iter().enumerate())
+            .filter(|(_, f)| f.has_events())
+            .map(|(k, _)| k)
+            .collect();
         let dense = options.output_times.is_some();
         let if_dense = |x: &Vec<Vec3>| if dense { x.clone() } else { Vec::new() };
         let scratch = Scratch {
@@ -508,7 +567,7 @@ impl<'a> Simulation<'a> {
             q_out: if_dense(&q),
             v_out: if_dense(&v),
             lambda_out: if dense { lambda.clone() } else { Vec::new() },
-            rule_saved: if adaptive {
+            rule_saved: if adaptive || !event_forces.is_empty() {
                 rule.clone()
             } else {
                 RuleState::new(&[])
@@ -535,6 +594,9 @@ impl<'a> Simulation<'a> {
             scratch,
             sol,
             guard,
+            event_forces,
+            event_stop: None,
+            settle_until: f64::NEG_INFINITY,
             fingerprint: fingerprint(system),
             run: NEXT_RUN.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
             output_limit,
@@ -786,8 +848,9 @@ impl Simulation<'_> {
     fn attempt(&mut self, stop: f64, observer: &mut dyn Observer) -> Next {
         let (system, scheme, t_end) = (self.system, self.options.scheme, self.options.t_end);
         let c = &mut self.carried;
+        let event_stop = self.event_stop.filter(|&te| te > c.t && te < stop);
         let (h_try, end) = match &c.controller {
-            Controller::Fixed(fixed) => fixed.propose(c.t, stop, t_end),
+            Controller::Fixed(fixed) => fixed.propose(c.t, event_stop.unwrap_or(stop), t_end),
             Controller::Adaptive(control) => {
                 // Error-controlled steps are not bent to an intermediate stop: the run stops at
                 // the end of the step that reaches or passes it.
@@ -819,7 +882,12 @@ impl Simulation<'_> {
             // Modified Newton starting from a matrix of an earlier step gets one more attempt
             // with a fresh matrix before the step counts as failed.
             let stale = self.newton.jacobian_reuse && ws.matrix.holds(scheme.matrix_key(h_try));
-            let may_reject = matches!(c.controller, Controller::Adaptive(_));
+            // A step to an event found before is not searched for events again.
+            let to_event = event_stop.is_some_and(|te| end == StepEnd::At(te));
+            let events = matches!(c.controller, Controller::Fixed(_))
+                && !self.event_forces.is_empty()
+                && !to_event;
+            let may_reject = matches!(c.controller, Controller::Adaptive(_)) || events;
             if may_reject {
                 self.scratch.rule_saved.copy_from(&c.rule);
             }
@@ -833,7 +901,37 @@ impl Simulation<'_> {
                 return Next::Stop;
             }
             match attempt {
-                Ok(report) => return self.converged(h_try, end, ends_run, report, observer),
+                Ok(report) => {
+                    let start = (&c.q[..], &c.v[..], &c.acc[..]);
+                    let event = events
+                        .then(|| first_event(system, &self.event_forces, start, &ws.state.q, h_try))
+                        .flatten()
+                        .filter(|&(s, _)| {
+                            s > EVENT_MARGIN * h_try && s < (1.0 - EVENT_MARGIN) * h_try
+                        })
+                        .filter(|&(s, _)| unresolved_step(c.t, s).is_none());
+                    if let Some((s, f)) = event {
+                        // A force jumped within the step: the run steps to the jump instead, then
+                        // through the transient it starts in short steps.
+                        self.sol.steps_rejected += 1;
+                        c.rule.copy_from(&self.scratch.rule_saved);
+                        self.event_stop = Some(c.t + s);
+                        let settle = system.forces()[f].settling_time(&ws.inertia);
+                        self.settle_until = c.t + s + SETTLING_SPANS * settle;
+                        return Next::Go;
+                    }
+                    if to_event {
+                        self.event_stop = None;
+                    }
+                    let settling = c.t < self.settle_until;
+                    let next = self.converged(h_try, end, ends_run, report, observer);
+                    if settling {
+                        if let Controller::Fixed(fixed) = &mut self.carried.controller {
+                            fixed.after_event();
+                        }
+                    }
+                    return next;
+                }
                 Err(_) if stale => {
                     ws.matrix.invalidate();
                     fresh_retry = true;
@@ -841,7 +939,7 @@ impl Simulation<'_> {
                 Err(failure) => {
                     self.sol.steps_rejected += 1;
                     let retry = match &mut c.controller {
-                        Controller::Fixed(fixed) => fixed.newton_failed(),
+                        Controller::Fixed(fixed) => fixed.halve(),
                         Controller::Adaptive(control) => control.newton_failed(h_try),
                     };
                     if may_reject {
@@ -1037,6 +1135,23 @@ impl Simulation<'_> {
 }
 
 /// Stores a state with its violations and the statistics of the step that produced it.
+/// The earliest time after the start of a step of size `h` from `start` (positions,
+/// velocities, accelerations) to the positions `q1` at which one of the forces `event_forces` of
+/// `system` (those that can switch, [`crate::forces::Force::has_events`]) jumps, if any.
+fn first_event(
+    system: &System,
+    event_forces: &[usize],
+    start: (&[Vec3], &[Vec3], &[Vec3]),
+    q1: &[Vec3],
+    h: f64,
+) -> Option<(f64, usize)> {
+    let forces = system.forces();
+    event_forces
+        .iter()
+        .filter_map(|&f| forces[f].switch_time(start, q1, h).map(|s| (s, f)))
+        .reduce(|a, b| if b.0 < a.0 { b } else { a })
+}
+
 fn store(
     sol: &mut Solution,
     system: &System,

@@ -147,6 +147,38 @@ impl Force {
         dispatch!(self, f => f.add_jacobian(q, v, t, dq, dv))
     }
 
+    /// When the element's force jumps during a step of size `h` from the state (`q0`, `v0`,
+    /// `a0`) to the positions `q1` (a seabed contact that begins or ends): the time after the
+    /// step's start, the run loop's contact event ([`crate::run`]); None for every element
+    /// whose force is continuous.
+    #[inline]
+    pub fn switch_time(
+        &self,
+        start: (&[Vec3], &[Vec3], &[Vec3]),
+        q1: &[Vec3],
+        h: f64,
+    ) -> Option<f64> {
+        match self {
+            Force::SeabedContact(f) => f.switch_time(start.0, start.1, start.2, q1, h),
+            _ => None,
+        }
+    }
+
+    /// The time scale of the transient that the element's jump starts on a node of inertia
+    /// `m` (0 for an element without jumps): the run loop's steps stay short for a few of it
+    /// after a contact event ([`crate::run`]).
+    pub fn settling_time(&self, inertia: &[f64]) -> f64 {
+        match self {
+            Force::SeabedContact(f) => f.settling_time(inertia[f.node.node()]),
+            _ => 0.0,
+        }
+    }
+
+    /// Whether [`Force::switch_time`] can ever be `Some` for this element.
+    pub fn has_events(&self) -> bool {
+        matches!(self, Force::SeabedContact(_))
+    }
+
     /// Potential energy of the conservative part (0 for non-conservative elements).
     pub fn potential(&self, q: &[Vec3]) -> f64 {
         match self {

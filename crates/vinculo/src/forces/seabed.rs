@@ -209,6 +209,47 @@ impl SeabedContact {
         }
     }
 
+    /// When the node comes into contact or leaves it during a step of size `h` from the state
+    /// (`q0`, `v0`, `a0`) to the positions `q1` (its penetration changes sign: the normal force
+    /// jumps by A cBot |v_z| there, a discontinuity that a step straddling it resolves only to
+    /// first order): the time after the step's start, None when it does not switch.
+    ///
+    /// The time is the first root in (0, h] of the height's Taylor polynomial from the start,
+    /// z(s) = z0 + v0 s + a0 s^2 / 2 - z_b (its error O(h^3) in z, so that a step to that time
+    /// lands within O(h^3) of the seabed), or, when the polynomial does not cross in the step
+    /// although the step did, the chord's root h p0 / (p0 - p1).
+    pub(crate) fn switch_time(
+        &self,
+        q0: &[Vec3],
+        v0: &[Vec3],
+        a0: &[Vec3],
+        q1: &[Vec3],
+        h: f64,
+    ) -> Option<f64> {
+        let i = self.node.node();
+        let (p0, p1) = (self.seabed_z - q0[i][2], self.seabed_z - q1[i][2]);
+        if (p0 > 0.0) == (p1 > 0.0) {
+            return None;
+        }
+        let (c, b, a) = (q0[i][2] - self.seabed_z, v0[i][2], 0.5 * a0[i][2]);
+        let chord = h * p0 / (p0 - p1);
+        Some(first_root(a, b, c, h).unwrap_or(chord))
+    }
+
+    /// The time scale of the transient a touchdown starts for a node of inertia `m`: the
+    /// seabed's damping stops the node within m / (A cBot) (the fast root of the overdamped
+    /// contact, MoorDyn's cBot being above critical damping for line nodes), or, without
+    /// damping, sqrt(m / (A kBot)), a radian of the contact's oscillation.
+    pub(crate) fn settling_time(&self, m: f64) -> f64 {
+        if self.damping > 0.0 {
+            m / (self.area * self.damping)
+        } else if self.stiffness > 0.0 {
+            (m / (self.area * self.stiffness)).sqrt()
+        } else {
+            0.0
+        }
+    }
+
     /// Energy of the seabed's spring, A kBot p^2 / 2 while the node penetrates (the damping
     /// and the friction dissipate).
     pub(crate) fn potential(&self, q: &[Vec3]) -> f64 {
@@ -266,6 +307,26 @@ impl SeabedContact {
     }
 }
 
+/// The smallest root s in (0, h] of a s^2 + b s + c, if any (the numerically stable form of
+/// the quadratic formula).
+fn first_root(a: f64, b: f64, c: f64, h: f64) -> Option<f64> {
+    let mut roots = [f64::NAN; 2];
+    if a == 0.0 {
+        roots[0] = -c / b;
+    } else {
+        let disc = b * b - 4.0 * a * c;
+        if disc < 0.0 {
+            return None;
+        }
+        let q = -0.5 * (b + b.signum() * disc.sqrt());
+        roots = [q / a, c / q];
+    }
+    roots
+        .into_iter()
+        .filter(|s| s.is_finite() && *s > 0.0 && *s <= h)
+        .reduce(f64::min)
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::{fd, Force};
@@ -307,6 +368,37 @@ mod tests {
     /// linear friction branch (slow sliding), the kinetic branch (fast sliding) in both parts
     /// or in one, static friction above the kinetic one (m_c > 1), a node without a tangent,
     /// an end node whose tangent runs from or to itself, and a node out of contact.
+    /// The event time of a node falling freely onto the seabed is the root of its height's
+    /// Taylor polynomial (exact for constant acceleration), the earlier root when the
+    /// polynomial crosses twice in the step, and the chord's root when it does not cross.
+    #[test]
+    fn switch_time_is_the_touchdown_of_the_taylor_polynomial() {
+        let c = contact(None, SeabedFriction::NONE);
+        let zb = c.seabed_z;
+        // From 0.5 m above at rest, g = 9.81: touchdown at sqrt(2 0.5 / 9.81) = 0.3193 s.
+        let q0 = vec![[0.0; 3], [0.0, 0.0, zb + 0.5], [0.0; 3]];
+        let v0 = vec![[0.0; 3]; 3];
+        let a0 = vec![[0.0, 0.0, -9.81]; 3];
+        let q1 = vec![[0.0; 3], [0.0, 0.0, zb - 0.01], [0.0; 3]];
+        let s = c.switch_time(&q0, &v0, &a0, &q1, 0.4).unwrap();
+        assert!((s - (2.0 * 0.5 / 9.81f64).sqrt()).abs() < 1e-14, "{s}");
+        // No sign change of the penetration: no event.
+        assert!(c.switch_time(&q0, &v0, &a0, &q0, 0.4).is_none());
+        // Rising through the seabed and decelerating: of the roots 0.1 and 0.3 s of
+        // z - zb = -0.03 + 0.4 s - s^2, the first.
+        let below = vec![[0.0; 3], [0.0, 0.0, zb - 0.03], [0.0; 3]];
+        let up = vec![[0.0; 3], [0.0, 0.0, 0.4], [0.0; 3]];
+        let down = vec![[0.0, 0.0, -2.0]; 3];
+        let above = vec![[0.0; 3], [0.0, 0.0, zb + 0.01], [0.0; 3]];
+        let s = c.switch_time(&below, &up, &down, &above, 0.2).unwrap();
+        assert!((s - 0.1).abs() < 1e-14, "{s}");
+        // A polynomial that stays below although the step ended above: the chord,
+        // 0.2 * 0.03 / 0.04.
+        let slow = vec![[0.0; 3], [0.0, 0.0, 0.01], [0.0; 3]];
+        let s = c.switch_time(&below, &slow, &down, &above, 0.2).unwrap();
+        assert!((s - 0.15).abs() < 1e-14, "{s}");
+    }
+
     #[test]
     fn jacobian_matches_finite_differences() {
         let (q, mut v) = state();
@@ -320,7 +412,11 @@ mod tests {
             let c = contact(None, friction(1.0));
             let n = c.normal(q[1], vel).unwrap().0;
             let part = c.parts(vel, None)[0].take().unwrap();
-            assert_eq!(c.friction_of(part.mu, part.w, n).1, kinetic, "branch at {vel:?}");
+            assert_eq!(
+                c.friction_of(part.mu, part.w, n).1,
+                kinetic,
+                "branch at {vel:?}"
+            );
             for tangent in [Some([0, 2]), None, Some([1, 0]), Some([2, 1])] {
                 for mc in [1.0, 1.5] {
                     let f = Force::SeabedContact(Box::new(contact(tangent, friction(mc))));
