@@ -47,7 +47,10 @@ class RunOptions:
         max_halvings: how many times a failing step may be halved before giving up (at most 30
             are made: dt / 2^30 is a billionth of dt; larger values mean 30). A halved step
             that the floating-point times cannot resolve (fewer than 50 spacings of t) stops
-            the run with a ``StepSizeTooSmallError`` instead.
+            the run with a ``StepSizeTooSmallError`` instead. A model with seabed contact has
+            four more: its fixed steps go to each touchdown and lift-off of a node and through
+            the transient it starts at dt / 16 (docs/theory/seabed-and-line-loads.md, contact
+            events).
         initial_tolerance: largest initial violation accepted, relative to the model's scales:
             ``|s_k Phi_k| <= initial_tolerance * length_scale`` for positions and
             ``|s_k (Phi_q v + Phi_t)| <= initial_tolerance * speed`` for velocities, the speed being

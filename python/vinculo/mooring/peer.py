@@ -227,10 +227,7 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
                 f"{motion.source} covers t = {start:g} to {end:g} s; the run needs 0 to "
                 f"{t_end:g} s", name="t_end", value=t_end)
         with _silenced():
-            try:
-                system = md.Create(str(path))
-            except Exception as exc:  # MoorDyn raises a bare RuntimeError
-                raise PeerError(f"MoorDyn rejected {path.name}: {exc}") from None
+            system = _create(md, path)
             try:
                 lines = [md.GetLine(system, k + 1) for k in range(len(model.lines))]
                 sizes = [md.GetLineN(line) for line in lines]
@@ -300,6 +297,14 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
                    steps=steps, error=error)
 
 
+def _create(md, path: Path):
+    """MoorDyn's system of the input file ``path``."""
+    try:
+        return md.Create(str(path))
+    except Exception as exc:  # MoorDyn raises a bare RuntimeError
+        raise PeerError(f"MoorDyn rejected {path.name}: {exc}") from None
+
+
 def _initialise(md, system, x: list[float], v: list[float],
                 initial_state: str | Path | None) -> None:
     """MoorDyn's initial state: its own solve, or the saved ``initial_state``."""
@@ -361,10 +366,7 @@ def moordyn_initial_state(source: str | Path | MoorDynFile, motion: Motion | Non
         x = motion.positions(0.0).ravel().tolist()
         v = motion.velocities(0.0).ravel().tolist()
         with _silenced():
-            try:
-                system = md.Create(str(file))
-            except Exception as exc:  # MoorDyn raises a bare RuntimeError
-                raise PeerError(f"MoorDyn rejected {file.name}: {exc}") from None
+            system = _create(md, file)
             try:
                 _initialise(md, system, x, v, None)
                 md.SaveState(system, str(path))
