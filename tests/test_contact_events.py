@@ -74,3 +74,25 @@ def test_the_run_lands_on_the_touchdown():
     assert times[k] == pytest.approx(t_c, abs=1e-12)
     assert solution.positions[k, 0, 2] == pytest.approx(-DEPTH, abs=1e-9)
     assert solution.steps_rejected >= 1
+
+
+def test_a_snapshot_taken_during_a_contact_event_restores_bit_for_bit(tmp_path):
+    # The contact event's state (a pending event, the short steps of its transient) belongs to
+    # the step controller: a snapshot taken 0.01 s after the touchdown (within the transient's
+    # ten settling times of 5 ms), saved, loaded into a new simulation and stepped on, repeats
+    # the steps of the simulation it was taken from.
+    system = vinculo.System(gravity=(0.0, 0.0, -G))
+    ball = system.add_particle(mass=MASS, position=(0.0, 0.0, -DEPTH + HEIGHT))
+    system.add_seabed_contact(ball, depth=DEPTH, diameter=1.0, length=1.0, kbot=KBOT, cbot=CBOT)
+    first = vinculo.Simulation(system, 0.8, 0.04)
+    first.step_to(math.sqrt(2.0 * HEIGHT / G) + 0.01)
+    path = tmp_path / "touchdown.snap"
+    first.save_snapshot(path)
+    second = vinculo.Simulation(system, 0.8, 0.04)
+    second.load_snapshot(path)
+    first.step_to(0.8)
+    second.step_to(0.8)
+    a, b = first.solution(), second.solution()
+    assert a.times[-1] == b.times[-1] == pytest.approx(0.8, abs=1e-12)
+    np.testing.assert_array_equal(a.positions[-5:], b.positions[-5:])
+    np.testing.assert_array_equal(a.times[-5:], b.times[-5:])

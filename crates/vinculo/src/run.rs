@@ -89,6 +89,11 @@ pub(crate) struct FixedSteps {
     pub(crate) units: u64,
     pub(crate) level: u32,
     pub(crate) t_grid: f64,
+    /// The time of the contact event the next step goes to, once a step found one.
+    pub(crate) event_stop: Option<f64>,
+    /// The steps stay at dt / 2^[`EVENT_HALVINGS`] until this time, through the transient of
+    /// the last contact event ([`SETTLING_SPANS`] of its settling time).
+    pub(crate) settle_until: f64,
 }
 
 /// Where a proposed step ends.
@@ -158,6 +163,8 @@ impl FixedSteps {
             units: 0,
             level: top,
             t_grid: t0,
+            event_stop: None,
+            settle_until: f64::NEG_INFINITY,
         }
     }
 
@@ -361,11 +368,6 @@ pub struct Simulation<'a> {
     guard: Option<EnergyGuard>,
     /// The forces that can switch within a step (contact events, module documentation).
     event_forces: Vec<usize>,
-    /// The time of the contact event the next fixed step goes to, once a step found one.
-    event_stop: Option<f64>,
-    /// The fixed steps stay at dt / 2^[`EVENT_HALVINGS`] until this time, through the transient
-    /// of the last contact event ([`SETTLING_SPANS`] of its settling time).
-    settle_until: f64,
 }
 
 impl<'a> Simulation<'a> {
@@ -595,8 +597,6 @@ impl<'a> Simulation<'a> {
             sol,
             guard,
             event_forces,
-            event_stop: None,
-            settle_until: f64::NEG_INFINITY,
             fingerprint: fingerprint(system),
             run: NEXT_RUN.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
             output_limit,
@@ -848,7 +848,10 @@ impl Simulation<'_> {
     fn attempt(&mut self, stop: f64, observer: &mut dyn Observer) -> Next {
         let (system, scheme, t_end) = (self.system, self.options.scheme, self.options.t_end);
         let c = &mut self.carried;
-        let event_stop = self.event_stop.filter(|&te| te > c.t && te < stop);
+        let event_stop = match &c.controller {
+            Controller::Fixed(fixed) => fixed.event_stop.filter(|&te| te > c.t && te < stop),
+            Controller::Adaptive(_) => None,
+        };
         let (h_try, end) = match &c.controller {
             Controller::Fixed(fixed) => fixed.propose(c.t, event_stop.unwrap_or(stop), t_end),
             Controller::Adaptive(control) => {
@@ -910,20 +913,23 @@ impl Simulation<'_> {
                             s > EVENT_MARGIN * h_try && s < (1.0 - EVENT_MARGIN) * h_try
                         })
                         .filter(|&(s, _)| unresolved_step(c.t, s).is_none());
-                    if let Some((s, f)) = event {
-                        // A force jumped within the step: the run steps to the jump instead, then
-                        // through the transient it starts in short steps.
-                        self.sol.steps_rejected += 1;
-                        c.rule.copy_from(&self.scratch.rule_saved);
-                        self.event_stop = Some(c.t + s);
-                        let settle = system.forces()[f].settling_time(&ws.inertia);
-                        self.settle_until = c.t + s + SETTLING_SPANS * settle;
-                        return Next::Go;
+                    let mut settling = false;
+                    if let Controller::Fixed(fixed) = &mut c.controller {
+                        if let Some((s, f)) = event {
+                            // A force jumped within the step: the run steps to the jump instead,
+                            // then through the transient it starts in short steps.
+                            self.sol.steps_rejected += 1;
+                            c.rule.copy_from(&self.scratch.rule_saved);
+                            let settle = system.forces()[f].settling_time(&ws.inertia);
+                            fixed.event_stop = Some(c.t + s);
+                            fixed.settle_until = c.t + s + SETTLING_SPANS * settle;
+                            return Next::Go;
+                        }
+                        if to_event {
+                            fixed.event_stop = None;
+                        }
+                        settling = c.t < fixed.settle_until;
                     }
-                    if to_event {
-                        self.event_stop = None;
-                    }
-                    let settling = c.t < self.settle_until;
                     let next = self.converged(h_try, end, ends_run, report, observer);
                     if settling {
                         if let Controller::Fixed(fixed) = &mut self.carried.controller {

@@ -1,6 +1,6 @@
 //! Snapshot files: a [`Snapshot`] saved to and loaded from a small binary file.
 //!
-//! # Format (version 3)
+//! # Format (version 4)
 //!
 //! Little-endian throughout; every float is stored as its IEEE-754 bits, so a loaded snapshot
 //! is bit for bit the saved one.
@@ -8,7 +8,7 @@
 //! | field | type |
 //! |---|---|
 //! | magic `VNCLSNAP` | 8 bytes |
-//! | version (3) | u32 |
+//! | version (4) | u32 |
 //! | model fingerprint ([`crate::run::fingerprint`]), particles n, constraint equations m | 3 x u64 |
 //! | time | f64 |
 //! | positions, velocities, accelerations | 3 x (n x 3 f64) |
@@ -18,7 +18,9 @@
 //! | accepted steps, next output, stored rows, steps taken, steps rejected, accepted step sizes, factorisations | 7 x u64 |
 //! | checksum: FNV-1a 64 of every byte before it | u64 |
 //!
-//! Fixed steps (tag 0): top u32, unit f64, units u64, level u32, t_grid f64.
+//! Fixed steps (tag 0): top u32, unit f64, units u64, level u32, t_grid f64, and the contact
+//! events' state (`run.rs`): the pending event's time (NaN: none) and the end of the short
+//! steps after the last event (-inf: none), 2 x f64.
 //!
 //! Error control (tag 1, `adaptive.rs`; its scratch arrays are not saved):
 //!
@@ -30,7 +32,8 @@
 //! | PI controller: order k, last error norm, last attempt rejected (0 or 1), hold | f64, f64, u8, f64 |
 //! | next step size h, error norm of the last judged step | 2 x f64 |
 //!
-//! Version 1 is version 3 with fixed steps only (tag 0). Version 2 also kept an acceleration
+//! Version 3 is version 4 without the contact events' state (read as none pending). Version 1
+//! is version 3 with fixed steps only (tag 0). Version 2 also kept an acceleration
 //! history for the error estimate, which step doubling no longer
 //! needs; its files with fixed steps are still read, those of error-controlled runs refused.
 //! Snapshots of runs that stopped are not saved.
@@ -45,7 +48,7 @@ use crate::run::{Carried, Controller, FixedSteps, Fnv, Snapshot};
 use crate::step_control::{AdaptiveOptions, ErrorWeights, PiController};
 
 const MAGIC: &[u8; 8] = b"VNCLSNAP";
-const VERSION: u32 = 3;
+const VERSION: u32 = 4;
 /// The oldest format version still read.
 const OLDEST: u32 = 1;
 
@@ -267,6 +270,8 @@ impl Snapshot {
                 w.u64(fixed.units);
                 w.u32(fixed.level);
                 w.f64(fixed.t_grid);
+                w.f64(fixed.event_stop.unwrap_or(f64::NAN));
+                w.f64(fixed.settle_until);
             }
             Controller::Adaptive(control) => {
                 w.0.push(1);
@@ -295,7 +300,7 @@ impl Snapshot {
     ///
     /// # Errors
     /// [`Error::Snapshot`] when the file cannot be read, is not a snapshot file, is of a format
-    /// version this vinculo does not read (1 to 3 are; of 2 only fixed steps), or is truncated or corrupt (its
+    /// version this vinculo does not read (1 to 4 are; of 2 only fixed steps), or is truncated or corrupt (its
     /// checksum does not match).
     pub fn load(path: impl AsRef<Path>) -> Result<Snapshot> {
         let path = path.as_ref();
@@ -351,13 +356,24 @@ impl Snapshot {
         };
         let tag = r.take(1)?[0];
         let controller = match tag {
-            0 => Controller::Fixed(FixedSteps {
-                top: r.u32()?,
-                unit: r.f64()?,
-                units: r.u64()?,
-                level: r.u32()?,
-                t_grid: r.f64()?,
-            }),
+            0 => {
+                let (top, unit, units, level, t_grid) =
+                    (r.u32()?, r.f64()?, r.u64()?, r.u32()?, r.f64()?);
+                let (event_stop, settle_until) = if version >= 4 {
+                    (Some(r.f64()?).filter(|t| !t.is_nan()), r.f64()?)
+                } else {
+                    (None, f64::NEG_INFINITY)
+                };
+                Controller::Fixed(FixedSteps {
+                    top,
+                    unit,
+                    units,
+                    level,
+                    t_grid,
+                    event_stop,
+                    settle_until,
+                })
+            }
             1 if version >= 3 => Controller::Adaptive(Box::new(r.error_control()?)),
             1 if version == 2 => {
                 return Err(file_error(
