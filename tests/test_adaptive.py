@@ -259,8 +259,10 @@ def test_bad_options_are_named(options, name):
     assert info.value.name == name
 
 
-def test_t_eval_needs_adaptive_steps():
+def test_t_eval_outside_a_fixed_step_run_is_named():
+    # Fixed steps take output times too (tests/test_output_times.py); one outside the run is
+    # refused with its index.
     system, _ = CASE.build()
-    with pytest.raises(vinculo.InvalidInputError, match="adaptive") as info:
-        vinculo.simulate(system, 0.5, 1e-3, t_eval=[0.1])
-    assert info.value.name == "output time t_eval[0]"
+    with pytest.raises(vinculo.InvalidInputError, match="t_end") as info:
+        vinculo.simulate(system, 0.5, 1e-3, t_eval=[0.1, 0.6])
+    assert info.value.name == "output time t_eval[1]"

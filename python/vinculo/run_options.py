@@ -86,10 +86,11 @@ class RunOptions:
         h_min: smallest adaptive step, in s: a run that would need a smaller one stops with
             :class:`StepSizeTooSmallError`.
         h_max: largest adaptive step, in s (default: no limit).
-        t_eval: times at which to return the state with ``adaptive=True`` (strictly increasing,
-            within ``[t_start, t_end]``), interpolated inside the step that contains each (cubic
-            Hermite positions, its derivative for velocities, linear multipliers) without forcing
-            the steps onto them. Default: the state after every accepted step (every
+        t_eval: times at which to return the state (strictly increasing, within
+            ``[t_start, t_end]``), with fixed or adaptive steps, interpolated inside the step that
+            contains each (cubic Hermite positions, its derivative for velocities, linear
+            multipliers) without forcing the steps onto them; a time on a step's end is that
+            step's state. Default: the state after every accepted step (every
             ``save_every``-th).
         max_output_bytes: the largest memory the stored output may take, in bytes (default:
             a third of the memory available when the run starts, ``MemAvailable`` of

@@ -53,7 +53,7 @@ class Solution:
 
     Row 0 of every array is the initial state (0 Newton iterations, step size 0, multipliers from
     the consistent initial accelerations); row ``k`` is the state after step ``k``. With
-    ``simulate(..., adaptive=True, t_eval=...)`` the rows are the requested times instead
+    ``simulate(..., t_eval=...)`` the rows are the requested times instead
     (interpolated inside the steps that contain them; the initial state is a row only when
     ``t_start`` is requested), and the per-row statistics are those of the containing step. The
     arrays are read-only.

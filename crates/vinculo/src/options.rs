@@ -58,9 +58,10 @@ pub struct SimulationOptions {
     /// Fixed steps (the default) or error-controlled ones ([`StepControl::Adaptive`], where
     /// `dt` is the first step).
     pub step_control: StepControl,
-    /// Times at which to store the state (strictly increasing, in [t_start, t_end]; error-controlled
-    /// steps only), interpolated inside the steps that contain them (Python: `t_eval`). `None`:
-    /// store the end of every step (every `save_every`-th).
+    /// Times at which to store the state (strictly increasing, in [t_start, t_end]), interpolated
+    /// inside the steps that contain them, fixed or error-controlled (Python: `t_eval`): a time on
+    /// a step's end is that step's state. `None`: store the end of every step (every
+    /// `save_every`-th).
     pub output_times: Option<Vec<f64>>,
 }
 
@@ -206,8 +207,8 @@ pub(crate) fn check_options(system: &System, o: &SimulationOptions) -> Result<()
     Ok(())
 }
 
-/// Requested output times: error-controlled steps only, finite, strictly increasing, within the
-/// run.
+/// Requested output times: finite, strictly increasing, within the run (fixed or
+/// error-controlled steps alike).
 fn check_output_times(o: &SimulationOptions, times: &[f64]) -> Result<()> {
     let bad = |k: usize, expected: String| {
         Err(Error::InvalidParameter {
@@ -223,14 +224,6 @@ fn check_output_times(o: &SimulationOptions, times: &[f64]) -> Result<()> {
             expected: "no output time given: give at least one, or none (None) for every step"
                 .into(),
         });
-    }
-    if o.step_control == StepControl::Fixed {
-        return bad(
-            0,
-            "output times need error-controlled steps (adaptive); with fixed steps every step \
-             (or every save_every-th) is stored"
-                .into(),
-        );
     }
     for k in 0..times.len() {
         if !(times[k] >= o.t_start && times[k] <= o.t_end) {

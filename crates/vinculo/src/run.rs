@@ -1075,14 +1075,25 @@ impl Simulation<'_> {
                     Some((_, _, second)) => second,
                     None => whole,
                 };
-                ends.interpolate(t_out, &mut s.q_out, &mut s.v_out, &mut s.lambda_out);
-                store(
-                    sol,
-                    system,
-                    t_out,
-                    (&s.q_out, &s.v_out, &s.lambda_out),
-                    stats,
-                );
+                if t_out == t_new {
+                    // A time on the step's end (a fixed step's grid time): its state itself.
+                    store(
+                        sol,
+                        system,
+                        t_out,
+                        (&s.q_new, &s.v_new, &s.lambda_new),
+                        stats,
+                    );
+                } else {
+                    ends.interpolate(t_out, &mut s.q_out, &mut s.v_out, &mut s.lambda_out);
+                    store(
+                        sol,
+                        system,
+                        t_out,
+                        (&s.q_out, &s.v_out, &s.lambda_out),
+                        stats,
+                    );
+                }
                 c.next_output += 1;
             }
             // A run that stops here shows the state where it stopped.
