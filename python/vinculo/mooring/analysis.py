@@ -233,10 +233,10 @@ def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_en
             contact events of nodes landing on the seabed take between them.
             ``jacobian_reuse`` defaults to True here (modified Newton): a line's iteration
             matrix changes slowly, so one factorisation serves many steps, to the same
-            tolerance: end tensions
-            within 5e-6 of the peak tension of full Newton's on the benchmark's hanging chain
-            and cable, at a third to two thirds of the CPU time; on the chain on the seabed, whose
-            steps are halved at contact events, within that case's time-step error.
+            tolerance: end tensions within 5e-6 of the peak tension of full Newton's on the
+            benchmark's hanging chain and cable, at a third to two thirds of the CPU time; on
+            the chain on the seabed, whose steps go to each contact event, within that case's
+            time-step error.
 
     Returns:
         The run.
