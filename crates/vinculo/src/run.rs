@@ -506,12 +506,20 @@ impl<'a> Simulation<'a> {
                 sol.status = Err(e);
             }
         }
+        // The forces that can switch within a step (contact events, module documentation).
+        let event_forces: Vec<usize> = (system.forces().iter().enumerate())
+            .filter(|(_, f)| f.has_events())
+            .map(|(k, _)| k)
+            .collect();
         let controller = match options.step_control {
             StepControl::Fixed => {
                 // The steps after a contact event take levels of their own below dt, so that a
                 // Newton failure there still has its max_halvings.
-                let events = system.forces().iter().any(|f| f.has_events());
-                let extra = if events { EVENT_HALVINGS as usize } else { 0 };
+                let extra = if event_forces.is_empty() {
+                    0
+                } else {
+                    EVENT_HALVINGS as usize
+                };
                 Controller::Fixed(FixedSteps::new(
                     options.dt,
                     options.max_halvings + extra,
@@ -555,10 +563,6 @@ impl<'a> Simulation<'a> {
         // Buffers of what only some runs do (allocated empty otherwise: at 10^6 particles each
         // array of 3-vectors is 24 MB).
         let adaptive = matches!(controller, Controller::Adaptive(_));
-        let event_forces: Vec<usize> = (system.forces().iter().enumerate())
-            .filter(|(_, f)| f.has_events())
-            .map(|(k, _)| k)
-            .collect();
         let dense = options.output_times.is_some();
         let if_dense = |x: &Vec<Vec3>| if dense { x.clone() } else { Vec::new() };
         let scratch = Scratch {
