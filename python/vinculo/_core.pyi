@@ -12,7 +12,9 @@ from vinculo.errors import VinculoError
 class Law:
     """A prescribed scalar function of time with its first and second derivatives.
 
-    Built by the constructors ``Law.constant``, ``Law.polynomial``, ``Law.sine`` and ``Law.tabulated``.
+    Built by the constructors ``Law.constant``, ``Law.polynomial``, ``Law.sine``, ``Law.tabulated``,
+    ``Law.spline``, ``Law.piecewise_linear``, ``Law.driven``, ``Law.apply`` and ``Law.function``, and
+    composed with ``+ - * / **`` (between laws and numbers).
     """
     @staticmethod
     def constant(value: float) -> "Law":
@@ -29,6 +31,29 @@ class Law:
     def tabulated(times: Sequence[float], values: Sequence[float]) -> "Law":
         """Natural cubic spline through the samples (C2). Runs must stay within [times[0], times[-1]];
         evaluated outside, the spline continues along its end tangents."""
+    @staticmethod
+    def spline(times: Sequence[float], values: Sequence[float], ends: str = "natural",
+               slopes: tuple[float, float] | None = None) -> "Law":
+        """Cubic spline through the samples with end condition "natural", "clamped" (with the end
+        slopes) or "not-a-knot"."""
+    @staticmethod
+    def apply(name: str, law: Scalar, exponent: float | None = None) -> "Law":
+        """name(law) for "sqrt", "sin", "cos", "exp", "log", or law ** exponent for "power"."""
+    @staticmethod
+    def function(function: Callable[[float], tuple[float, float, float]],
+                 name: str | None = None) -> "Law":
+        """A law computed by a Python function t -> (value, rate, acceleration)."""
+    def __add__(self, other: Scalar) -> "Law": ...
+    def __radd__(self, other: Scalar) -> "Law": ...
+    def __sub__(self, other: Scalar) -> "Law": ...
+    def __rsub__(self, other: Scalar) -> "Law": ...
+    def __mul__(self, other: Scalar) -> "Law": ...
+    def __rmul__(self, other: Scalar) -> "Law": ...
+    def __truediv__(self, other: Scalar) -> "Law": ...
+    def __rtruediv__(self, other: Scalar) -> "Law": ...
+    def __pow__(self, exponent: float) -> "Law": ...
+    def __neg__(self) -> "Law": ...
+    def __pos__(self) -> "Law": ...
     @staticmethod
     def piecewise_linear(times: Sequence[float], values: Sequence[float]) -> "Law":
         """Linear interpolation between knots (left-continuous rate), at rest outside them.

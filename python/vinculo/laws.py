@@ -5,21 +5,44 @@ integrator needs for the constraints' time derivatives. Anywhere the model takes
 move (a point's coordinate, a plane's normal or point, a fixed coordinate's value, a force
 component), a ``Law`` may stand in for a plain float.
 
+Laws compose: ``+``, ``-``, ``*``, ``/`` and ``**`` (a number exponent) between laws and numbers,
+and :func:`sqrt`, :func:`sin`, :func:`cos`, :func:`exp`, :func:`log` of a law, give laws whose
+derivatives are exact (chain and product rules, no differencing). :func:`function` makes a law of
+a Python function that returns its own derivatives.
+
 Example:
     >>> from vinculo import laws
     >>> x = laws.sine(amplitude=0.005, frequency=0.9, ramp_time=3.0)
     >>> value, rate, acceleration = x.derivatives(1.0)
+    >>> guide = laws.sqrt(2.0**2 - laws.sine(amplitude=0.7, frequency=0.4) ** 2)
+    >>> round(guide(0.0), 12)
+    2.0
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
 from vinculo._core import Law
 
-__all__ = ["Law", "constant", "driven", "piecewise_linear", "polynomial", "sine", "tabulated"]
+__all__ = [
+    "Law",
+    "constant",
+    "cos",
+    "driven",
+    "exp",
+    "function",
+    "log",
+    "piecewise_linear",
+    "polynomial",
+    "sin",
+    "sine",
+    "sqrt",
+    "tabulated",
+    "time",
+]
 
 
 def _floats(name: str, values: Sequence[float] | np.ndarray) -> list[float]:
@@ -105,25 +128,44 @@ def sine(
     )
 
 
-def tabulated(times: Sequence[float] | np.ndarray, values: Sequence[float] | np.ndarray) -> Law:
-    """A natural cubic spline through samples (twice continuously differentiable).
+def tabulated(
+    times: Sequence[float] | np.ndarray,
+    values: Sequence[float] | np.ndarray,
+    ends: str = "natural",
+    slopes: tuple[float, float] | None = None,
+) -> Law:
+    """A cubic spline through samples (twice continuously differentiable).
 
-    The law is defined on ``[times[0], times[-1]]`` only (see ``Law.domain``). A natural spline
-    reproduces linear data exactly; smooth data are reproduced to O(h^4) away from the ends, where
-    the natural end conditions (zero second derivative) apply.
+    The law is defined on ``[times[0], times[-1]]`` only (see ``Law.domain``). The end condition
+    closes the spline at the first and last samples:
+
+    - ``"natural"``: zero second derivative at both ends. It reproduces linear data exactly, but
+      where the data curve at an end its slope is only first-order accurate there (a slope error
+      that does not vanish as fast as the samples get closer).
+    - ``"clamped"``: the slopes at both ends are ``slopes=(first, last)``, when they are known
+      (a motion that starts and ends at rest: ``(0, 0)``).
+    - ``"not-a-knot"``: the first two and the last two pieces are one cubic each (no condition
+      on the data beyond the samples; with 3 samples, the parabola through them).
+
+    Clamped and not-a-knot splines reproduce cubic data exactly and are fourth-order accurate up to
+    the ends.
 
     Arguments:
         times: strictly increasing sample times.
         values: the samples, one per time.
+        ends: ``"natural"``, ``"clamped"`` or ``"not-a-knot"``.
+        slopes: the end slopes (first, last) of a clamped spline, in value per second.
 
     Returns:
         The law.
 
     Raises:
         InvalidInputError: if the lengths differ, there are fewer than two samples, the times are
-            not strictly increasing, or a number is not finite.
+            not strictly increasing, a number is not finite, ``ends`` is unknown, or ``slopes`` is
+            missing for a clamped spline (or given for another).
     """
-    return Law.tabulated(_floats("times", times), _floats("values", values))
+    pair = None if slopes is None else (float(slopes[0]), float(slopes[1]))
+    return Law.spline(_floats("times", times), _floats("values", values), ends, pair)
 
 
 def piecewise_linear(
@@ -166,3 +208,107 @@ def driven(x0: float, t0: float = 0.0) -> Law:
         InvalidInputError: if a number is not finite.
     """
     return Law.driven(float(x0), float(t0))
+
+
+def time() -> Law:
+    """The law ``t`` itself, to write laws as formulas of time: ``laws.sin(3 * laws.time())``.
+
+    Returns:
+        The law.
+    """
+    return Law.polynomial([0.0, 1.0])
+
+
+def _apply(name: str, law: Law | float) -> Law:
+    """``name(law)`` for one of the elementary functions of the core."""
+    return Law.apply(name, law)
+
+
+def sqrt(law: Law | float) -> Law:
+    """The square root of a law, with exact derivatives.
+
+    Where the argument is negative (or zero, where the rate is infinite) the law has no finite
+    value; a run that reaches such a time stops with an ``InvalidInputError`` naming the law, the
+    element it drives and the time.
+
+    Arguments:
+        law: a law or a number.
+
+    Returns:
+        The law ``sqrt(law)``.
+    """
+    return _apply("sqrt", law)
+
+
+def sin(law: Law | float) -> Law:
+    """The sine of a law (radians), with exact derivatives.
+
+    Arguments:
+        law: a law or a number.
+
+    Returns:
+        The law ``sin(law)``.
+    """
+    return _apply("sin", law)
+
+
+def cos(law: Law | float) -> Law:
+    """The cosine of a law (radians), with exact derivatives.
+
+    Arguments:
+        law: a law or a number.
+
+    Returns:
+        The law ``cos(law)``.
+    """
+    return _apply("cos", law)
+
+
+def exp(law: Law | float) -> Law:
+    """The exponential of a law, with exact derivatives.
+
+    Arguments:
+        law: a law or a number.
+
+    Returns:
+        The law ``exp(law)``.
+    """
+    return _apply("exp", law)
+
+
+def log(law: Law | float) -> Law:
+    """The natural logarithm of a law (defined where the law is positive), with exact derivatives.
+
+    Arguments:
+        law: a law or a number.
+
+    Returns:
+        The law ``log(law)``.
+    """
+    return _apply("log", law)
+
+
+def function(f: Callable[[float], tuple[float, float, float]], name: str | None = None) -> Law:
+    """A law computed by a Python function of time that returns its value and two derivatives.
+
+    The constraints need the rate and acceleration of a prescribed motion exactly (they enter the
+    consistent start and every step), so ``f`` returns all three: ``f(t) -> (value, rate,
+    acceleration)``. The function is called from the run's thread, with the Python interpreter
+    held, at every evaluation: a law made of :func:`sine`, :func:`polynomial` and the operators is
+    evaluated by the compiled core and is much faster.
+
+    A function that raises, or returns something other than three finite numbers, stops the run
+    with a ``UserFunctionError`` naming the law, the element it drives, the time and the
+    exception's text; the states computed before are kept on the error's ``solution``.
+
+    Arguments:
+        f: the function of time ``t`` (s).
+        name: the law's name in messages (``f.__name__`` by default).
+
+    Returns:
+        The law.
+
+    Raises:
+        InvalidInputError: if ``f`` is not callable.
+    """
+    return Law.function(f, name)

@@ -36,6 +36,14 @@ fn details<'py>(py: Python<'py>, e: &Error) -> PyResult<Bound<'py, PyDict>> {
         Error::ConstraintOnFixedParticles { what } => d.set_item("name", what)?,
         Error::UnknownParticle { index, .. } => d.set_item("value", index)?,
         Error::LawOutOfDomain { what, .. } => d.set_item("name", what)?,
+        Error::LawNotFinite { what, t, user, .. } => {
+            d.set_item("name", what)?;
+            d.set_item("time", t)?;
+            if let Some(law) = user {
+                d.set_item("group", law)?;
+                d.set_item("call", "law")?;
+            }
+        }
         Error::InconsistentInitialState {
             level,
             constraint,

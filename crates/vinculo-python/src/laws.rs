@@ -2,7 +2,8 @@
 
 use crate::errors::{invalid, to_py};
 use pyo3::prelude::*;
-use vinculo::laws::{DrivenLaw, Law, VectorLaw};
+use std::sync::Arc;
+use vinculo::laws::{DrivenLaw, EndCondition, Function, Law, UserLaw, VectorLaw};
 
 /// A prescribed scalar function of time with its first and second derivatives.
 #[pyclass(name = "Law", module = "vinculo._core", frozen)]
@@ -62,6 +63,167 @@ impl PyLaw {
         })
     }
 
+    /// A cubic spline through samples with end condition `ends` ("natural", "clamped" with
+    /// `slopes`, or "not-a-knot").
+    #[staticmethod]
+    #[pyo3(signature = (times, values, ends="natural", slopes=None))]
+    fn spline(
+        times: Vec<f64>,
+        values: Vec<f64>,
+        ends: &str,
+        slopes: Option<(f64, f64)>,
+    ) -> PyResult<PyLaw> {
+        let ends = match (ends, slopes) {
+            ("natural", None) => EndCondition::Natural,
+            ("not-a-knot", None) => EndCondition::NotAKnot,
+            ("clamped", Some((d0, dn))) => EndCondition::Clamped(d0, dn),
+            ("clamped", None) => {
+                return Err(invalid(
+                    "slopes",
+                    "None",
+                    "a clamped spline needs its end slopes: slopes=(first, last)",
+                ))
+            }
+            ("natural" | "not-a-knot", Some(s)) => {
+                return Err(invalid(
+                    "slopes",
+                    format!("{s:?}"),
+                    "only a clamped spline takes end slopes (ends='clamped')",
+                ))
+            }
+            (other, _) => {
+                return Err(invalid(
+                    "ends",
+                    other,
+                    "expected 'natural', 'clamped' or 'not-a-knot'",
+                ))
+            }
+        };
+        Ok(PyLaw {
+            inner: Law::tabulated_with(times, values, ends).map_err(to_py)?,
+        })
+    }
+
+    /// f(law) for f one of sqrt, sin, cos, exp, log, or law ** exponent for "power".
+    #[staticmethod]
+    #[pyo3(signature = (name, law, exponent=None))]
+    fn apply(name: &str, law: &Bound<'_, PyAny>, exponent: Option<f64>) -> PyResult<PyLaw> {
+        let f = match (name, exponent) {
+            ("sqrt", None) => Function::Sqrt,
+            ("sin", None) => Function::Sin,
+            ("cos", None) => Function::Cos,
+            ("exp", None) => Function::Exp,
+            ("log", None) => Function::Log,
+            ("power", Some(p)) => Function::Power(p),
+            _ => {
+                return Err(invalid(
+                    "function",
+                    name,
+                    "expected 'sqrt', 'sin', 'cos', 'exp', 'log', or 'power' with an exponent",
+                ))
+            }
+        };
+        let argument = scalar(law, &format!("argument of {name}"))?;
+        Ok(PyLaw {
+            inner: Law::apply(f, argument).map_err(to_py)?,
+        })
+    }
+
+    /// A law computed by a Python function t -> (value, rate, acceleration).
+    #[staticmethod]
+    #[pyo3(signature = (function, name=None))]
+    fn function(function: Bound<'_, PyAny>, name: Option<String>) -> PyResult<PyLaw> {
+        if !function.is_callable() {
+            return Err(invalid(
+                "function",
+                function.repr()?.to_string(),
+                "expected a callable t -> (value, rate, acceleration)",
+            ));
+        }
+        let name = match name {
+            Some(n) => n,
+            None => function
+                .getattr("__name__")
+                .and_then(|n| n.extract::<String>())
+                .unwrap_or_else(|_| "law".to_string()),
+        };
+        let callable: Py<PyAny> = function.unbind();
+        let call = move |t: f64| -> Result<(f64, f64, f64), String> {
+            Python::attach(|py| {
+                let out = callable.bind(py).call1((t,)).map_err(|e| e.to_string())?;
+                out.extract::<(f64, f64, f64)>().map_err(|_| {
+                    let shown = out.repr().map(|r| r.to_string()).unwrap_or_default();
+                    format!(
+                        "must return (value, rate, acceleration) as three numbers, returned \
+                         {shown}"
+                    )
+                })
+            })
+        };
+        Ok(PyLaw {
+            inner: Law::User(UserLaw::new(name, Arc::new(call))),
+        })
+    }
+
+    fn __add__(&self, py: Python<'_>, other: &Bound<'_, PyAny>) -> Py<PyAny> {
+        self.binary(py, other, |a, b| Law::sum(a, b))
+    }
+
+    fn __radd__(&self, py: Python<'_>, other: &Bound<'_, PyAny>) -> Py<PyAny> {
+        self.binary(py, other, |a, b| Law::sum(b, a))
+    }
+
+    fn __sub__(&self, py: Python<'_>, other: &Bound<'_, PyAny>) -> Py<PyAny> {
+        self.binary(py, other, |a, b| Law::sum(a, negative(b)))
+    }
+
+    fn __rsub__(&self, py: Python<'_>, other: &Bound<'_, PyAny>) -> Py<PyAny> {
+        self.binary(py, other, |a, b| Law::sum(b, negative(a)))
+    }
+
+    fn __mul__(&self, py: Python<'_>, other: &Bound<'_, PyAny>) -> Py<PyAny> {
+        self.binary(py, other, |a, b| Law::product(a, b))
+    }
+
+    fn __rmul__(&self, py: Python<'_>, other: &Bound<'_, PyAny>) -> Py<PyAny> {
+        self.binary(py, other, |a, b| Law::product(b, a))
+    }
+
+    fn __truediv__(&self, py: Python<'_>, other: &Bound<'_, PyAny>) -> Py<PyAny> {
+        self.binary(py, other, |a, b| Law::quotient(a, b))
+    }
+
+    fn __rtruediv__(&self, py: Python<'_>, other: &Bound<'_, PyAny>) -> Py<PyAny> {
+        self.binary(py, other, |a, b| Law::quotient(b, a))
+    }
+
+    fn __neg__(&self) -> PyLaw {
+        PyLaw {
+            inner: negative(self.inner.clone()),
+        }
+    }
+
+    fn __pos__(&self) -> PyLaw {
+        self.clone()
+    }
+
+    fn __pow__(
+        &self,
+        py: Python<'_>,
+        exponent: &Bound<'_, PyAny>,
+        modulo: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Py<PyAny>> {
+        match (exponent.extract::<f64>(), modulo) {
+            (Ok(p), None) => Ok(PyLaw {
+                inner: Law::apply(Function::Power(p), self.inner.clone()).map_err(to_py)?,
+            }
+            .into_pyobject(py)?
+            .into_any()
+            .unbind()),
+            _ => Ok(py.NotImplemented()),
+        }
+    }
+
     /// A piecewise-linear law driven while a run is stepped: value x at time t (and before).
     #[staticmethod]
     #[pyo3(signature = (x, t=0.0))]
@@ -108,8 +270,41 @@ impl PyLaw {
             Law::Tabulated(s) => format!("Law.tabulated(<spline on {:?}>)", s.domain()),
             Law::PiecewiseLinear(_) => "Law(<piecewise linear>)".to_string(),
             Law::Driven(_) => "Law(<driven>)".to_string(),
+            other => format!("Law({})", other.formula()),
         }
     }
+}
+
+impl PyLaw {
+    /// `op(self, other)` as a new law, or NotImplemented when `other` is neither a number nor
+    /// a law (so that Python tries the other operand, then raises TypeError).
+    fn binary(
+        &self,
+        py: Python<'_>,
+        other: &Bound<'_, PyAny>,
+        op: impl Fn(Law, Law) -> Law,
+    ) -> Py<PyAny> {
+        let other = match other.cast::<PyLaw>() {
+            Ok(law) => law.get().inner.clone(),
+            Err(_) => match other.extract::<f64>() {
+                // A NaN or infinite operand stays NaN in the law: the run names it (LawNotFinite).
+                Ok(v) => Law::Constant(v),
+                Err(_) => return py.NotImplemented(),
+            },
+        };
+        let law = PyLaw {
+            inner: op(self.inner.clone(), other),
+        };
+        match law.into_pyobject(py) {
+            Ok(obj) => obj.into_any().unbind(),
+            Err(_) => py.NotImplemented(),
+        }
+    }
+}
+
+/// -law, as the product with -1.
+fn negative(law: Law) -> Law {
+    Law::product(Law::Constant(-1.0), law)
 }
 
 /// A Python float or Law as a core law.

@@ -64,6 +64,19 @@ pub enum Error {
         /// Simulation end.
         t_end: f64,
     },
+    /// A prescribed law gives no finite value, rate or acceleration at a time the run needs it
+    /// (a square root of a negative value, a quotient by zero), or its user function failed.
+    #[error("the law of {what} cannot be evaluated at t = {t:.6} s: {detail}; the states computed before are kept")]
+    LawNotFinite {
+        /// Where the law is used.
+        what: String,
+        /// The time.
+        t: f64,
+        /// What went wrong.
+        detail: String,
+        /// The user law's name when its function failed (a `UserFunctionError`).
+        user: Option<String>,
+    },
     /// The initial positions (Phi) or velocities (Phi_q v + Phi_t) violate a constraint.
     #[error("initial {level} violate {constraint}: |{quantity}| = {violation:.3e} (scaled: {scaled:.3e}) exceeds the tolerance {tolerance:.1e}; call System.project_initial_state() to move the state onto the constraints")]
     InconsistentInitialState {
@@ -254,7 +267,9 @@ impl Error {
             | Error::SameParticle { .. }
             | Error::ConstraintOnFixedParticles { .. }
             | Error::LawOutOfDomain { .. }
+            | Error::LawNotFinite { user: None, .. }
             | Error::Snapshot { .. } => "InvalidInputError",
+            Error::LawNotFinite { user: Some(_), .. } => "UserFunctionError",
             Error::UnknownParticle { .. } => "UnknownHandleError",
             Error::InconsistentInitialState { .. } => "InconsistentInitialStateError",
             Error::RedundantConstraints { .. } => "RedundantConstraintsError",
@@ -375,7 +390,7 @@ mod tests {
     use super::*;
 
     /// Number of variants of [`Error`] (the arms of [`ordinal`]).
-    const VARIANTS: usize = 20;
+    const VARIANTS: usize = 21;
 
     /// The position of a variant. An exhaustive match: a new variant does not compile until it
     /// has an arm here, and then [`one_of_each`] must give an example of it.
@@ -401,6 +416,7 @@ mod tests {
             Error::OutputTooLarge { .. } => 17,
             Error::StepBelowTimeResolution { .. } => 18,
             Error::EnergyGrowth { .. } => 19,
+            Error::LawNotFinite { .. } => 20,
         }
     }
 
@@ -508,6 +524,12 @@ mod tests {
                 energy: 1e3,
                 initial: 0.0,
                 bound: 9.81,
+            },
+            Error::LawNotFinite {
+                what: s("fixed coordinate #0"),
+                t: 1.5,
+                detail: s("sqrt(-1) is NaN"),
+                user: None,
             },
         ]
     }

@@ -368,6 +368,9 @@ pub struct Simulation<'a> {
     guard: Option<EnergyGuard>,
     /// The forces that can switch within a step (contact events, module documentation).
     event_forces: Vec<usize>,
+    /// A law that was not finite at the end of a failed attempt of the current step (a square
+    /// root of a negative value): the cause to report if the step finally fails.
+    law_trouble: Option<Error>,
 }
 
 impl<'a> Simulation<'a> {
@@ -419,6 +422,11 @@ impl<'a> Simulation<'a> {
             .map(|x| crate::math::norm(*x))
             .fold((crate::math::norm(g) * length).sqrt(), f64::max);
         let speed = if speed > 0.0 { speed } else { length };
+        // A law that cannot be evaluated at the start (a square root of a negative value) is named
+        // before the checks it would spoil.
+        if let Some(e) = system.law_failure(t0) {
+            return Err(e);
+        }
         let (worst, k) = scaled_violation(system, &q, t0);
         let velocity_worst = scaled_velocity_violation(system, &q, &v, t0);
         if let Some(e) = system.user_failure() {
@@ -601,6 +609,7 @@ impl<'a> Simulation<'a> {
             sol,
             guard,
             event_forces,
+            law_trouble: None,
             fingerprint: fingerprint(system),
             run: NEXT_RUN.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
             output_limit,
@@ -909,6 +918,7 @@ impl Simulation<'_> {
             }
             match attempt {
                 Ok(report) => {
+                    self.law_trouble = None;
                     let start = (&c.q[..], &c.v[..], &c.acc[..]);
                     let event = events
                         .then(|| first_event(system, &self.event_forces, start, &ws.state.q, h_try))
@@ -948,6 +958,9 @@ impl Simulation<'_> {
                 }
                 Err(failure) => {
                     self.sol.steps_rejected += 1;
+                    if self.law_trouble.is_none() {
+                        self.law_trouble = system.law_failure(c.t + h_try);
+                    }
                     let retry = match &mut c.controller {
                         Controller::Fixed(fixed) => fixed.halve(),
                         Controller::Adaptive(control) => control.newton_failed(h_try),
@@ -958,7 +971,11 @@ impl Simulation<'_> {
                     if retry {
                         return Next::Go;
                     }
-                    let e = step_failure(system, &ws.layout, failure, c.t, h_try);
+                    // A law that was not finite at the end of an attempt is why the step failed.
+                    let e = match self.law_trouble.take() {
+                        Some(law) => law,
+                        None => step_failure(system, &ws.layout, failure, c.t, h_try),
+                    };
                     self.sol.status = Err(explain_singular(system, &c.q, c.t, e));
                     return Next::Stop;
                 }

@@ -39,6 +39,7 @@ pub use point_distance::PointDistance;
 pub use redundancy::{explain_singular, find_redundant, MAX_ENTRIES, RANK_TOLERANCE};
 pub use user::{ConstraintCall, ConstraintGroup, UserConstraint, UserConstraints};
 
+use crate::laws::Law;
 use crate::local::{Blocks, PerParticle, Rows};
 use crate::math::Vec3;
 
@@ -228,20 +229,25 @@ impl Constraint {
         matches!(self, Constraint::ElasticDistance(c) if c.ea.is_finite())
     }
 
+    /// The prescribed laws of time the constraint follows.
+    pub fn laws(&self) -> Vec<&Law> {
+        match self {
+            Constraint::Distance(_) | Constraint::User(_) => Vec::new(),
+            Constraint::ElasticDistance(c) => vec![&c.length],
+            Constraint::PointDistance(c) => c.point.components().iter().collect(),
+            Constraint::Plane(c) => c
+                .normal
+                .components()
+                .iter()
+                .chain(c.point.components())
+                .collect(),
+            Constraint::FixedCoordinate(c) => vec![&c.value],
+        }
+    }
+
     /// The time interval on which the constraint's laws are defined.
     pub fn domain(&self) -> (f64, f64) {
-        match self {
-            Constraint::Distance(_) => (f64::NEG_INFINITY, f64::INFINITY),
-            Constraint::ElasticDistance(c) => c.length.domain(),
-            Constraint::PointDistance(c) => c.point.domain(),
-            Constraint::Plane(c) => {
-                let (a, b) = c.normal.domain();
-                let (e, f) = c.point.domain();
-                (a.max(e), b.min(f))
-            }
-            Constraint::FixedCoordinate(c) => c.value.domain(),
-            Constraint::User(_) => (f64::NEG_INFINITY, f64::INFINITY),
-        }
+        crate::laws::common_domain(self.laws())
     }
 
     /// A readable name, e.g. "distance #3 (particles 2-3)".

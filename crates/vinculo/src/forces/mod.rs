@@ -207,10 +207,15 @@ impl Force {
 
     /// The time interval on which the force's laws are defined.
     pub fn domain(&self) -> (f64, f64) {
+        crate::laws::common_domain(self.laws())
+    }
+
+    /// The prescribed laws of time the force follows.
+    pub fn laws(&self) -> Vec<&crate::laws::Law> {
         match self {
-            Force::Applied(f) => f.force.domain(),
-            Force::Morison(f) => f.fluid.domain(),
-            _ => (f64::NEG_INFINITY, f64::INFINITY),
+            Force::Applied(f) => f.force.components().iter().collect(),
+            Force::Morison(f) => f.fluid.components().iter().collect(),
+            _ => Vec::new(),
         }
     }
 

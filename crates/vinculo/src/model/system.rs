@@ -27,6 +27,9 @@ pub struct System {
     /// `constraints`), see [`super::user_groups`].
     pub(super) user_forces: Vec<std::sync::Arc<crate::forces::UserForces>>,
     pub(super) user_constraints: Vec<std::sync::Arc<crate::constraints::UserConstraints>>,
+    /// The user laws of the constraints and forces, with the element each drives (a failed
+    /// user function stops the run at once, see [`System::user_failure`]).
+    pub(super) user_laws: Vec<(String, crate::laws::UserLaw)>,
 }
 
 impl System {
@@ -50,6 +53,7 @@ impl System {
             tension_only: Vec::new(),
             user_forces: Vec::new(),
             user_constraints: Vec::new(),
+            user_laws: Vec::new(),
         })
     }
 
@@ -108,8 +112,51 @@ impl System {
                 what: c.name(index),
             });
         }
+        let what = c.name(index);
+        self.note_user_laws(what, c.laws());
         self.constraints.push(c);
         Ok(ConstraintId(index))
+    }
+
+    /// Keeps the user laws among `laws` (those of the element `what`) for the failure checks.
+    fn note_user_laws(&mut self, what: String, laws: Vec<&crate::laws::Law>) {
+        for law in laws {
+            for user in law.user_laws() {
+                self.user_laws.push((what.clone(), user.clone()));
+            }
+        }
+    }
+
+    /// The first law of a constraint or force that cannot be used at `t`: a user law whose
+    /// function failed, or a law that is not finite there (a square root of a negative value).
+    /// Looks at every element: for the failure paths of a run, not every step.
+    pub fn law_failure(&self, t: f64) -> Option<Error> {
+        let constraints = self
+            .constraints
+            .iter()
+            .enumerate()
+            .map(|(k, c)| (c.name(k), c.laws()));
+        let forces = self
+            .forces
+            .iter()
+            .enumerate()
+            .map(|(k, f)| (f.name(k), f.laws()));
+        constraints.chain(forces).find_map(|(what, laws)| {
+            laws.iter().find_map(|law| {
+                let (t, detail) = law.failure_at(t)?;
+                let user = law
+                    .user_laws()
+                    .iter()
+                    .find(|u| u.failure().is_some())
+                    .map(|u| u.name().to_string());
+                Some(Error::LawNotFinite {
+                    what: what.clone(),
+                    t,
+                    detail,
+                    user,
+                })
+            })
+        })
     }
 
     /// Fixed distance between `a` and `b` (paper eq. 17). `length = None` takes the current distance.
@@ -320,11 +367,14 @@ impl System {
     /// A prescribed force F(t) on `p`.
     pub fn add_force(&mut self, p: ParticleId, force: VectorLaw) -> Result<ForceId> {
         let i = self.check(p)?;
-        self.forces.push(Force::Applied(Box::new(AppliedForce {
+        let index = self.forces.len();
+        let element = Force::Applied(Box::new(AppliedForce {
             particles: [i],
             force,
-        })));
-        Ok(ForceId(self.forces.len() - 1))
+        }));
+        self.note_user_laws(element.name(index), element.laws());
+        self.forces.push(element);
+        Ok(ForceId(index))
     }
 
     /// Linear drag f = -c v on `p`.
@@ -374,7 +424,9 @@ impl System {
             fluid: spec.fluid,
             gravity: self.gravity,
         };
-        self.forces.push(Force::Morison(Box::new(element)));
+        let element = Force::Morison(Box::new(element));
+        self.note_user_laws(element.name(index), element.laws());
+        self.forces.push(element);
         Ok(ForceId(index))
     }
 

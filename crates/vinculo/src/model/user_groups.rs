@@ -93,9 +93,12 @@ impl System {
         Ok((group, first))
     }
 
-    /// True when the system has user force or constraint groups.
+    /// True when the system has user force or constraint groups or user laws (whose functions
+    /// are called from the run's thread only: such models assemble serially).
     pub fn has_user_groups(&self) -> bool {
-        !(self.user_forces.is_empty() && self.user_constraints.is_empty())
+        !(self.user_forces.is_empty()
+            && self.user_constraints.is_empty()
+            && self.user_laws.is_empty())
     }
 
     /// The user force groups.
@@ -112,13 +115,26 @@ impl System {
     pub fn reset_user_groups(&self) {
         self.user_forces.iter().for_each(|g| g.reset());
         self.user_constraints.iter().for_each(|g| g.reset());
+        self.user_laws.iter().for_each(|(_, law)| law.reset());
     }
 
-    /// The first failure of a user function since the last reset, as a run error.
+    /// The first failure of a user function (of a group or a law) since the last reset, as a
+    /// run error.
     pub fn user_failure(&self) -> Option<Error> {
         self.user_forces
             .iter()
             .find_map(|g| g.failure())
             .or_else(|| self.user_constraints.iter().find_map(|g| g.failure()))
+            .or_else(|| {
+                self.user_laws.iter().find_map(|(what, law)| {
+                    let (t, detail) = law.failure()?;
+                    Some(Error::LawNotFinite {
+                        what: what.clone(),
+                        t,
+                        detail,
+                        user: Some(law.name().to_string()),
+                    })
+                })
+            })
     }
 }
