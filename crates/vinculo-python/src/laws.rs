@@ -166,7 +166,7 @@ impl PyLaw {
     }
 
     fn __add__(&self, py: Python<'_>, other: &Bound<'_, PyAny>) -> Py<PyAny> {
-        self.binary(py, other, |a, b| Law::sum(a, b))
+        self.binary(py, other, Law::sum)
     }
 
     fn __radd__(&self, py: Python<'_>, other: &Bound<'_, PyAny>) -> Py<PyAny> {
@@ -182,7 +182,7 @@ impl PyLaw {
     }
 
     fn __mul__(&self, py: Python<'_>, other: &Bound<'_, PyAny>) -> Py<PyAny> {
-        self.binary(py, other, |a, b| Law::product(a, b))
+        self.binary(py, other, Law::product)
     }
 
     fn __rmul__(&self, py: Python<'_>, other: &Bound<'_, PyAny>) -> Py<PyAny> {
@@ -190,7 +190,7 @@ impl PyLaw {
     }
 
     fn __truediv__(&self, py: Python<'_>, other: &Bound<'_, PyAny>) -> Py<PyAny> {
-        self.binary(py, other, |a, b| Law::quotient(a, b))
+        self.binary(py, other, Law::quotient)
     }
 
     fn __rtruediv__(&self, py: Python<'_>, other: &Bound<'_, PyAny>) -> Py<PyAny> {
