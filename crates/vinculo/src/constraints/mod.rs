@@ -24,19 +24,25 @@
 //! its elements at once ([`user`]).
 
 mod distance;
+mod dot_product;
 mod elastic_distance;
 mod fixed_coordinate;
+mod on_points;
 mod plane;
 mod point_distance;
 mod redundancy;
+mod relative_coordinate;
 pub mod user;
 
 pub use distance::Distance;
+pub use dot_product::DotProduct;
 pub use elastic_distance::ElasticDistance;
 pub use fixed_coordinate::FixedCoordinate;
+pub use on_points::OnPoints;
 pub use plane::Plane;
 pub use point_distance::PointDistance;
 pub use redundancy::{explain_singular, find_redundant, MAX_ENTRIES, RANK_TOLERANCE};
+pub use relative_coordinate::RelativeCoordinate;
 pub use user::{ConstraintCall, ConstraintGroup, UserConstraint, UserConstraints};
 
 use crate::laws::Law;
@@ -61,6 +67,12 @@ pub enum Constraint {
     Plane(Box<Plane>),
     /// One coordinate of a particle follows a prescribed law (constant by default).
     FixedCoordinate(FixedCoordinate),
+    /// One coordinate of a particle relative to another follows a law (a joint's coincidence).
+    RelativeCoordinate(Box<RelativeCoordinate>),
+    /// The dot product of two particle differences follows a law (a joint's axis equations).
+    DotProduct(Box<DotProduct>),
+    /// A constraint of another kind over points fixed in bodies or in the ground.
+    OnPoints(Box<OnPoints>),
     /// One equation of a group computed by user functions.
     User(UserConstraint),
 }
@@ -73,6 +85,9 @@ macro_rules! dispatch {
             Constraint::PointDistance($c) => $e,
             Constraint::Plane($c) => $e,
             Constraint::FixedCoordinate($c) => $e,
+            Constraint::RelativeCoordinate($c) => $e,
+            Constraint::DotProduct($c) => $e,
+            Constraint::OnPoints($c) => $e,
             Constraint::User($c) => $e,
         }
     };
@@ -189,6 +204,7 @@ impl Constraint {
             Constraint::Distance(c) => c.length,
             Constraint::ElasticDistance(c) => c.share * c.length.value(0.0),
             Constraint::PointDistance(c) => c.length,
+            Constraint::OnPoints(c) => c.inner.length(),
             _ => 0.0,
         }
     }
@@ -196,10 +212,13 @@ impl Constraint {
     /// True for the kinds that hold a distance (whose multiplier is a tension 2 lambda L, or the
     /// tension itself for an elastic segment).
     pub fn is_distance(&self) -> bool {
-        matches!(
-            self,
-            Constraint::Distance(_) | Constraint::PointDistance(_) | Constraint::ElasticDistance(_)
-        )
+        match self {
+            Constraint::Distance(_)
+            | Constraint::PointDistance(_)
+            | Constraint::ElasticDistance(_) => true,
+            Constraint::OnPoints(c) => c.inner.is_distance(),
+            _ => false,
+        }
     }
 
     /// The tension (N, > 0 pulling) that multiplier `lambda` means, for the distance kinds:
@@ -210,6 +229,7 @@ impl Constraint {
             Constraint::Distance(_) | Constraint::PointDistance(_) => {
                 Some(2.0 * lambda * self.length())
             }
+            Constraint::OnPoints(c) => c.inner.tension(lambda),
             _ => None,
         }
     }
@@ -220,13 +240,18 @@ impl Constraint {
     pub fn compliance(&self, t: f64) -> f64 {
         match self {
             Constraint::ElasticDistance(c) => c.compliance(t),
+            Constraint::OnPoints(c) => c.inner.compliance(t),
             _ => 0.0,
         }
     }
 
     /// True when the constraint's equation has a compliance (its row gets a diagonal entry).
     pub fn is_compliant(&self) -> bool {
-        matches!(self, Constraint::ElasticDistance(c) if c.ea.is_finite())
+        match self {
+            Constraint::ElasticDistance(c) => c.ea.is_finite(),
+            Constraint::OnPoints(c) => c.inner.is_compliant(),
+            _ => false,
+        }
     }
 
     /// The prescribed laws of time the constraint follows.
@@ -242,6 +267,9 @@ impl Constraint {
                 .chain(c.point.components())
                 .collect(),
             Constraint::FixedCoordinate(c) => vec![&c.value],
+            Constraint::RelativeCoordinate(c) => vec![&c.value],
+            Constraint::DotProduct(c) => vec![&c.value],
+            Constraint::OnPoints(c) => c.laws(),
         }
     }
 
@@ -269,6 +297,14 @@ impl Constraint {
                     ["x", "y", "z"][c.axis]
                 )
             }
+            Constraint::RelativeCoordinate(c) => format!(
+                "relative coordinate #{index} (particles {}-{}, axis {})",
+                p[0],
+                p[1],
+                ["x", "y", "z"][c.axis]
+            ),
+            Constraint::DotProduct(_) => format!("dot product #{index} (particles {p:?})"),
+            Constraint::OnPoints(c) => format!("{} #{index} (particles {p:?})", c.label),
             Constraint::User(c) => format!(
                 "user constraint '{}' element {} #{index} (particles {p:?})",
                 c.group.name, c.element

@@ -50,22 +50,30 @@ pub struct EnergyGuard {
 /// True when `system` is one the guard watches: constrained, and no element can put energy
 /// into it or store it elastically (module documentation).
 pub fn watched(system: &System) -> bool {
-    let still = |law: &crate::laws::VectorLaw| law.0.iter().all(|l| l.is_constant());
     let forces = system
         .forces()
         .iter()
         .all(|f| matches!(f, Force::LinearDrag(_) | Force::QuadraticDrag(_)));
-    let constraints = system.constraints().iter().all(|c| match c {
+    let constraints = system.constraints().iter().all(passive);
+    !system.constraints().is_empty() && forces && constraints
+}
+
+/// True when the constraint can neither put energy into the model nor store it.
+fn passive(c: &Constraint) -> bool {
+    let still = |law: &crate::laws::VectorLaw| law.0.iter().all(|l| l.is_constant());
+    match c {
         Constraint::Distance(_) => true,
         Constraint::FixedCoordinate(f) => f.value.is_constant(),
+        Constraint::RelativeCoordinate(f) => f.value.is_constant(),
+        Constraint::DotProduct(f) => f.value.is_constant(),
         Constraint::Plane(p) => still(&p.normal) && still(&p.point),
         Constraint::PointDistance(p) => still(&p.point),
+        Constraint::OnPoints(p) => passive(&p.inner),
         // An elastic segment's strain energy lives in its multiplier (the tension), which
         // `System::potential_energy` does not count, and a winch law puts work in: not watched.
         Constraint::ElasticDistance(_) => false,
         Constraint::User(_) => false,
-    });
-    !system.constraints().is_empty() && forces && constraints
+    }
 }
 
 impl EnergyGuard {

@@ -3,11 +3,13 @@
 
 mod line_loads;
 mod particle;
+mod point;
 mod rigid_body;
 mod system;
 pub mod user_groups;
 
 pub use line_loads::{LineHydroSpec, SeabedSpec};
 pub use particle::{ConstraintId, ForceId, Particle, ParticleId};
+pub use point::{Point, PointMap};
 pub use rigid_body::{RigidBody, RigidBodySpec};
 pub use system::System;

@@ -29,7 +29,7 @@ use super::particle::{ConstraintId, ParticleId};
 use super::system::System;
 use crate::constraints::find_redundant;
 use crate::error::{finite_vector, positive, Error, Result};
-use crate::math::{add, add_mat, norm, outer, scale, sub, Mat3, Vec3};
+use crate::math::{add, add_mat, cross, norm, outer, scale, sub, Mat3, Vec3};
 
 /// What a rigid body is made of and how it starts moving.
 #[derive(Debug, Clone, PartialEq)]
@@ -95,14 +95,6 @@ fn column(a: &Mat3, k: usize) -> Vec3 {
 fn det(a: Vec3, b: Vec3, c: Vec3) -> f64 {
     a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
         + a[2] * (b[0] * c[1] - b[1] * c[0])
-}
-
-fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 /// Principal axes and second moments of a symmetric 3 x 3 matrix (ascending), world axes when it

@@ -1,0 +1,121 @@
+//! A constraint over points (points fixed in bodies, ground points, particles): a constraint of
+//! any kind written for m particles acts on m points through their [`PointMap`].
+//!
+//! The inner constraint is built over the element's points as if they were particles 0..m-1;
+//! it is evaluated at the points' positions and velocities, and its gradient and Hessian reach
+//! the particles by the chain rule of [`crate::model::point`]: x_j = offset_j + sum_p w_jp q_p is
+//! linear in q with constant weights, so Phi_t and gamma are the inner constraint's own.
+
+use super::{Constraint, Hessian};
+use crate::laws::Law;
+use crate::local::Blocks;
+use crate::math::Vec3;
+use crate::model::PointMap;
+
+/// A constraint over points.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OnPoints {
+    /// The constraint over the points, numbered 0..m-1 as particles.
+    pub inner: Constraint,
+    /// How the points reach the particles.
+    pub map: PointMap,
+    /// Its name in messages (e.g. "revolute joint #1, axis equation 2").
+    pub label: String,
+}
+
+impl OnPoints {
+    pub(crate) fn particles(&self) -> &[usize] {
+        &self.map.particles
+    }
+
+    pub(crate) fn residual(&self, q: &[Vec3], t: f64) -> f64 {
+        self.inner.residual(&self.map.positions(q), t)
+    }
+
+    pub(crate) fn gradient(&self, q: &[Vec3], t: f64) -> crate::local::Rows {
+        let x = self.map.positions(q);
+        let g = self.inner.gradient_rows(&x, t);
+        crate::local::Rows::Any(self.map.rows(self.inner.particles(), &g))
+    }
+
+    pub(crate) fn add_hessian(&self, q: &[Vec3], t: f64, w: f64, out: &mut Hessian) {
+        let x = self.map.positions(q);
+        let mut h = Blocks::zeros(self.inner.particles().len());
+        self.inner.add_hessian(&x, t, w, &mut h);
+        self.map.add_blocks(self.inner.particles(), &h, out);
+    }
+
+    pub(crate) fn phi_t(&self, q: &[Vec3], t: f64) -> f64 {
+        self.inner.phi_t(&self.map.positions(q), t)
+    }
+
+    pub(crate) fn gamma(&self, q: &[Vec3], v: &[Vec3], t: f64) -> f64 {
+        let x = self.map.positions(q);
+        self.inner.gamma(&x, &self.map.velocities(v), t)
+    }
+
+    pub(crate) fn scale(&self) -> f64 {
+        self.inner.scale()
+    }
+
+    pub(crate) fn laws(&self) -> Vec<&Law> {
+        self.inner.laws()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{fd, Distance, DotProduct};
+    use super::*;
+    use crate::model::Point;
+
+    /// Particles 0..3 frame a body, 4..7 another; 8 is a lone particle.
+    fn state() -> (Vec<Vec3>, Vec<Vec3>) {
+        let q: Vec<Vec3> = (0..9)
+            .map(|i| {
+                let s = i as f64;
+                [
+                    0.3 * s.sin() + 0.1 * s,
+                    (1.7 * s).cos(),
+                    0.2 * s * s - 0.5 * (s % 3.0),
+                ]
+            })
+            .collect();
+        let v: Vec<Vec3> = (0..9)
+            .map(|i| [0.1 * i as f64, -0.3, 0.05 * (i * i) as f64])
+            .collect();
+        (q, v)
+    }
+
+    #[test]
+    fn constraints_over_body_points_match_finite_differences() {
+        let (q, v) = state();
+        let a = Point::in_frame(&[0, 1, 2, 3], &q[0..4], [0.4, -0.2, 0.9]).unwrap();
+        let a2 = Point::in_frame(&[0, 1, 2, 3], &q[0..4], [1.4, 0.3, 0.2]).unwrap();
+        let b = Point::in_frame(&[4, 5, 6, 7], &q[4..8], [0.1, 0.6, 1.5]).unwrap();
+        let ground = Point::ground([0.5, 0.5, 0.5]);
+        // A distance between a point of each body.
+        let distance = Constraint::OnPoints(Box::new(OnPoints {
+            inner: Constraint::Distance(Distance {
+                particles: [0, 1],
+                length: 1.0,
+            }),
+            map: PointMap::new(&[a.clone(), b.clone()]),
+            label: "test".into(),
+        }));
+        fd::check(&distance, &q, &v, 0.2);
+        // A dot product of a body's direction (a2 - a) with (particle 8 - ground point): the
+        // same body's particles appear in two points, merged by the map.
+        let dot = Constraint::OnPoints(Box::new(OnPoints {
+            inner: Constraint::DotProduct(Box::new(DotProduct {
+                particles: [0, 1, 2, 3],
+                value: Law::sine(0.1, 1.0, 0.0, 0.2, 0.0, 0.0).unwrap(),
+                inverse_length: 1.0,
+            })),
+            map: PointMap::new(&[a, a2, ground, Point::particle(8)]),
+            label: "test".into(),
+        }));
+        assert_eq!(dot.particles(), &[0, 1, 2, 3, 8]);
+        fd::check(&dot, &q, &v, 0.2);
+    }
+}
