@@ -26,6 +26,7 @@ mod drag;
 mod line_hydro;
 mod line_node;
 mod morison;
+mod on_points;
 mod seabed;
 mod spring_damper;
 pub mod user;
@@ -36,6 +37,7 @@ pub use drag::{LinearDrag, QuadraticDrag};
 pub use line_hydro::LineHydro;
 pub use line_node::LineNode;
 pub use morison::{Morison, MorisonSpec};
+pub use on_points::ForceOnPoints;
 pub use seabed::{SeabedContact, SeabedFriction};
 pub use spring_damper::SpringDamper;
 pub use user::{ForceGroup, UserForce, UserForces};
@@ -67,6 +69,8 @@ pub enum Force {
     SeabedContact(Box<SeabedContact>),
     /// Buoyancy and drag on a line node, in the line's local frame.
     LineHydro(Box<LineHydro>),
+    /// A force of another kind over points fixed in bodies or in the ground.
+    OnPoints(Box<ForceOnPoints>),
     /// One element of a group computed by a user function.
     User(UserForce),
 }
@@ -82,6 +86,7 @@ macro_rules! dispatch {
             Force::Bending($f) => $e,
             Force::SeabedContact($f) => $e,
             Force::LineHydro($f) => $e,
+            Force::OnPoints($f) => $e,
             Force::User($f) => $e,
         }
     };
@@ -186,13 +191,18 @@ impl Force {
             Force::Bending(f) => f.potential(q),
             Force::SeabedContact(f) => f.potential(q),
             Force::LineHydro(f) => f.potential(q),
+            Force::OnPoints(f) => f.potential(q),
             _ => 0.0,
         }
     }
 
     /// True when the Jacobian is identically zero (the element adds nothing to the matrix).
     pub fn has_jacobian(&self) -> bool {
-        !matches!(self, Force::Applied(_))
+        match self {
+            Force::Applied(_) => false,
+            Force::OnPoints(f) => f.inner.has_jacobian(),
+            _ => true,
+        }
     }
 
     /// Mass the element adds to the inertia of a particle's translation: (particle, mass).
@@ -215,6 +225,7 @@ impl Force {
         match self {
             Force::Applied(f) => f.force.components().iter().collect(),
             Force::Morison(f) => f.fluid.components().iter().collect(),
+            Force::OnPoints(f) => f.laws(),
             _ => Vec::new(),
         }
     }
@@ -233,6 +244,7 @@ impl Force {
             Force::Bending(_) => format!("bending #{index} (particles {p:?})"),
             Force::SeabedContact(_) => format!("seabed contact #{index} (node {})", p[0]),
             Force::LineHydro(_) => format!("line hydrodynamics #{index} (node {})", p[0]),
+            Force::OnPoints(f) => format!("{} #{index} (particles {p:?})", f.label),
             Force::User(f) => format!(
                 "user force '{}' element {} #{index} (particles {p:?})",
                 f.group.name, f.element
