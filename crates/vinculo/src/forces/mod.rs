@@ -22,6 +22,7 @@
 
 mod applied;
 mod bending;
+mod couple;
 mod drag;
 mod line_hydro;
 mod line_node;
@@ -33,6 +34,7 @@ pub mod user;
 
 pub use applied::AppliedForce;
 pub use bending::Bending;
+pub use couple::Couple;
 pub use drag::{LinearDrag, QuadraticDrag};
 pub use line_hydro::LineHydro;
 pub use line_node::LineNode;
@@ -69,6 +71,8 @@ pub enum Force {
     SeabedContact(Box<SeabedContact>),
     /// Buoyancy and drag on a line node, in the line's local frame.
     LineHydro(Box<LineHydro>),
+    /// A torque about a world axis, as a couple on two points of a body.
+    Couple(Box<Couple>),
     /// A force of another kind over points fixed in bodies or in the ground.
     OnPoints(Box<ForceOnPoints>),
     /// One element of a group computed by a user function.
@@ -86,6 +90,7 @@ macro_rules! dispatch {
             Force::Bending($f) => $e,
             Force::SeabedContact($f) => $e,
             Force::LineHydro($f) => $e,
+            Force::Couple($f) => $e,
             Force::OnPoints($f) => $e,
             Force::User($f) => $e,
         }
@@ -225,6 +230,7 @@ impl Force {
         match self {
             Force::Applied(f) => f.force.components().iter().collect(),
             Force::Morison(f) => f.fluid.components().iter().collect(),
+            Force::Couple(f) => vec![&f.torque],
             Force::OnPoints(f) => f.laws(),
             _ => Vec::new(),
         }
@@ -244,6 +250,7 @@ impl Force {
             Force::Bending(_) => format!("bending #{index} (particles {p:?})"),
             Force::SeabedContact(_) => format!("seabed contact #{index} (node {})", p[0]),
             Force::LineHydro(_) => format!("line hydrodynamics #{index} (node {})", p[0]),
+            Force::Couple(_) => format!("torque #{index} (particles {p:?})"),
             Force::OnPoints(f) => format!("{} #{index} (particles {p:?})", f.label),
             Force::User(f) => format!(
                 "user force '{}' element {} #{index} (particles {p:?})",

@@ -1,14 +1,18 @@
 //! The model: particles and the system that owns them with their constraints and forces, and
 //! rigid bodies built from particles.
 
+mod joints;
 mod line_loads;
+mod on_points;
 mod particle;
 mod point;
 mod rigid_body;
 mod system;
 pub mod user_groups;
 
+pub use joints::JointKind;
 pub use line_loads::{LineHydroSpec, SeabedSpec};
+pub use on_points::{Built, OnPointsId};
 pub use particle::{ConstraintId, ForceId, Particle, ParticleId};
 pub use point::{Point, PointMap};
 pub use rigid_body::{RigidBody, RigidBodySpec};

@@ -162,10 +162,21 @@ pub struct PointMap {
 impl PointMap {
     /// The map of `points` (element point j is `points[j]`).
     pub fn new(points: &[Point]) -> PointMap {
+        let all: Vec<usize> = (0..points.len()).collect();
+        PointMap::for_points(points, &all)
+    }
+
+    /// The map of `points` for an element that touches only the points `used` (its particles
+    /// are then those of the used points alone).
+    pub fn for_points(points: &[Point], used: &[usize]) -> PointMap {
         let mut particles: Vec<usize> = Vec::new();
         let terms = points
             .iter()
-            .map(|point| {
+            .enumerate()
+            .map(|(j, point)| {
+                if !used.contains(&j) {
+                    return Vec::new();
+                }
                 point
                     .particles
                     .iter()

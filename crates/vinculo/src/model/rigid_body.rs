@@ -81,6 +81,20 @@ pub struct RigidBody {
     pub axes: Mat3,
 }
 
+impl RigidBody {
+    /// Four of its particles that frame it (the centre and the +e1, +e2, +e3 vertices, not
+    /// coplanar): every point fixed in the body is an affine combination of them
+    /// ([`System::point_in`]).
+    pub fn frame(&self) -> [ParticleId; 4] {
+        [
+            self.centre,
+            self.vertices[0],
+            self.vertices[2],
+            self.vertices[4],
+        ]
+    }
+}
+
 /// Mass and position of the 7 octahedron particles: centre, then +-e1, +-e2, +-e3.
 struct Octahedron {
     masses: [f64; 7],

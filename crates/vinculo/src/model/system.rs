@@ -2,7 +2,8 @@
 
 use super::particle::{ConstraintId, ForceId, Particle, ParticleId};
 use crate::constraints::{
-    Constraint, Distance, ElasticDistance, FixedCoordinate, Plane, PointDistance,
+    Constraint, Distance, DotProduct, ElasticDistance, FixedCoordinate, Plane, PointDistance,
+    RelativeCoordinate,
 };
 use crate::error::{finite_vector, non_negative, positive, Error, Result};
 use crate::forces::{
@@ -21,8 +22,8 @@ pub struct System {
     gravity: Vec3,
     particles: Vec<Particle>,
     pub(super) constraints: Vec<Constraint>,
-    pub(super) forces: Vec<Force>,
-    tension_only: Vec<usize>,
+    pub(crate) forces: Vec<Force>,
+    pub(super) tension_only: Vec<usize>,
     /// Groups of user forces and constraints (their elements are also in `forces` and
     /// `constraints`), see [`super::user_groups`].
     pub(super) user_forces: Vec<std::sync::Arc<crate::forces::UserForces>>,
@@ -30,6 +31,8 @@ pub struct System {
     /// The user laws of the constraints and forces, with the element each drives (a failed
     /// user function stops the run at once, see [`System::user_failure`]).
     pub(super) user_laws: Vec<(String, crate::laws::UserLaw)>,
+    /// How many joints were added (their number in messages).
+    pub(super) joints: usize,
 }
 
 impl System {
@@ -54,6 +57,7 @@ impl System {
             user_forces: Vec::new(),
             user_constraints: Vec::new(),
             user_laws: Vec::new(),
+            joints: 0,
         })
     }
 
@@ -119,7 +123,7 @@ impl System {
     }
 
     /// Keeps the user laws among `laws` (those of the element `what`) for the failure checks.
-    fn note_user_laws(&mut self, what: String, laws: Vec<&crate::laws::Law>) {
+    pub(super) fn note_user_laws(&mut self, what: String, laws: Vec<&crate::laws::Law>) {
         for law in laws {
             for user in law.user_laws() {
                 self.user_laws.push((what.clone(), user.clone()));
@@ -295,6 +299,83 @@ impl System {
             axis,
             value,
         }))
+    }
+
+    /// q_b[axis] - q_a[axis] = value(t) (`None`: the current difference): three at zero make
+    /// two points coincide. See [`crate::constraints::RelativeCoordinate`].
+    pub fn add_relative_coordinate(
+        &mut self,
+        a: ParticleId,
+        b: ParticleId,
+        axis: usize,
+        value: Option<Law>,
+    ) -> Result<ConstraintId> {
+        let (i, j) = (self.check(a)?, self.check(b)?);
+        let index = self.constraints.len();
+        if i == j {
+            return Err(Error::SameParticle {
+                what: format!("relative coordinate #{index}"),
+                particle: i,
+            });
+        }
+        if axis > 2 {
+            return Err(Error::InvalidParameter {
+                name: "axis of a relative coordinate".into(),
+                value: axis as f64,
+                expected: "must be 0, 1 or 2 (x, y or z)".into(),
+            });
+        }
+        let current = self.particles[j].position[axis] - self.particles[i].position[axis];
+        self.push_constraint(Constraint::RelativeCoordinate(Box::new(
+            RelativeCoordinate {
+                particles: [i, j],
+                axis,
+                value: value.unwrap_or(Law::Constant(current)),
+            },
+        )))
+    }
+
+    /// (q_b - q_a) . (q_d - q_c) = value(t) (`None`: the current value): zero keeps two
+    /// directions perpendicular. Particles may repeat (two vectors from one point). See
+    /// [`crate::constraints::DotProduct`].
+    pub fn add_dot_product(
+        &mut self,
+        [a, b, c, d]: [ParticleId; 4],
+        value: Option<Law>,
+    ) -> Result<ConstraintId> {
+        let ids = [
+            self.check(a)?,
+            self.check(b)?,
+            self.check(c)?,
+            self.check(d)?,
+        ];
+        let index = self.constraints.len();
+        let q = |k: usize| self.particles[ids[k]].position;
+        let (u, w) = (sub(q(1), q(0)), sub(q(3), q(2)));
+        for (k, v) in [(0, u), (2, w)] {
+            if norm(v) == 0.0 {
+                return Err(Error::SameParticle {
+                    what: format!("dot product #{index} (vector {})", k / 2 + 1),
+                    particle: ids[k],
+                });
+            }
+        }
+        let distinct = (0..4).all(|x| (0..x).all(|y| ids[x] != ids[y]));
+        if !distinct {
+            // A shared particle: over points, whose map merges its two slots.
+            let points: Vec<_> = ids.iter().map(|&i| super::Point::particle(i)).collect();
+            let label = format!("dot product #{index}");
+            return self
+                .on_points(&points, &label, |s, p| {
+                    s.add_dot_product([p[0], p[1], p[2], p[3]], value)
+                })
+                .map(|(id, _)| id);
+        }
+        self.push_constraint(Constraint::DotProduct(Box::new(DotProduct {
+            particles: ids,
+            value: value.unwrap_or(Law::Constant(dot(u, w))),
+            inverse_length: 1.0 / norm(w),
+        })))
     }
 
     /// Adds bending stiffness at the middle particle `b` of three consecutive particles
