@@ -3,6 +3,7 @@
 
 mod errors;
 mod laws;
+mod points;
 mod reentry;
 mod run;
 mod run_result;
@@ -18,6 +19,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<laws::PyLaw>()?;
     m.add_class::<system::PySystem>()?;
     m.add_class::<system::PyParticleId>()?;
+    m.add_class::<points::PyPoint>()?;
     m.add_class::<system::PyConstraintId>()?;
     m.add_class::<system::PyForceId>()?;
     m.add_class::<user_physics::PyUserGroup>()?;

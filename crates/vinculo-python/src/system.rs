@@ -2,6 +2,7 @@
 
 use crate::errors::{invalid, to_py};
 use crate::laws::{scalar, vector};
+use crate::points::PyPoint;
 use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
@@ -69,6 +70,20 @@ pub struct PySystem {
     pub user_errors: crate::user_physics::PendingError,
 }
 
+/// An axis given as 0, 1, 2 or "x", "y", "z".
+fn axis_index(axis: &Bound<'_, PyAny>) -> PyResult<usize> {
+    if let Ok(s) = axis.extract::<String>() {
+        return match s.as_str() {
+            "x" => Ok(0),
+            "y" => Ok(1),
+            "z" => Ok(2),
+            _ => Err(invalid("axis", s, "expected 0, 1, 2 or 'x', 'y', 'z'")),
+        };
+    }
+    axis.extract::<usize>()
+        .map_err(|_| invalid("axis", axis, "expected 0, 1, 2 or 'x', 'y', 'z'"))
+}
+
 fn vec3(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<[f64; 3]> {
     let v: Vec<f64> = obj.extract().map_err(|_| {
         invalid(
@@ -113,7 +128,7 @@ impl PySystem {
         Ok(Some((self.particle(&items[0])?, self.particle(&items[1])?)))
     }
 
-    fn particle(&self, obj: &Bound<'_, PyAny>) -> PyResult<ParticleId> {
+    pub fn particle(&self, obj: &Bound<'_, PyAny>) -> PyResult<ParticleId> {
         let id = obj.cast::<PyParticleId>().map_err(|_| {
             Python::attach(|py| {
                 let d = PyDict::new(py);
@@ -223,8 +238,9 @@ impl PySystem {
         b: &Bound<'_, PyAny>,
         length: Option<f64>,
     ) -> PyResult<PyConstraintId> {
-        let (a, b) = (self.particle(a)?, self.particle(b)?);
-        let id = self.inner.add_distance(a, b, length).map_err(to_py)?;
+        let id = self.over(&[a, b], "distance", |s, p| {
+            s.add_distance(p[0], p[1], length)
+        })?;
         Ok(PyConstraintId { index: id.0 })
     }
 
@@ -240,12 +256,10 @@ impl PySystem {
         ea: f64,
         share: f64,
     ) -> PyResult<PyConstraintId> {
-        let (a, b) = (self.particle(a)?, self.particle(b)?);
         let length = scalar(length, "unstretched length")?;
-        let id = self
-            .inner
-            .add_elastic_distance(a, b, (length, share), ea)
-            .map_err(to_py)?;
+        let id = self.over(&[a, b], "elastic segment", |s, p| {
+            s.add_elastic_distance(p[0], p[1], (length, share), ea)
+        })?;
         Ok(PyConstraintId { index: id.0 })
     }
 
@@ -257,12 +271,10 @@ impl PySystem {
         point: &Bound<'_, PyAny>,
         length: Option<f64>,
     ) -> PyResult<PyConstraintId> {
-        let p = self.particle(particle)?;
         let point = vector(point, "point")?;
-        let id = self
-            .inner
-            .add_distance_to_point(p, point, length)
-            .map_err(to_py)?;
+        let id = self.over(&[particle], "distance to a moving point", |s, p| {
+            s.add_distance_to_point(p[0], point, length)
+        })?;
         Ok(PyConstraintId { index: id.0 })
     }
 
@@ -273,12 +285,11 @@ impl PySystem {
         normal: &Bound<'_, PyAny>,
         point: &Bound<'_, PyAny>,
     ) -> PyResult<PyConstraintId> {
-        let p = self.particle(particle)?;
         let (n, p0) = (
             vector(normal, "plane normal")?,
             vector(point, "plane point")?,
         );
-        let id = self.inner.add_plane(p, n, p0).map_err(to_py)?;
+        let id = self.over(&[particle], "plane", |s, p| s.add_plane(p[0], n, p0))?;
         Ok(PyConstraintId { index: id.0 })
     }
 
@@ -290,25 +301,13 @@ impl PySystem {
         axis: &Bound<'_, PyAny>,
         value: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<PyConstraintId> {
-        let p = self.particle(particle)?;
-        let axis = if let Ok(s) = axis.extract::<String>() {
-            match s.as_str() {
-                "x" => 0,
-                "y" => 1,
-                "z" => 2,
-                _ => return Err(invalid("axis", s, "expected 0, 1, 2 or 'x', 'y', 'z'")),
-            }
-        } else {
-            axis.extract::<usize>()
-                .map_err(|_| invalid("axis", axis, "expected 0, 1, 2 or 'x', 'y', 'z'"))?
-        };
+        let axis = axis_index(axis)?;
         let value = value
             .map(|v| scalar(v, "fixed coordinate value"))
             .transpose()?;
-        let id = self
-            .inner
-            .add_fixed_coordinate(p, axis, value)
-            .map_err(to_py)?;
+        let id = self.over(&[particle], "fixed coordinate", |s, p| {
+            s.add_fixed_coordinate(p[0], axis, value)
+        })?;
         Ok(PyConstraintId { index: id.0 })
     }
 
@@ -322,11 +321,9 @@ impl PySystem {
         damping: f64,
         rest_length: Option<f64>,
     ) -> PyResult<PyForceId> {
-        let (a, b) = (self.particle(a)?, self.particle(b)?);
-        let id = self
-            .inner
-            .add_spring_damper(a, b, stiffness, damping, rest_length)
-            .map_err(to_py)?;
+        let id = self.over(&[a, b], "spring-damper", |s, p| {
+            s.add_spring_damper(p[0], p[1], stiffness, damping, rest_length)
+        })?;
         Ok(PyForceId { index: id.0 })
     }
 
@@ -341,11 +338,9 @@ impl PySystem {
         ei: f64,
         spacing: Option<f64>,
     ) -> PyResult<PyForceId> {
-        let (a, b, c) = (self.particle(a)?, self.particle(b)?, self.particle(c)?);
-        let id = self
-            .inner
-            .add_bending(a, b, c, ei, spacing)
-            .map_err(to_py)?;
+        let id = self.over(&[a, b, c], "bending", |s, p| {
+            s.add_bending(p[0], p[1], p[2], ei, spacing)
+        })?;
         Ok(PyForceId { index: id.0 })
     }
 
@@ -355,9 +350,8 @@ impl PySystem {
         particle: &Bound<'_, PyAny>,
         force: &Bound<'_, PyAny>,
     ) -> PyResult<PyForceId> {
-        let p = self.particle(particle)?;
         let f = vector(force, "force")?;
-        let id = self.inner.add_force(p, f).map_err(to_py)?;
+        let id = self.over(&[particle], "applied force", |s, p| s.add_force(p[0], f))?;
         Ok(PyForceId { index: id.0 })
     }
 
@@ -367,8 +361,9 @@ impl PySystem {
         particle: &Bound<'_, PyAny>,
         coefficient: f64,
     ) -> PyResult<PyForceId> {
-        let p = self.particle(particle)?;
-        let id = self.inner.add_linear_drag(p, coefficient).map_err(to_py)?;
+        let id = self.over(&[particle], "linear drag", |s, p| {
+            s.add_linear_drag(p[0], coefficient)
+        })?;
         Ok(PyForceId { index: id.0 })
     }
 
@@ -378,10 +373,129 @@ impl PySystem {
         particle: &Bound<'_, PyAny>,
         coefficient: f64,
     ) -> PyResult<PyForceId> {
-        let p = self.particle(particle)?;
+        let id = self.over(&[particle], "quadratic drag", |s, p| {
+            s.add_quadratic_drag(p[0], coefficient)
+        })?;
+        Ok(PyForceId { index: id.0 })
+    }
+
+    /// q_b[axis] - q_a[axis] = value(t) (None: the current difference), over particles or points.
+    #[pyo3(signature = (a, b, axis, value=None))]
+    fn add_relative_coordinate(
+        &mut self,
+        a: &Bound<'_, PyAny>,
+        b: &Bound<'_, PyAny>,
+        axis: &Bound<'_, PyAny>,
+        value: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<PyConstraintId> {
+        let axis = axis_index(axis)?;
+        let value = value
+            .map(|v| scalar(v, "relative coordinate value"))
+            .transpose()?;
+        let id = self.over(&[a, b], "relative coordinate", |s, p| {
+            s.add_relative_coordinate(p[0], p[1], axis, value)
+        })?;
+        Ok(PyConstraintId { index: id.0 })
+    }
+
+    /// (q_b - q_a) . (q_d - q_c) = value(t) (None: the current value), over particles or points.
+    #[pyo3(signature = (a, b, c, d, value=None))]
+    fn add_dot_product(
+        &mut self,
+        a: &Bound<'_, PyAny>,
+        b: &Bound<'_, PyAny>,
+        c: &Bound<'_, PyAny>,
+        d: &Bound<'_, PyAny>,
+        value: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<PyConstraintId> {
+        let value = value.map(|v| scalar(v, "dot product value")).transpose()?;
+        let id = self.over(&[a, b, c, d], "dot product", |s, p| {
+            s.add_dot_product([p[0], p[1], p[2], p[3]], value)
+        })?;
+        Ok(PyConstraintId { index: id.0 })
+    }
+
+    /// The point of `body` (a rigid body's dict, a frame of 3 or 4 ParticleIds) at world
+    /// position `position` now; with body None, the ground point there.
+    fn point(
+        &self,
+        body: Option<&Bound<'_, PyAny>>,
+        position: &Bound<'_, PyAny>,
+    ) -> PyResult<PyPoint> {
+        let frame = self.frame(body, "body")?;
+        let at = vec3(position, "position")?;
+        let point = if frame.is_empty() {
+            vinculo::model::Point::ground(at)
+        } else {
+            self.inner.point_in(&frame, at).map_err(to_py)?
+        };
+        Ok(self.make_point(point))
+    }
+
+    /// A joint of `kind` ("spherical", "revolute", "prismatic", "fixed", "point-on-line",
+    /// "point-on-plane") between bodies a and b (None: the ground) at world point `at` with
+    /// axis `axis`; returns its equations' ConstraintIds.
+    #[pyo3(signature = (kind, a, b, at, axis=None))]
+    fn add_joint(
+        &mut self,
+        kind: &str,
+        a: Option<&Bound<'_, PyAny>>,
+        b: Option<&Bound<'_, PyAny>>,
+        at: &Bound<'_, PyAny>,
+        axis: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Vec<PyConstraintId>> {
+        use vinculo::model::JointKind;
+        let kind = match kind {
+            "spherical" => JointKind::Spherical,
+            "revolute" => JointKind::Revolute,
+            "prismatic" => JointKind::Prismatic,
+            "fixed" => JointKind::Fixed,
+            "point-on-line" => JointKind::PointOnLine,
+            "point-on-plane" => JointKind::PointOnPlane,
+            other => {
+                return Err(invalid(
+                    "kind",
+                    other,
+                    "expected 'spherical', 'revolute', 'prismatic', 'fixed', 'point-on-line' or 'point-on-plane'",
+                ))
+            }
+        };
+        let needs_axis = !matches!(kind, JointKind::Spherical | JointKind::Fixed);
+        let axis = match axis {
+            Some(a) => vec3(a, "axis")?,
+            None if needs_axis => {
+                return Err(invalid(
+                    "axis",
+                    "None",
+                    &format!("a {} needs its axis (3 numbers)", kind.name()),
+                ))
+            }
+            None => [0.0, 0.0, 1.0],
+        };
+        let (fa, fb) = (self.frame(a, "a")?, self.frame(b, "b")?);
+        let at = vec3(at, "at")?;
+        let ids = self
+            .inner
+            .add_joint(kind, (&fa, &fb), at, axis)
+            .map_err(to_py)?;
+        Ok(ids.iter().map(|c| PyConstraintId { index: c.0 }).collect())
+    }
+
+    /// A torque (N m; a number or a Law) about the world axis `axis` through `at` on `body`.
+    #[pyo3(signature = (body, torque, axis, at))]
+    fn add_torque(
+        &mut self,
+        body: &Bound<'_, PyAny>,
+        torque: &Bound<'_, PyAny>,
+        axis: &Bound<'_, PyAny>,
+        at: &Bound<'_, PyAny>,
+    ) -> PyResult<PyForceId> {
+        let frame = self.frame(Some(body), "body")?;
+        let torque = scalar(torque, "torque")?;
+        let (axis, at) = (vec3(axis, "axis")?, vec3(at, "at")?);
         let id = self
             .inner
-            .add_quadratic_drag(p, coefficient)
+            .add_torque(&frame, at, axis, torque)
             .map_err(to_py)?;
         Ok(PyForceId { index: id.0 })
     }
@@ -445,6 +559,7 @@ impl PySystem {
         d.set_item("vertices", ids(&body.vertices))?;
         d.set_item("points", ids(&body.points))?;
         d.set_item("particles", ids(&body.particles))?;
+        d.set_item("frame", ids(&body.frame()))?;
         let constraints: Vec<PyConstraintId> = body
             .constraints
             .iter()
