@@ -122,3 +122,114 @@ def test_a_redundant_joint_is_named():
     system.add_joint("revolute", first, second, joint, Y)
     with pytest.raises(vinculo.RedundantConstraintsError, match="revolute joint #2"):
         vinculo.simulate(system, t_end=0.1, dt=1e-3)
+
+
+def planar_bar(system, mass, start, end, **kwargs):
+    """A planar bar (in the x-z plane) from `start` to `end`: inertia m L^2 / 12 about y."""
+    start, end = np.asarray(start, float), np.asarray(end, float)
+    length = np.linalg.norm(end - start)
+    return system.add_planar_body(
+        mass, tuple((start + end) / 2), mass * length**2 / 12, normal="y", **kwargs
+    )
+
+
+def xz(x, z):
+    return (x, 0.0, z)
+
+
+def driven_crank(system, crank, pin, phi0, omega):
+    """Drives the crank's pin (at angle phi from +x, in the x-z plane) at phi = phi0 + omega t:
+    the pin stays on the plane through the origin of normal (-sin phi, 0, cos phi)."""
+    phi = vinculo.laws.polynomial([phi0, omega])
+    normal = (-vinculo.laws.sin(phi), 0.0, vinculo.laws.cos(phi))
+    return system.add_plane(system.point(crank, pin), normal, (0.0, 0.0, 0.0))
+
+
+def test_a_four_bar_linkage_follows_its_closed_form_kinematics():
+    # A crank-rocker (Grashof: 0.25 + 0.8 <= 0.7 + 0.5) of planar bars and four revolute joints,
+    # the crank turned at 1 rev/s. The coupler's far end B is where the circles about the crank
+    # pin A (radius r3) and the rocker's pivot O4 (radius r4) meet: the linkage is driven, so its
+    # positions are the constraints' alone, to the solver's tolerance.
+    r2, r3, r4, d = 0.25, 0.7, 0.5, 0.8
+    omega, phi0 = 2 * math.pi, 0.3
+
+    def closed_form(phi):
+        a = np.array([r2 * math.cos(phi), r2 * math.sin(phi)])
+        gap = np.array([d, 0.0]) - a
+        dist = np.linalg.norm(gap)
+        along = (r3**2 - r4**2 + dist**2) / (2 * dist)
+        height = math.sqrt(r3**2 - along**2)
+        b = a + along * gap / dist + height * np.array([-gap[1], gap[0]]) / dist
+        return a, b
+
+    a0, b0 = closed_form(phi0)
+    system = vinculo.System(gravity=(0.0, 0.0, -G))
+    crank = planar_bar(system, 0.5, xz(0, 0), xz(*a0))
+    coupler = planar_bar(system, 1.2, xz(*a0), xz(*b0))
+    rocker = planar_bar(system, 0.9, xz(d, 0), xz(*b0))
+    system.add_joint("revolute", None, crank, xz(0, 0), Y)
+    system.add_joint("revolute", crank, coupler, xz(*a0), Y)
+    system.add_joint("revolute", coupler, rocker, xz(*b0), Y)
+    system.add_joint("revolute", rocker, None, xz(d, 0), Y)
+    driven_crank(system, crank, xz(*a0), phi0, omega)
+    # The bodies start at rest: the projection gives them the velocities of the driven motion.
+    system.project_initial_state()
+    tip = system.point(coupler, xz(*b0))
+    solution = vinculo.simulate(system, t_end=1.0, dt=1e-3)
+    q = solution.positions
+    for k in range(0, len(solution.times), 50):
+        _, b = closed_form(phi0 + omega * solution.times[k])
+        assert np.allclose(tip.position(q[k]), xz(*b), rtol=0, atol=1e-10)
+    # One full turn of the crank brings every body back.
+    np.testing.assert_allclose(q[-1], q[0], rtol=0, atol=1e-10)
+
+
+def test_a_slider_crank_follows_its_closed_form_kinematics():
+    # Crank r, rod l, slider on the x axis: x_B = r cos(phi) + sqrt(l^2 - r^2 sin(phi)^2) and its
+    # rate x_B' = -r w sin(phi) (1 + r cos(phi) / sqrt(l^2 - r^2 sin(phi)^2)). Positions to the
+    # solver's tolerance; the slider's velocity to the trapezoidal rule's O(dt^2).
+    r, rod, omega, phi0 = 0.2, 0.6, 2 * math.pi, 0.0
+    system = vinculo.System(gravity=(0.0, 0.0, -G))
+    a0 = (r * math.cos(phi0), r * math.sin(phi0))
+    b0 = (a0[0] + math.sqrt(rod**2 - a0[1] ** 2), 0.0)
+    crank = planar_bar(system, 0.4, xz(0, 0), xz(*a0))
+    connecting_rod = planar_bar(system, 1.0, xz(*a0), xz(*b0))
+    slider = system.add_planar_body(2.0, xz(*b0), 0.01, normal="y")
+    system.add_joint("revolute", None, crank, xz(0, 0), Y)
+    system.add_joint("revolute", crank, connecting_rod, xz(*a0), Y)
+    system.add_joint("revolute", connecting_rod, slider, xz(*b0), Y)
+    system.add_joint("prismatic", None, slider, xz(*b0), (1.0, 0.0, 0.0))
+    driven_crank(system, crank, xz(*a0), phi0, omega)
+    system.project_initial_state()
+    errors = []
+    for dt in (2e-3, 1e-3):
+        solution = vinculo.simulate(system, t_end=1.0, dt=dt)
+        t = solution.times
+        phi = phi0 + omega * t
+        root = np.sqrt(rod**2 - (r * np.sin(phi)) ** 2)
+        # The slider's centre: the mean of its three particles of equal mass.
+        x = np.mean([solution.particle(p)[:, 0] for p in slider["particles"]], axis=0)
+        np.testing.assert_allclose(x, r * np.cos(phi) + root, rtol=0, atol=1e-10)
+        rate = -r * omega * np.sin(phi) * (1 + r * np.cos(phi) / root)
+        velocity = np.mean(
+            [solution.particle_velocity(p)[:, 0] for p in slider["particles"]], axis=0
+        )
+        errors.append(np.max(np.abs(velocity - rate)))
+    assert errors[1] < 1e-3 * r * omega
+    assert 3.5 < errors[0] / errors[1] < 4.5
+
+
+def test_a_torque_turns_a_pinned_bar_at_its_closed_form_rate():
+    # A bar pinned at one end, no gravity, a constant torque tau about the pin's axis:
+    # theta = tau t^2 / (2 I_O), I_O = m L^2 / 3.
+    mass, length, tau = 1.5, 0.8, 0.4
+    system = vinculo.System(gravity=(0.0, 0.0, 0.0))
+    rod = planar_bar(system, mass, xz(0, 0), xz(length, 0))
+    system.add_joint("revolute", None, rod, xz(0, 0), Y)
+    system.add_torque(rod, tau, Y, xz(0, 0))
+    solution = vinculo.simulate(system, t_end=1.0, dt=1e-3)
+    centre = np.mean([solution.particle(p) for p in rod["particles"]], axis=0)
+    # A positive torque about +y turns +x towards -z.
+    theta = np.unwrap(np.arctan2(-centre[:, 2], centre[:, 0]))
+    expected = tau * solution.times**2 / (2 * mass * length**2 / 3)
+    np.testing.assert_allclose(theta, expected, rtol=0, atol=1e-6)

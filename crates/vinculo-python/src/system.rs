@@ -500,6 +500,49 @@ impl PySystem {
         Ok(PyForceId { index: id.0 })
     }
 
+    /// A planar rigid body moving in the plane normal to axis `normal` ("x", "y", "z"): three
+    /// particles with its mass, centre and moment of inertia about the normal.
+    #[pyo3(signature = (mass, centre, inertia, normal=None, velocity=None, angular_velocity=0.0))]
+    fn add_planar_body<'py>(
+        &mut self,
+        py: Python<'py>,
+        mass: f64,
+        centre: &Bound<'_, PyAny>,
+        inertia: f64,
+        normal: Option<&Bound<'_, PyAny>>,
+        velocity: Option<&Bound<'_, PyAny>>,
+        angular_velocity: f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let spec = vinculo::model::PlanarBodySpec {
+            mass,
+            centre: vec3(centre, "centre")?,
+            inertia,
+            normal: normal.map(axis_index).transpose()?.unwrap_or(1),
+            velocity: velocity
+                .map(|v| vec3(v, "velocity"))
+                .transpose()?
+                .unwrap_or([0.0; 3]),
+            angular_velocity,
+        };
+        let body = self.inner.add_planar_body(&spec).map_err(to_py)?;
+        let ids: Vec<PyParticleId> = body
+            .particles
+            .iter()
+            .map(|&inner| PyParticleId { inner })
+            .collect();
+        let d = PyDict::new(py);
+        d.set_item("particles", ids.clone())?;
+        d.set_item("frame", ids)?;
+        let constraints: Vec<PyConstraintId> = body
+            .constraints
+            .iter()
+            .map(|c| PyConstraintId { index: c.0 })
+            .collect();
+        d.set_item("constraints", constraints)?;
+        d.set_item("normal", ["x", "y", "z"][body.normal])?;
+        Ok(d)
+    }
+
     /// A rigid body made of particles: same mass, centre and inertia tensor, exactly rigid.
     ///
     /// Returns a dict with "centre", "vertices", "points", "particles" (ParticleIds),

@@ -15,6 +15,13 @@
 //! - fixed: spherical and the three orientation equations (6);
 //! - point on a line of A: the two line equations; point on a plane of A (normal n): one.
 //!
+//! Between planar bodies (or a planar body and the ground) of one plane, a joint keeps only its
+//! in-plane equations: with u, v the in-plane world axes, d the joint's in-plane direction and
+//! p = e_normal x d, spherical and revolute are the two relative coordinates along u and v;
+//! prismatic is d^A . p^B = 0 and (x_B - x_A) . p^A = 0; fixed is the two coordinates and
+//! d^A . p^B = 0; point on a line (along d) is (x_B - x_A) . p^A = 0; point on a "plane" of
+//! normal n (a line in the plane) is (x_B - x_A) . n^A = 0.
+//!
 //! The orientation equations hold for a small relative rotation w, e1^B = e1 + w x e1, ...:
 //! n . (w x e1) = -w . e2, n . (w x e2) = w . e1, e1 . (w x e2) = -w . n, so together they
 //! fix every relative rotation and the two axis equations leave only the one about n.
@@ -104,6 +111,53 @@ impl System {
             });
         }
         let n = scale(1.0 / length, axis);
+        let built = match self.plane_of(&label, a, b)? {
+            None => self.joint_in_space(kind, (a, b), at, n, &label)?,
+            Some(normal) => self.joint_in_plane(kind, (a, b), at, (n, normal), &label)?,
+        };
+        self.joints += 1;
+        Ok(built.constraints)
+    }
+
+    /// The normal axis of the plane of a joint between planar bodies (None in space).
+    fn plane_of(&self, label: &str, a: &[ParticleId], b: &[ParticleId]) -> Result<Option<usize>> {
+        let normal = |f: &[ParticleId]| -> Result<Option<usize>> {
+            match f.len() {
+                0 | 4 => Ok(None),
+                3 => self.frame_normal(f).map(Some),
+                n => Err(Error::InvalidParameter {
+                    name: format!("frame of a body of {label}"),
+                    value: n as f64,
+                    expected: "give a rigid body's 4 frame particles, a planar body's 3, or \
+                               none (the ground)"
+                        .into(),
+                }),
+            }
+        };
+        let (na, nb) = (normal(a)?, normal(b)?);
+        let mixed =
+            |planar: &[ParticleId], other: &[ParticleId]| planar.len() == 3 && other.len() == 4;
+        if mixed(a, b) || mixed(b, a) || matches!((na, nb), (Some(x), Some(y)) if x != y) {
+            return Err(Error::InvalidParameter {
+                name: format!("bodies of {label}"),
+                value: f64::NAN,
+                expected: "a planar body joins the ground or planar bodies of the same plane \
+                           normal"
+                    .into(),
+            });
+        }
+        Ok(na.or(nb))
+    }
+
+    /// The equations of a joint in space (module doc).
+    fn joint_in_space(
+        &mut self,
+        kind: JointKind,
+        (a, b): (&[ParticleId], &[ParticleId]),
+        at: Vec3,
+        n: Vec3,
+        label: &str,
+    ) -> Result<Built> {
         let (e1, e2) = triad(n);
         let offset = |d: Vec3| [at[0] + d[0], at[1] + d[1], at[2] + d[2]];
         // Points 0..3: A at `at`, +n, +e1, +e2; 4..7: the same of B.
@@ -114,7 +168,7 @@ impl System {
                 points.push(self.body_point(frame, offset(d))?);
             }
         }
-        let (_, built) = self.on_points(&points, &label, |s, p| {
+        let (_, built) = self.on_points(&points, label, |s, p| {
             let coincide = |s: &mut System| -> Result<()> {
                 for axis in 0..3 {
                     s.add_relative_coordinate(p[0], p[4], axis, Some(Law::Constant(0.0)))?;
@@ -159,8 +213,94 @@ impl System {
             }
             Ok(())
         })?;
-        self.joints += 1;
-        Ok(built.constraints)
+        Ok(built)
+    }
+
+    /// The equations of a joint between planar bodies of normal axis `normal` (module doc):
+    /// in the plane, a shared point is 2 equations and a shared direction 1.
+    fn joint_in_plane(
+        &mut self,
+        kind: JointKind,
+        (a, b): (&[ParticleId], &[ParticleId]),
+        at: Vec3,
+        (n, normal): (Vec3, usize),
+        label: &str,
+    ) -> Result<Built> {
+        let (u, v) = super::planar_body::in_plane(normal);
+        let along_normal = (n[normal].abs() - 1.0).abs() < 1e-12;
+        let turning = matches!(
+            kind,
+            JointKind::Spherical | JointKind::Revolute | JointKind::Fixed
+        );
+        // The in-plane direction d of a slider or line (e_u for a joint that turns), and its
+        // normal p in the plane.
+        let d = if turning {
+            std::array::from_fn(|k| if k == u { 1.0 } else { 0.0 })
+        } else if n[normal].abs() < 1e-12 {
+            n
+        } else {
+            return Err(Error::InvalidVector {
+                name: format!("axis of {label}"),
+                value: n.to_vec(),
+                expected: format!(
+                    "must lie in the bodies' plane (component {} = 0)",
+                    ["x", "y", "z"][normal]
+                ),
+            });
+        };
+        if turning && !along_normal && kind == JointKind::Revolute {
+            return Err(Error::InvalidVector {
+                name: format!("axis of {label}"),
+                value: n.to_vec(),
+                expected: format!(
+                    "a revolute joint of planar bodies turns about their plane's normal, the {} axis",
+                    ["x", "y", "z"][normal]
+                ),
+            });
+        }
+        let mut e_normal = [0.0; 3];
+        e_normal[normal] = 1.0;
+        let p = cross(e_normal, d);
+        let offset = |x: Vec3| [at[0] + x[0], at[1] + x[1], at[2] + x[2]];
+        // Points 0..2: A at `at`, +d, +p; 3..5: the same of B.
+        let mut points = Vec::with_capacity(6);
+        for frame in [a, b] {
+            points.push(self.body_point(frame, at)?);
+            points.push(self.body_point(frame, offset(d))?);
+            points.push(self.body_point(frame, offset(p))?);
+        }
+        let (_, built) = self.on_points(&points, label, |s, q| {
+            let zero = || Some(Law::Constant(0.0));
+            let coincide = |s: &mut System| -> Result<()> {
+                s.add_relative_coordinate(q[0], q[3], u, zero())?;
+                s.add_relative_coordinate(q[0], q[3], v, zero())?;
+                Ok(())
+            };
+            // d^A . p^B = 0: no relative rotation.
+            let aligned = |s: &mut System| s.add_dot_product([q[0], q[1], q[3], q[5]], zero());
+            // (x_B - x_A) . p^A = 0: B's point on A's line along d.
+            let on_line = |s: &mut System| s.add_dot_product([q[0], q[3], q[0], q[2]], zero());
+            match kind {
+                JointKind::Spherical | JointKind::Revolute => coincide(s)?,
+                JointKind::Prismatic => {
+                    aligned(s)?;
+                    on_line(s)?;
+                }
+                JointKind::Fixed => {
+                    coincide(s)?;
+                    aligned(s)?;
+                }
+                JointKind::PointOnLine => {
+                    on_line(s)?;
+                }
+                JointKind::PointOnPlane => {
+                    // In the plane, a "plane" of normal n through `at` is the line along p.
+                    s.add_dot_product([q[0], q[3], q[0], q[1]], zero())?;
+                }
+            }
+            Ok(())
+        })?;
+        Ok(built)
     }
 
     /// A torque `torque(t)` (N m) about the world axis `axis` on the body `frame`, turning about
