@@ -255,8 +255,8 @@ def test_a_tumbling_body_flips_about_its_intermediate_axis_as_eulers_equations_s
     spans = [q[:, vertices[2 * k]] - q[:, vertices[2 * k + 1]] for k in range(3)]
     rates = [v[:, vertices[2 * k]] - v[:, vertices[2 * k + 1]] for k in range(3)]
     lengths = [np.linalg.norm(s[0]) for s in spans]
-    axes = [s / n for s, n in zip(spans, lengths)]
-    omega = 0.5 * sum(np.cross(e, r / n) for e, r, n in zip(axes, rates, lengths))
+    axes = [s / n for s, n in zip(spans, lengths, strict=True)]
+    omega = 0.5 * sum(np.cross(e, r / n) for e, r, n in zip(axes, rates, lengths, strict=True))
     body_omega = np.stack([np.sum(omega * e, axis=1) for e in axes], axis=1)
     # The octahedron's axes are principal and right-handed: Euler's equations hold in them, with
     # the moments and the initial spin projected on them.
