@@ -14,7 +14,7 @@ Example:
 
 from importlib.metadata import PackageNotFoundError, version
 
-from vinculo._core import ConstraintId, ForceId, Law, ParticleId, System, UserGroup
+from vinculo._core import ConstraintId, ForceId, Law, ParticleId, Point, System, UserGroup
 from vinculo.errors import (
     ConvergenceError,
     InconsistentInitialStateError,
@@ -62,6 +62,7 @@ __all__ = [
     "NegativeTensionError",
     "OutputTooLargeError",
     "ParticleId",
+    "Point",
     "RedundantConstraintsError",
     "ReentrantRunError",
     "RunOptions",

@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from vinculo import _core
-from vinculo._core import ConstraintId, ParticleId, System
+from vinculo._core import ConstraintId, ParticleId, Point, System
 from vinculo.errors import InvalidInputError, UnknownHandleError
 
 __all__ = ["Solution"]
@@ -186,6 +186,51 @@ class Solution:
         index = self._index(particle, ParticleId, self.positions.shape[1], "particle")
         return self.positions[:, index, :]
 
+    def point(self, point: Point) -> np.ndarray:
+        """Trajectory of a point fixed in a body or in the ground (``System.point``).
+
+        Arguments:
+            point: the point (a combination of particles with constant weights).
+
+        Returns:
+            (s, 3) positions of the point at the stored times.
+
+        Raises:
+            InvalidInputError: if the point uses a particle this solution does not have.
+        """
+        return self._combine(point, self.positions, offset=True)
+
+    def point_velocity(self, point: Point) -> np.ndarray:
+        """Velocity history of a point fixed in a body or in the ground (``System.point``).
+
+        Arguments:
+            point: the point.
+
+        Returns:
+            (s, 3) velocities of the point at the stored times.
+
+        Raises:
+            InvalidInputError: if the point uses a particle this solution does not have.
+        """
+        return self._combine(point, self.velocities, offset=False)
+
+    def _combine(self, point: Point, values: np.ndarray, offset: bool) -> np.ndarray:
+        """sum_k w_k values[:, p_k] (+ the point's constant position when ``offset``)."""
+        weights = point.weights
+        count = values.shape[1]
+        if any(p >= count for p, _ in weights):
+            raise InvalidInputError(
+                f"{point!r} uses a particle this solution of {count} particles does not have",
+                name="point",
+                value=point,
+            )
+        out = np.zeros((values.shape[0], 3))
+        if offset:
+            out += np.asarray(point.position(np.zeros((count, 3))))
+        for p, w in weights:
+            out += w * values[:, p, :]
+        return out
+
     def particle_velocity(self, particle: ParticleId) -> np.ndarray:
         """Velocity history of one particle.
 
@@ -217,9 +262,7 @@ class Solution:
         index = self._index(constraint, ConstraintId, self.multipliers.shape[1], "constraint")
         return self.multipliers[:, index]
 
-    def distance_tension(
-        self, constraint: ConstraintId, length: float | None = None
-    ) -> np.ndarray:
+    def distance_tension(self, constraint: ConstraintId, length: float | None = None) -> np.ndarray:
         """Tension in a distance constraint (a massless rigid link).
 
         With ``Phi = L^2 - |q_a - q_b|^2`` the constraint force on ``a`` is

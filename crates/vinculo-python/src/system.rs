@@ -547,7 +547,7 @@ impl PySystem {
     ///
     /// Returns a dict with "centre", "vertices", "points", "particles" (ParticleIds),
     /// "constraints" (ConstraintIds) and "axes" (principal axes as columns).
-    #[pyo3(signature = (mass, centre, inertia, velocity=None, angular_velocity=None, points=None, point_mass_fraction=0.01))]
+    #[pyo3(signature = (mass, centre, inertia, velocity=None, angular_velocity=None, points=None, point_mass_fraction=0.01, particles=7))]
     #[allow(clippy::too_many_arguments)]
     fn add_rigid_body<'py>(
         &mut self,
@@ -559,6 +559,7 @@ impl PySystem {
         angular_velocity: Option<&Bound<'_, PyAny>>,
         points: Option<Vec<Bound<'_, PyAny>>>,
         point_mass_fraction: f64,
+        particles: usize,
     ) -> PyResult<Bound<'py, PyDict>> {
         let rows: Vec<Vec<f64>> = inertia.extract().map_err(|_| {
             invalid(
@@ -593,10 +594,39 @@ impl PySystem {
                 .collect::<PyResult<_>>()?,
             point_mass_fraction,
         };
-        let body = self.inner.add_rigid_body(&spec).map_err(to_py)?;
         let ids = |v: &[ParticleId]| -> Vec<PyParticleId> {
             v.iter().map(|&inner| PyParticleId { inner }).collect()
         };
+        match particles {
+            7 => {}
+            4 => {
+                let body = self.inner.add_rigid_tetrahedron(&spec).map_err(to_py)?;
+                let d = PyDict::new(py);
+                d.set_item("particles", ids(&body.particles))?;
+                d.set_item("frame", ids(&body.particles))?;
+                let centre = self
+                    .inner
+                    .point_in(&body.particles, spec.centre)
+                    .map_err(to_py)?;
+                d.set_item("centre", self.make_point(centre))?;
+                let constraints: Vec<PyConstraintId> = body
+                    .constraints
+                    .iter()
+                    .map(|c| PyConstraintId { index: c.0 })
+                    .collect();
+                d.set_item("constraints", constraints)?;
+                d.set_item("axes", body.axes.map(|r| r.to_vec()).to_vec())?;
+                return Ok(d);
+            }
+            n => {
+                return Err(invalid(
+                    "particles",
+                    n,
+                    "expected 7 (an octahedron and its centre) or 4 (a tetrahedron)",
+                ))
+            }
+        }
+        let body = self.inner.add_rigid_body(&spec).map_err(to_py)?;
         let d = PyDict::new(py);
         d.set_item("centre", PyParticleId { inner: body.centre })?;
         d.set_item("vertices", ids(&body.vertices))?;

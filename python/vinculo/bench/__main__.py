@@ -11,7 +11,8 @@ integration, model building excluded). The last row is the buoy of the case stud
 (``vinculo.bench.buoy``). ``python -m vinculo.bench work-precision`` prints the work-precision
 table of error-controlled runs instead (:mod:`vinculo.bench.work_precision`), and
 ``python -m vinculo.bench python-overhead`` the cost of the Python layer
-(:mod:`vinculo.bench.python_overhead`).
+(:mod:`vinculo.bench.python_overhead`), and ``python -m vinculo.bench rigid-chain`` a chain of
+rigid bodies and revolute joints against Exudyn (:mod:`vinculo.bench.rigid_chain`).
 """
 
 from __future__ import annotations
@@ -192,7 +193,7 @@ def compare(quick: bool = False, repeat: int = 3, out=print) -> bool:
 def main(argv: list[str] | None = None) -> int:
     """Command line entry point (``work-precision`` as the first argument: the work-precision
     table of :mod:`vinculo.bench.work_precision`; ``python-overhead``:
-    :mod:`vinculo.bench.python_overhead`)."""
+    :mod:`vinculo.bench.python_overhead`; ``rigid-chain``: :mod:`vinculo.bench.rigid_chain`)."""
     argv = sys.argv[1:] if argv is None else argv
     if argv[:1] == ["work-precision"]:
         from vinculo.bench import work_precision
@@ -202,6 +203,10 @@ def main(argv: list[str] | None = None) -> int:
         from vinculo.bench import python_overhead
 
         return python_overhead.main(argv[1:])
+    if argv[:1] == ["rigid-chain"]:
+        from vinculo.bench import rigid_chain
+
+        return rigid_chain.main(argv[1:])
     parser = argparse.ArgumentParser(prog="python -m vinculo.bench", description=__doc__)
     parser.add_argument("--quick", action="store_true", help="small models only (smoke run)")
     parser.add_argument("--no-scaling", action="store_true", help="skip the scaling run")

@@ -9,6 +9,7 @@ mod planar_body;
 mod point;
 mod rigid_body;
 mod system;
+mod tetrahedron_body;
 pub mod user_groups;
 
 pub use joints::JointKind;
@@ -19,3 +20,4 @@ pub use planar_body::{PlanarBody, PlanarBodySpec};
 pub use point::{Point, PointMap};
 pub use rigid_body::{RigidBody, RigidBodySpec};
 pub use system::System;
+pub use tetrahedron_body::TetrahedronBody;

@@ -113,7 +113,7 @@ fn det(a: Vec3, b: Vec3, c: Vec3) -> f64 {
 
 /// Principal axes and second moments of a symmetric 3 x 3 matrix (ascending), world axes when it
 /// is isotropic, always right-handed.
-fn principal(j: &Mat3) -> Result<(Vec3, Mat3)> {
+pub(super) fn principal(j: &Mat3) -> Result<(Vec3, Mat3)> {
     let m = faer::Mat::<f64>::from_fn(3, 3, |r, c| j[r][c]);
     let evd = m
         .self_adjoint_eigen(faer::Side::Lower)
@@ -136,6 +136,41 @@ fn principal(j: &Mat3) -> Result<(Vec3, Mat3)> {
         }
     }
     Ok((values, axes))
+}
+
+/// The validated mass, centre, velocity, angular velocity and second moment of mass
+/// J = tr(I)/2 1 - I about the centre (module doc) of a body.
+pub(super) fn checked(spec: &RigidBodySpec) -> Result<(f64, Vec3, Vec3, Vec3, Mat3)> {
+    let m = positive("mass of the rigid body", spec.mass)?;
+    let c = finite_vector("centre of the rigid body", spec.centre)?;
+    let v = finite_vector("velocity of the rigid body", spec.velocity)?;
+    let w = finite_vector("angular velocity of the rigid body", spec.angular_velocity)?;
+    let inertia = spec.inertia;
+    let size = inertia
+        .iter()
+        .flatten()
+        .fold(0.0_f64, |a, x| a.max(x.abs()));
+    for r in 0..3 {
+        finite_vector(format!("row {r} of the inertia tensor"), inertia[r])?;
+        for k in 0..3 {
+            if (inertia[r][k] - inertia[k][r]).abs() > 1e-12 * size {
+                return Err(Error::InvalidVector {
+                    name: format!("row {r} of the inertia tensor"),
+                    value: inertia[r].to_vec(),
+                    expected: format!(
+                        "the tensor must be symmetric, but I[{r}][{k}] = {} and I[{k}][{r}] = {}",
+                        inertia[r][k], inertia[k][r]
+                    ),
+                });
+            }
+        }
+    }
+    let trace = inertia[0][0] + inertia[1][1] + inertia[2][2];
+    let j: Mat3 = std::array::from_fn(|r| {
+        std::array::from_fn(|k| if r == k { 0.5 * trace } else { 0.0 } - inertia[r][k])
+    });
+
+    Ok((m, c, v, w, j))
 }
 
 /// The octahedron with mass `m`, centre `c` and second moment `j` about `c`.
@@ -175,30 +210,7 @@ impl System {
     /// Invalid mass, non-finite or non-symmetric inertia, a flat or linear body, a bad
     /// `point_mass_fraction`, or (should the geometry be degenerate) redundant constraints.
     pub fn add_rigid_body(&mut self, spec: &RigidBodySpec) -> Result<RigidBody> {
-        let m = positive("mass of the rigid body", spec.mass)?;
-        let c = finite_vector("centre of the rigid body", spec.centre)?;
-        let v = finite_vector("velocity of the rigid body", spec.velocity)?;
-        let w = finite_vector("angular velocity of the rigid body", spec.angular_velocity)?;
-        let inertia = spec.inertia;
-        let size = inertia
-            .iter()
-            .flatten()
-            .fold(0.0_f64, |a, x| a.max(x.abs()));
-        for r in 0..3 {
-            finite_vector(format!("row {r} of the inertia tensor"), inertia[r])?;
-            for k in 0..3 {
-                if (inertia[r][k] - inertia[k][r]).abs() > 1e-12 * size {
-                    return Err(Error::InvalidVector {
-                        name: format!("row {r} of the inertia tensor"),
-                        value: inertia[r].to_vec(),
-                        expected: format!(
-                            "the tensor must be symmetric, but I[{r}][{k}] = {} and I[{k}][{r}] = {}",
-                            inertia[r][k], inertia[k][r]
-                        ),
-                    });
-                }
-            }
-        }
+        let (m, c, v, w, j) = checked(spec)?;
         let fraction = spec.point_mass_fraction;
         if !(fraction.is_finite() && fraction > 0.0 && fraction <= 0.1) {
             return Err(Error::InvalidParameter {
@@ -210,11 +222,6 @@ impl System {
         for (k, p) in spec.points.iter().enumerate() {
             finite_vector(format!("point {k} of the rigid body"), *p)?;
         }
-        let trace = inertia[0][0] + inertia[1][1] + inertia[2][2];
-        let j: Mat3 = std::array::from_fn(|r| {
-            std::array::from_fn(|k| if r == k { 0.5 * trace } else { 0.0 } - inertia[r][k])
-        });
-
         // Points on a vertex or the centre of the plain octahedron are those particles.
         let plain = octahedron(m, c, &j)?;
         let extent = (0..7)
