@@ -192,9 +192,8 @@ def compare(chain: RigidChain, repeat: int = 3, out=print) -> dict[str, float]:
             f"| {name} | {run.seconds:.3f} | {chain.steps / run.seconds:.0f} | {error:.2e} | "
             f"{run.note} |"
         )
-    out(
-        f"gap between the codes' tips: {gap:.2e} m; Exudyn / vinculo time: {theirs.seconds / mine.seconds:.2f}x"
-    )
+    ratio = theirs.seconds / mine.seconds
+    out(f"gap between the codes' tips: {gap:.2e} m; Exudyn / vinculo time: {ratio:.2f}x")
     return {
         "vinculo_s": mine.seconds,
         "vinculo_modified_s": reuse.seconds,
