@@ -107,6 +107,24 @@ class ParticleId:
     """Handle of a particle, returned by ``System.add_particle``; valid only with its system."""
     index: int
     """Position of the particle in the system (row of ``Solution.positions``)."""
+class Point:
+    """A point fixed in a body (an affine combination of its particles, constant weights) or in
+    the ground, returned by ``System.point``. Every constraint and force method accepts it where
+    it accepts a ParticleId (docs/theory/mechanisms.md)."""
+    weights: list[tuple[int, float]]
+    """The particles it combines, as (particle index, weight) pairs (none for a ground point)."""
+    def position(self, positions: Sequence[Sequence[float]]) -> tuple[float, float, float]:
+        """Its world position for the positions (n, 3) of every particle of its system.
+
+        Arguments:
+            positions: the positions of all particles (rows of ``Solution.positions``).
+
+        Returns:
+            The point's position (m).
+
+        Raises:
+            InvalidInputError: fewer rows than the point's particles need.
+        """
 class ConstraintId:
     """Handle of a constraint, returned by the ``System.add_*`` constraint methods."""
     index: int
@@ -171,7 +189,7 @@ class System:
         Raises:
             InvalidInputError: a mass <= 0 or a non-finite position or velocity.
         """
-    def add_distance(self, a: ParticleId, b: ParticleId, length: float | None = None) -> ConstraintId:
+    def add_distance(self, a: ParticleId | Point, b: ParticleId | Point, length: float | None = None) -> ConstraintId:
         """A rigid link between two particles: Phi = L^2 - |q_a - q_b|^2 (paper eq. 17).
 
         The multiplier lambda is positive in tension; the tension is 2 lambda L
@@ -189,7 +207,7 @@ class System:
             InvalidInputError: a == b, or a length that is not finite and positive.
             UnknownHandleError: a handle of another system.
         """
-    def add_elastic_distance(self, a: ParticleId, b: ParticleId, length: float | Law, ea: float,
+    def add_elastic_distance(self, a: ParticleId | Point, b: ParticleId | Point, length: float | Law, ea: float,
                              share: float = 1.0) -> ConstraintId:
         """An elastic segment: |q_a - q_b| = l + (l / EA) T, its multiplier the tension T
         (docs/theory/moorings.md).
@@ -210,7 +228,7 @@ class System:
                 (0, 1] or an EA that is not positive.
             UnknownHandleError: a handle of another system.
         """
-    def add_distance_to_point(self, particle: ParticleId, point: Vector,
+    def add_distance_to_point(self, particle: ParticleId | Point, point: Vector,
                               length: float | None = None) -> ConstraintId:
         """A link from a particle to a prescribed point p(t): Phi = L^2 - |q - p(t)|^2.
 
@@ -226,7 +244,7 @@ class System:
             InvalidInputError: a length that is not finite and positive.
             UnknownHandleError: a handle of another system.
         """
-    def add_plane(self, particle: ParticleId, normal: Vector, point: Vector) -> ConstraintId:
+    def add_plane(self, particle: ParticleId | Point, normal: Vector, point: Vector) -> ConstraintId:
         """Hold a particle on a plane: Phi = n(t) . (q - p0(t)) (paper eq. 18).
 
         The constraint force is n lambda: with a unit normal, lambda is the normal force.
@@ -244,7 +262,7 @@ class System:
             InvalidInputError: a normal of zero length.
             UnknownHandleError: a handle of another system.
         """
-    def add_fixed_coordinate(self, particle: ParticleId, axis: int | str,
+    def add_fixed_coordinate(self, particle: ParticleId | Point, axis: int | str,
                              value: Scalar | None = None) -> ConstraintId:
         """Prescribe one coordinate of a particle: Phi = q[axis] - value(t).
 
@@ -262,7 +280,133 @@ class System:
             InvalidInputError: an axis that is not one of the three.
             UnknownHandleError: a handle of another system.
         """
-    def add_spring_damper(self, a: ParticleId, b: ParticleId, stiffness: float, damping: float = 0.0,
+    def add_relative_coordinate(self, a: ParticleId | Point, b: ParticleId | Point, axis: int | str,
+                                value: Scalar | None = None) -> ConstraintId:
+        """Prescribe a coordinate of b relative to a: Phi = q_b[axis] - q_a[axis] - value(t).
+
+        Three of them at 0 make two points coincide; one with a law drives a slider.
+
+        Arguments:
+            a: the reference particle or point.
+            b: the other particle or point.
+            axis: 0, 1, 2 or "x", "y", "z".
+            value: the difference (m), a number or a Law; None keeps the current one.
+
+        Returns:
+            The constraint's handle (one equation).
+
+        Raises:
+            InvalidInputError: an axis that is not one of the three, a and b the same particle.
+            UnknownHandleError: a handle of another system.
+        """
+    def add_dot_product(self, a: ParticleId | Point, b: ParticleId | Point, c: ParticleId | Point,
+                        d: ParticleId | Point, value: Scalar | None = None) -> ConstraintId:
+        """Prescribe the dot product of two directions: Phi = (q_b - q_a) . (q_d - q_c) - value(t).
+
+        Zero keeps the directions perpendicular (a joint's axis equations); a constant keeps their
+        angle. The multiplier scale is 1 / |q_d - q_c| at the start.
+
+        Arguments:
+            a, b: the first direction, from a to b (particles or points).
+            c, d: the second direction, from c to d.
+            value: the dot product (m^2), a number or a Law; None keeps the current one.
+
+        Returns:
+            The constraint's handle (one equation).
+
+        Raises:
+            InvalidInputError: a direction of zero length.
+            UnknownHandleError: a handle of another system.
+        """
+    def point(self, body: dict[str, Any] | Sequence[ParticleId] | None,
+              position: Vector) -> Point:
+        """The point of a body at a world position now; it moves with the body.
+
+        Arguments:
+            body: a rigid body (the dict of ``add_rigid_body`` or ``add_planar_body``), a frame
+                of 4 particles (3 for a planar body), or None for the ground.
+            position: the point's world position at the initial configuration (m); for a planar
+                body, in its plane.
+
+        Returns:
+            The point (an affine combination of the body's frame particles).
+
+        Raises:
+            InvalidInputError: coplanar frame particles (collinear for 3), a point off a planar
+                body's plane, or a position that is not finite.
+            UnknownHandleError: a particle of another system.
+        """
+    def add_joint(self, kind: str, a: dict[str, Any] | Sequence[ParticleId] | None,
+                  b: dict[str, Any] | Sequence[ParticleId] | None, at: Vector,
+                  axis: Vector | None = None) -> list[ConstraintId]:
+        """A joint between two bodies at a world point (docs/theory/mechanisms.md).
+
+        Kinds: "spherical" (a shared point, 3 equations), "revolute" (a shared point and axis,
+        5), "prismatic" (a shared line and orientation, 5), "fixed" (6), "point-on-line" (b's
+        point on a's line along the axis, 2), "point-on-plane" (b's point on a's plane normal to
+        the axis, 1). Between planar bodies (or a planar body and the ground) a joint keeps its
+        in-plane equations: 2 for a shared point, 1 for a shared direction or line.
+
+        Arguments:
+            kind: the joint.
+            a: the first body (a rigid or planar body's dict, a frame of particles) or None for the
+                ground.
+            b: the second body, or None for the ground.
+            at: the joint's world point at the initial configuration (m).
+            axis: the joint's axis (turning axis, sliding direction, line or plane normal);
+                needed except for "spherical" and "fixed". For planar bodies a revolute axis is
+                the plane's normal, a sliding axis lies in the plane.
+
+        Returns:
+            The handles of its equations, one per equation (named "<kind> #<n>, equation k" in
+            messages and redundancy reports).
+
+        Raises:
+            InvalidInputError: an unknown kind, a missing or zero axis, bodies of different
+                kinds or planes, both bodies the ground.
+            UnknownHandleError: a particle of another system.
+        """
+    def add_torque(self, body: dict[str, Any] | Sequence[ParticleId], torque: Scalar,
+                   axis: Vector, at: Vector) -> ForceId:
+        """A torque about a world axis on a body turning about it (a motor at a revolute joint),
+        as a couple on two points of the body: tau (n x r) / |r|^2 at an arm point and its
+        opposite at ``at``, r = arm - at normal to the axis.
+
+        Arguments:
+            body: the body (its dict or frame).
+            torque: tau (N m), a number or a Law (``laws.function`` for a user function).
+            axis: the axis n (normalised).
+            at: a point of the axis, on the body (m).
+
+        Returns:
+            The force's handle.
+
+        Raises:
+            InvalidInputError: a zero axis, the ground as the body.
+        """
+    def add_planar_body(self, mass: float, centre: Vector, inertia: float, normal: int | str = "y",
+                        velocity: Vector | None = None,
+                        angular_velocity: float = 0.0) -> dict[str, Any]:
+        """A rigid body moving in the plane normal to a world axis: three particles of mass m/3
+        at an equilateral triangle of circumradius sqrt(I / m) about the centre, held by its
+        three sides, their normal coordinates fixed (docs/theory/mechanisms.md).
+
+        Arguments:
+            mass: m (kg, > 0).
+            centre: the centre of mass (m); its normal coordinate is the plane's.
+            inertia: I, the moment about the normal through the centre (kg m^2, > 0).
+            normal: the plane's normal axis, "x", "y" or "z" (or 0, 1, 2).
+            velocity: the centre's velocity (m/s, in the plane).
+            angular_velocity: about the normal (rad/s).
+
+        Returns:
+            {"particles": [3 ParticleId], "frame": the same, "constraints": [6 ConstraintId],
+            "normal": the axis}.
+
+        Raises:
+            InvalidInputError: a mass or moment not > 0, a velocity out of the plane.
+        """
+    def add_spring_damper(self, a: ParticleId | Point, b: ParticleId | Point, stiffness: float, damping: float = 0.0,
                           rest_length: float | None = None) -> ForceId:
         """A linear spring and dashpot between two particles: axial force k (l - L0) + c l'.
 
@@ -280,7 +424,7 @@ class System:
             InvalidInputError: a negative or non-finite coefficient, or a == b.
             UnknownHandleError: a handle of another system.
         """
-    def add_bending(self, a: ParticleId, b: ParticleId, c: ParticleId, ei: float,
+    def add_bending(self, a: ParticleId | Point, b: ParticleId | Point, c: ParticleId | Point, ei: float,
                     spacing: float | None = None) -> ForceId:
         """Bending stiffness of a line at its particle ``b``, between its neighbours ``a`` and
         ``c``: a force on the three particles from the energy
@@ -305,7 +449,7 @@ class System:
                 particle given twice.
             UnknownHandleError: a handle of another system.
         """
-    def add_force(self, particle: ParticleId, force: Vector) -> ForceId:
+    def add_force(self, particle: ParticleId | Point, force: Vector) -> ForceId:
         """A prescribed force on one particle, each component a number or a Law of time (N).
 
         Arguments:
@@ -318,7 +462,7 @@ class System:
         Raises:
             UnknownHandleError: a handle of another system.
         """
-    def add_linear_drag(self, particle: ParticleId, coefficient: float) -> ForceId:
+    def add_linear_drag(self, particle: ParticleId | Point, coefficient: float) -> ForceId:
         """Linear drag f = -c v on one particle.
 
         Arguments:
@@ -332,7 +476,7 @@ class System:
             InvalidInputError: a negative or non-finite coefficient.
             UnknownHandleError: a handle of another system.
         """
-    def add_quadratic_drag(self, particle: ParticleId, coefficient: float) -> ForceId:
+    def add_quadratic_drag(self, particle: ParticleId | Point, coefficient: float) -> ForceId:
         """Quadratic drag f = -c |v| v on one particle.
 
         Arguments:
@@ -426,14 +570,22 @@ class System:
         angular_velocity: Vector | None = None,
         points: Sequence[Vector] | None = None,
         point_mass_fraction: float = 0.01,
+        particles: int = 7,
     ) -> dict[str, Any]:
         """A rigid body of 7 particles (octahedron + centre; more for points off the octahedron)
         with the given mass, centre of mass and inertia tensor (kg m^2, about the centre, world
         axes), held rigid by 15 independent distances (3 more per added point).
 
         Returns {"centre": ParticleId, "vertices": [6 ParticleId: +e1, -e1, +e2, -e2, +e3, -e3],
-        "points": [ParticleId per point], "particles": [...], "constraints": [ConstraintId...],
-        "axes": 3x3 principal axes as columns}.
+        "points": [ParticleId per point], "particles": [...], "frame": [4 ParticleId: the centre,
+        +e1, +e2, +e3], "constraints": [ConstraintId...], "axes": 3x3 principal axes as columns}.
+
+        With ``particles=4`` the body is a tetrahedron of four particles of mass m/4 at the
+        corners (+-a1, +-a2, +-a3) (an even number of minus signs) along the principal axes,
+        a_k = sqrt(J_k / m), held by its 6 edges: exact mass, centre and inertia with 12
+        coordinates instead of 21, for mechanisms of many bodies. It takes no ``points`` (use
+        ``System.point``) and returns {"particles", "frame": the 4 particles, "centre": a Point,
+        "constraints", "axes"}.
         Raises InvalidInputError (bad mass, non-symmetric or flat inertia),
         RedundantConstraintsError (degenerate geometry)."""
     def add_morison(
