@@ -307,8 +307,10 @@ class System:
         angle. The multiplier scale is 1 / |q_d - q_c| at the start.
 
         Arguments:
-            a, b: the first direction, from a to b (particles or points).
-            c, d: the second direction, from c to d.
+            a: the start of the first direction (a particle or a point).
+            b: its end.
+            c: the start of the second direction.
+            d: its end.
             value: the dot product (m^2), a number or a Law; None keeps the current one.
 
         Returns:
