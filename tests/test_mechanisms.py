@@ -291,3 +291,74 @@ def test_a_tumbling_body_flips_about_its_intermediate_axis_as_eulers_equations_s
     masses = system.masses()
     energy = 0.5 * np.einsum("i,tij,tij->t", masses, v, v)
     assert np.max(np.abs(energy / energy[0] - 1)) < 1e-10
+
+
+def test_a_triangle_of_particles_made_rigid_swings_as_a_compound_pendulum():
+    # Particles O (fixed pivot), A and B made one rigid body, released at rest in the x-z plane:
+    # it turns about y by alpha with I_O alpha'' = g sum m_i (x_i0 cos(alpha) + z_i0 sin(alpha))
+    # (Lagrange: T = 1/2 I_O alpha'^2, I_O = sum m_i (x_i0^2 + z_i0^2), V = g sum m_i z_i), and
+    # every particle is its start turned by alpha.
+    system = vinculo.System(gravity=(0.0, 0.0, -G))
+    pivot = system.add_particle(1.0, (0.0, 0.0, 0.0), fixed=True)
+    start = {"a": (1.0, (0.3, 0.0, -0.1)), "b": (0.6, (0.1, 0.0, -0.4))}
+    ids = {k: system.add_particle(m, x) for k, (m, x) in start.items()}
+    cluster = system.add_rigid_cluster([pivot, ids["a"], ids["b"]])
+    assert len(cluster["constraints"]) == 3
+    masses = np.array([m for m, _ in start.values()])
+    x0 = np.array([x for _, x in start.values()])
+    inertia = np.sum(masses * (x0[:, 0] ** 2 + x0[:, 2] ** 2))
+
+    def rhs(_t, y):
+        a = y[0]
+        torque = G * np.sum(masses * (x0[:, 0] * math.cos(a) + x0[:, 2] * math.sin(a)))
+        return [y[1], torque / inertia]
+
+    solution = vinculo.simulate(system, t_end=2.0, dt=5e-4)
+    alpha = scipy.integrate.solve_ivp(
+        rhs, (0, 2.0), [0.0, 0.0], t_eval=solution.times, rtol=1e-12, atol=1e-12
+    ).y[0]
+    for k, key in enumerate(start):
+        # R_y(alpha) (x, z) = (x cos(alpha) + z sin(alpha), -x sin(alpha) + z cos(alpha)).
+        x, z = x0[k, 0], x0[k, 2]
+        expected = np.stack(
+            [
+                x * np.cos(alpha) + z * np.sin(alpha),
+                0 * alpha,
+                -x * np.sin(alpha) + z * np.cos(alpha),
+            ],
+            axis=1,
+        )
+        np.testing.assert_allclose(solution.particle(ids[key]), expected, rtol=0, atol=2e-5)
+
+
+def test_bodies_that_share_a_particle_are_joined_there_by_a_spherical_joint():
+    # Two clusters of four particles in space with one in common: 7 particles, 6 + 6 distances,
+    # 21 - 12 = 9 degrees of freedom: a body in space (6) and a spherical joint (3). The start
+    # analysis finds no redundant equation, and during the run each cluster stays rigid.
+    system = vinculo.System(gravity=(0.0, 0.0, -G))
+    shared = system.add_particle(1.0, (0.0, 0.0, 0.0))
+    first = [shared] + [
+        system.add_particle(1.0, x) for x in [(0.4, 0.0, 0.1), (0.1, 0.3, 0.0), (0.0, 0.1, 0.5)]
+    ]
+    second = [shared] + [
+        system.add_particle(0.5, x)
+        for x in [(-0.4, 0.1, 0.0), (-0.1, -0.3, 0.2), (-0.2, 0.0, -0.5)]
+    ]
+    one = system.add_rigid_cluster(first)
+    two = system.add_rigid_cluster(second)
+    assert len(one["constraints"]) + len(two["constraints"]) == 12
+    assert 3 * system.num_particles - system.num_constraints == 9
+    system.add_joint("spherical", None, one, (0.1, 0.1, 0.2))
+    solution = vinculo.simulate(system, t_end=1.0, dt=1e-3)
+    for cluster in (first, second):
+        q = np.array([solution.particle(p) for p in cluster])
+        gaps = np.linalg.norm(q[:, None] - q[None, :], axis=-1)
+        np.testing.assert_allclose(gaps, gaps[:, :, :1] * np.ones_like(gaps), rtol=0, atol=1e-9)
+    # The second body swung about the shared particle (it is not welded to the first).
+    q = np.array([solution.particle(p) for p in first + second[1:]])
+    angle = lambda k: np.arccos(  # noqa: E731
+        np.dot(q[4, k] - q[0, k], q[1, k] - q[0, k])
+        / np.linalg.norm(q[4, k] - q[0, k])
+        / np.linalg.norm(q[1, k] - q[0, k])
+    )
+    assert abs(angle(-1) - angle(0)) > 0.1

@@ -386,6 +386,27 @@ class System:
         Raises:
             InvalidInputError: a zero axis, the ground as the body.
         """
+    def add_rigid_cluster(self, particles: Sequence[ParticleId]) -> dict[str, Any]:
+        """Make existing particles one rigid body, with their own masses (bodies may share
+        particles: two clusters with one in common are joined there by a spherical joint).
+
+        Its frame is 4 of them in space (held by the tetrahedron's 6 edges, every other particle
+        by 3 distances to it), or 3 when they all lie in a plane normal to a world axis (the
+        triangle's 3 sides, 2 distances for every other particle; each particle must then already
+        be held in that plane, by a fixed coordinate).
+
+        Arguments:
+            particles: at least 3 distinct particles, not collinear.
+
+        Returns:
+            {"particles": the particles, "frame": its 4 (or 3) frame particles, "constraints":
+            the distances}.
+
+        Raises:
+            InvalidInputError: fewer than 3, repeated or collinear particles, a planar cluster
+                whose particles are not held in their plane.
+            RedundantConstraintsError: a degenerate configuration.
+        """
     def add_planar_body(self, mass: float, centre: Vector, inertia: float, normal: int | str = "y",
                         velocity: Vector | None = None,
                         angular_velocity: float = 0.0) -> dict[str, Any]:

@@ -543,6 +543,33 @@ impl PySystem {
         Ok(d)
     }
 
+    /// Makes existing particles one rigid body (bodies may share particles); returns its frame
+    /// and constraints.
+    fn add_rigid_cluster<'py>(
+        &mut self,
+        py: Python<'py>,
+        particles: Vec<Bound<'_, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let ids = particles
+            .iter()
+            .map(|p| self.particle(p))
+            .collect::<PyResult<Vec<_>>>()?;
+        let cluster = self.inner.add_rigid_cluster(&ids).map_err(to_py)?;
+        let d = PyDict::new(py);
+        let handles = |v: &[ParticleId]| -> Vec<PyParticleId> {
+            v.iter().map(|&inner| PyParticleId { inner }).collect()
+        };
+        d.set_item("particles", handles(&ids))?;
+        d.set_item("frame", handles(&cluster.frame))?;
+        let constraints: Vec<PyConstraintId> = cluster
+            .constraints
+            .iter()
+            .map(|c| PyConstraintId { index: c.0 })
+            .collect();
+        d.set_item("constraints", constraints)?;
+        Ok(d)
+    }
+
     /// A rigid body made of particles: same mass, centre and inertia tensor, exactly rigid.
     ///
     /// Returns a dict with "centre", "vertices", "points", "particles" (ParticleIds),

@@ -1,6 +1,7 @@
 //! The model: particles and the system that owns them with their constraints and forces, and
 //! rigid bodies built from particles.
 
+mod cluster;
 mod joints;
 mod line_loads;
 mod on_points;
@@ -12,6 +13,7 @@ mod system;
 mod tetrahedron_body;
 pub mod user_groups;
 
+pub use cluster::RigidCluster;
 pub use joints::JointKind;
 pub use line_loads::{LineHydroSpec, SeabedSpec};
 pub use on_points::{Built, OnPointsId};
