@@ -503,6 +503,7 @@ impl PySystem {
     /// A planar rigid body moving in the plane normal to axis `normal` ("x", "y", "z"): three
     /// particles with its mass, centre and moment of inertia about the normal.
     #[pyo3(signature = (mass, centre, inertia, normal=None, velocity=None, angular_velocity=0.0))]
+    #[allow(clippy::too_many_arguments)]
     fn add_planar_body<'py>(
         &mut self,
         py: Python<'py>,

@@ -114,6 +114,8 @@ impl Constraint {
 
     /// dPhi/dq for each touched particle, on the stack for the built-in kinds.
     #[inline(always)]
+    // The kinds over points hand over `Rows` already (their size is their points' particles').
+    #[allow(clippy::useless_conversion)]
     pub fn gradient_rows(&self, q: &[Vec3], t: f64) -> Rows {
         dispatch!(self, c => c.gradient(q, t).into())
     }
