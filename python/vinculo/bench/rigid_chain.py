@@ -9,8 +9,9 @@ threads) as a measure of its speed. The bodies are exactly the same in mass, cen
 the codes differ in their coordinates (vinculo's particles, Exudyn's Euler parameters), so their
 discrete solutions differ by the schemes' errors, which the table reports: each code's error is
 the largest distance of a link's centre at t_end from its own answer at dt/2, times 4/3 (second
-order), and the gap is the largest distance between the two codes' centres. Speed is the wall time of the integration, model
-building excluded, the best of ``repeat`` runs, each code on one thread.
+order), and the gap is the largest distance between the two codes' centres. Speed is the wall
+time of the integration, model building excluded, the best of ``repeat`` runs, each code on one
+thread.
 """
 
 from __future__ import annotations
