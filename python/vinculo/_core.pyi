@@ -317,7 +317,8 @@ class System:
             The constraint's handle (one equation).
 
         Raises:
-            InvalidInputError: a direction of zero length.
+            InvalidInputError: a second direction of zero length (the first may start at zero:
+                a point on a line through it).
             UnknownHandleError: a handle of another system.
         """
     def point(self, body: dict[str, Any] | Sequence[ParticleId] | None,

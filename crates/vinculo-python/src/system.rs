@@ -129,6 +129,15 @@ impl PySystem {
     }
 
     pub fn particle(&self, obj: &Bound<'_, PyAny>) -> PyResult<ParticleId> {
+        if obj.cast::<PyPoint>().is_ok() {
+            return Err(invalid(
+                "particle",
+                obj.repr().map(|r| r.to_string()).unwrap_or_default(),
+                "this element acts on particles only (fluid forces, line loads, seabed contact, \
+                 user groups, tangents, clusters, frames): give a ParticleId, such as a body's \
+                 centre particle",
+            ));
+        }
         let id = obj.cast::<PyParticleId>().map_err(|_| {
             Python::attach(|py| {
                 let d = PyDict::new(py);

@@ -352,13 +352,12 @@ impl System {
         let index = self.constraints.len();
         let q = |k: usize| self.particles[ids[k]].position;
         let (u, w) = (sub(q(1), q(0)), sub(q(3), q(2)));
-        for (k, v) in [(0, u), (2, w)] {
-            if norm(v) == 0.0 {
-                return Err(Error::SameParticle {
-                    what: format!("dot product #{index} (vector {})", k / 2 + 1),
-                    particle: ids[k],
-                });
-            }
+        // u may vanish (a point on a line through it, at the start); w sets the scale.
+        if norm(w) == 0.0 {
+            return Err(Error::SameParticle {
+                what: format!("dot product #{index} (second vector)"),
+                particle: ids[2],
+            });
         }
         let distinct = (0..4).all(|x| (0..x).all(|y| ids[x] != ids[y]));
         if !distinct {
