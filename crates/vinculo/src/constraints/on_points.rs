@@ -69,27 +69,10 @@ mod tests {
     use super::*;
     use crate::model::Point;
 
-    /// Particles 0..3 frame a body, 4..7 another; 8 is a lone particle.
-    fn state() -> (Vec<Vec3>, Vec<Vec3>) {
-        let q: Vec<Vec3> = (0..9)
-            .map(|i| {
-                let s = i as f64;
-                [
-                    0.3 * s.sin() + 0.1 * s,
-                    (1.7 * s).cos(),
-                    0.2 * s * s - 0.5 * (s % 3.0),
-                ]
-            })
-            .collect();
-        let v: Vec<Vec3> = (0..9)
-            .map(|i| [0.1 * i as f64, -0.3, 0.05 * (i * i) as f64])
-            .collect();
-        (q, v)
-    }
-
     #[test]
     fn constraints_over_body_points_match_finite_differences() {
-        let (q, v) = state();
+        // Particles 0..3 frame a body, 4..7 another; 8 is a lone particle.
+        let (q, v) = crate::model::point::test_state(9);
         let a = Point::in_frame(&[0, 1, 2, 3], &q[0..4], [0.4, -0.2, 0.9]).unwrap();
         let a2 = Point::in_frame(&[0, 1, 2, 3], &q[0..4], [1.4, 0.3, 0.2]).unwrap();
         let b = Point::in_frame(&[4, 5, 6, 7], &q[4..8], [0.1, 0.6, 1.5]).unwrap();

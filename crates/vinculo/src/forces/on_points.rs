@@ -73,19 +73,7 @@ mod tests {
     fn a_spring_between_body_points_matches_finite_differences() {
         // Particles 0..3 frame one body, 4..7 another; the spring joins a point of each, and
         // a second spring joins a body point to a ground point.
-        let q: Vec<Vec3> = (0..8)
-            .map(|i| {
-                let s = i as f64;
-                [
-                    0.3 * s.sin() + 0.1 * s,
-                    (1.7 * s).cos(),
-                    0.2 * s * s - 0.5 * (s % 3.0),
-                ]
-            })
-            .collect();
-        let v: Vec<Vec3> = (0..8)
-            .map(|i| [0.1 * i as f64, -0.3, 0.05 * (i * i) as f64])
-            .collect();
+        let (q, v) = crate::model::point::test_state(8);
         let a = Point::in_frame(&[0, 1, 2, 3], &q[0..4], [0.4, -0.2, 0.9]).unwrap();
         let b = Point::in_frame(&[4, 5, 6, 7], &q[4..8], [0.1, 0.6, 1.5]).unwrap();
         let spring = |points: &[Point]| {

@@ -7,7 +7,7 @@ mod line_loads;
 mod on_points;
 mod particle;
 mod planar_body;
-mod point;
+pub(crate) mod point;
 mod rigid_body;
 mod system;
 mod tetrahedron_body;

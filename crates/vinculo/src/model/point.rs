@@ -270,6 +270,26 @@ impl PointMap {
     }
 }
 
+/// Positions and velocities of `n` particles in a general configuration, for the tests of
+/// elements over points (particles 0..3 frame one body, 4..7 another).
+#[cfg(test)]
+pub(crate) fn test_state(n: usize) -> (Vec<Vec3>, Vec<Vec3>) {
+    let q = (0..n)
+        .map(|i| {
+            let s = i as f64;
+            [
+                0.3 * s.sin() + 0.1 * s,
+                (1.7 * s).cos(),
+                0.2 * s * s - 0.5 * (s % 3.0),
+            ]
+        })
+        .collect();
+    let v = (0..n)
+        .map(|i| [0.1 * i as f64, -0.3, 0.05 * (i * i) as f64])
+        .collect();
+    (q, v)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -113,7 +113,7 @@ fn det(a: Vec3, b: Vec3, c: Vec3) -> f64 {
 
 /// Principal axes and second moments of a symmetric 3 x 3 matrix (ascending), world axes when it
 /// is isotropic, always right-handed.
-pub(super) fn principal(j: &Mat3) -> Result<(Vec3, Mat3)> {
+fn principal(j: &Mat3) -> Result<(Vec3, Mat3)> {
     let m = faer::Mat::<f64>::from_fn(3, 3, |r, c| j[r][c]);
     let evd = m
         .self_adjoint_eigen(faer::Side::Lower)
@@ -173,13 +173,10 @@ pub(super) fn checked(spec: &RigidBodySpec) -> Result<(f64, Vec3, Vec3, Vec3, Ma
     Ok((m, c, v, w, j))
 }
 
-/// The octahedron with mass `m`, centre `c` and second moment `j` about `c`.
-fn octahedron(m: f64, c: Vec3, j: &Mat3) -> Result<Octahedron> {
+/// The principal second moments and axes of `j` ([`principal`]), all > 0 as a solid's are;
+/// otherwise an error saying the body cannot be made of `shape` (the message's end).
+pub(super) fn solid_principal(j: &Mat3, shape: &str) -> Result<(Vec3, Mat3)> {
     let (moments, axes) = principal(j)?;
-    let mu = m / 10.0;
-    let mut positions = [c; 7];
-    let mut masses = [mu; 7];
-    masses[0] = 0.4 * m;
     for k in 0..3 {
         if moments[k] <= 1e-12 * moments[2].abs().max(f64::MIN_POSITIVE) {
             return Err(Error::InvalidParameter {
@@ -187,9 +184,28 @@ fn octahedron(m: f64, c: Vec3, j: &Mat3) -> Result<Octahedron> {
                     "principal second moment {k} of the body's mass (from its inertia tensor)"
                 ),
                 value: moments[k],
-                expected: "must be > 0: each principal moment of inertia must be smaller than the sum of the other two (a flat or linear body cannot be made of an octahedron of particles); or the attachment points are too heavy or too far out: lower point_mass_fraction".into(),
+                expected: format!(
+                    "must be > 0: each principal moment of inertia must be smaller than the sum \
+                     of the other two (a flat or linear body cannot be made of {shape}"
+                ),
             });
         }
+    }
+    Ok((moments, axes))
+}
+
+/// The octahedron with mass `m`, centre `c` and second moment `j` about `c`.
+fn octahedron(m: f64, c: Vec3, j: &Mat3) -> Result<Octahedron> {
+    let (moments, axes) = solid_principal(
+        j,
+        "an octahedron of particles); or the attachment points are too heavy or too far out: \
+         lower point_mass_fraction",
+    )?;
+    let mu = m / 10.0;
+    let mut positions = [c; 7];
+    let mut masses = [mu; 7];
+    masses[0] = 0.4 * m;
+    for k in 0..3 {
         let r = (moments[k] / (2.0 * mu)).sqrt();
         let e = column(&axes, k);
         positions[1 + 2 * k] = add(c, scale(r, e));

@@ -17,7 +17,7 @@
 //! bodies about four times cheaper to factorise.
 
 use super::particle::{ConstraintId, ParticleId};
-use super::rigid_body::{checked, principal, RigidBodySpec};
+use super::rigid_body::{checked, solid_principal, RigidBodySpec};
 use super::System;
 use crate::error::{Error, Result};
 use crate::math::{add, cross, scale, sub, Mat3, Vec3};
@@ -48,23 +48,8 @@ impl System {
             });
         }
         let (m, c, v, w, j) = checked(spec)?;
-        let (moments, axes) = principal(&j)?;
-        let mut half = [0.0; 3];
-        for k in 0..3 {
-            if moments[k] <= 1e-12 * moments[2].abs().max(f64::MIN_POSITIVE) {
-                return Err(Error::InvalidParameter {
-                    name: format!(
-                        "principal second moment {k} of the body's mass (from its inertia tensor)"
-                    ),
-                    value: moments[k],
-                    expected: "must be > 0: each principal moment of inertia must be smaller \
-                               than the sum of the other two (a flat or linear body cannot be \
-                               made of a tetrahedron of particles)"
-                        .into(),
-                });
-            }
-            half[k] = (moments[k] / m).sqrt();
-        }
+        let (moments, axes) = solid_principal(&j, "a tetrahedron of particles)")?;
+        let half: Vec3 = std::array::from_fn(|k| (moments[k] / m).sqrt());
         let axis = |k: usize| -> Vec3 { [axes[0][k], axes[1][k], axes[2][k]] };
         let mut particles = Vec::with_capacity(4);
         for signs in [
