@@ -152,24 +152,18 @@ mod tests {
             angular_velocity: 1.7,
         };
         let body = s.add_planar_body(&spec).unwrap();
+        // Mass, centre (first moment / mass) and the moment about y (the tensor's I_yy).
+        let (mass, first, tensor) =
+            super::super::rigid_body::moments(&s, &body.particles, spec.centre);
+        assert!((mass - 2.5).abs() < 1e-14);
+        assert!((0..3).all(|k| (first[k] / mass - spec.centre[k]).abs() < 1e-14));
+        assert!((tensor[1][1] - 0.07).abs() < 1e-14);
+        let centre = spec.centre;
         let p: Vec<_> = body
             .particles
             .iter()
             .map(|id| s.particles()[id.index()].clone())
             .collect();
-        let mass: f64 = p.iter().map(|x| x.mass).sum();
-        assert!((mass - 2.5).abs() < 1e-14);
-        let centre: Vec3 =
-            std::array::from_fn(|k| p.iter().map(|x| x.mass * x.position[k]).sum::<f64>() / mass);
-        assert!((0..3).all(|k| (centre[k] - spec.centre[k]).abs() < 1e-14));
-        let moment: f64 = p
-            .iter()
-            .map(|x| {
-                let (dz, dx) = (x.position[2] - centre[2], x.position[0] - centre[0]);
-                x.mass * (dz * dz + dx * dx)
-            })
-            .sum();
-        assert!((moment - 0.07).abs() < 1e-14);
         // Angular momentum about the centre: I omega (about y: z x - x z components).
         let h: f64 = p
             .iter()

@@ -350,29 +350,32 @@ fn best_anchors(positions: &[Vec3; 7], p: Vec3) -> [usize; 3] {
     best.0
 }
 
+/// Mass, first moment about the origin and inertia tensor about `c` of a set of particles (the
+/// tests of the bodies made of particles).
+#[cfg(test)]
+pub(super) fn moments(s: &System, ids: &[ParticleId], c: Vec3) -> (f64, Vec3, Mat3) {
+    let mut m = 0.0;
+    let mut first = [0.0; 3];
+    let mut inertia = [[0.0; 3]; 3];
+    for id in ids {
+        let p = &s.particles()[id.index()];
+        m += p.mass;
+        first = add(first, scale(p.mass, p.position));
+        let d = sub(p.position, c);
+        for r in 0..3 {
+            for k in 0..3 {
+                let dd = crate::math::dot(d, d);
+                inertia[r][k] += p.mass * (if r == k { dd } else { 0.0 } - d[r] * d[k]);
+            }
+        }
+    }
+    (m, first, inertia)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::math::dot;
-
-    /// Mass, first moment about the origin and inertia tensor about `c` of a set of particles.
-    fn moments(s: &System, ids: &[ParticleId], c: Vec3) -> (f64, Vec3, Mat3) {
-        let mut m = 0.0;
-        let mut first = [0.0; 3];
-        let mut inertia = [[0.0; 3]; 3];
-        for id in ids {
-            let p = &s.particles()[id.index()];
-            m += p.mass;
-            first = add(first, scale(p.mass, p.position));
-            let d = sub(p.position, c);
-            for r in 0..3 {
-                for k in 0..3 {
-                    inertia[r][k] += p.mass * (if r == k { dot(d, d) } else { 0.0 } - d[r] * d[k]);
-                }
-            }
-        }
-        (m, first, inertia)
-    }
 
     fn assert_body_matches(s: &System, body: &RigidBody, spec: &RigidBodySpec) {
         let (m, first, inertia) = moments(s, &body.particles, spec.centre);

@@ -96,27 +96,16 @@ mod tests {
         };
         let mut s = System::new([0.0; 3]);
         let body = s.add_rigid_tetrahedron(&spec).unwrap();
-        let p: Vec<_> = body
-            .particles
-            .iter()
-            .map(|id| s.particles()[id.index()].clone())
-            .collect();
-        let mass: f64 = p.iter().map(|x| x.mass).sum();
+        // The moments about the given centre: the mass, the first moment m c (so the centre
+        // is c) and the inertia tensor.
+        let (mass, first, tensor) =
+            super::super::rigid_body::moments(&s, &body.particles, spec.centre);
         assert!((mass - 3.0).abs() < 1e-14);
-        let c: Vec3 =
-            std::array::from_fn(|k| p.iter().map(|x| x.mass * x.position[k]).sum::<f64>() / mass);
-        assert!((0..3).all(|k| (c[k] - spec.centre[k]).abs() < 1e-13));
-        let mut tensor = [[0.0; 3]; 3];
+        assert!((0..3).all(|k| (first[k] / mass - spec.centre[k]).abs() < 1e-13));
         let mut h = [0.0; 3];
-        for x in &p {
-            let r = sub(x.position, c);
-            let rr: f64 = r.iter().map(|y| y * y).sum();
-            for a in 0..3 {
-                for b in 0..3 {
-                    tensor[a][b] += x.mass * (if a == b { rr } else { 0.0 } - r[a] * r[b]);
-                }
-            }
-            let hr = cross(r, sub(x.velocity, spec.velocity));
+        for id in &body.particles {
+            let x = &s.particles()[id.index()];
+            let hr = cross(sub(x.position, spec.centre), sub(x.velocity, spec.velocity));
             (0..3).for_each(|k| h[k] += x.mass * hr[k]);
         }
         for a in 0..3 {
