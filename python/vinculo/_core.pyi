@@ -361,8 +361,9 @@ class System:
                 the plane's normal, a sliding axis lies in the plane.
 
         Returns:
-            The handles of its equations, one per equation (named "<kind> #<n>, equation k" in
-            messages and redundancy reports).
+            The handles of its equations, one per equation, each named in messages and
+            redundancy reports by the joint and what it holds ("revolute joint #1: shared point
+            along x", "...: axis normal to B's e1").
 
         Raises:
             InvalidInputError: an unknown kind, a missing or zero axis, bodies of different

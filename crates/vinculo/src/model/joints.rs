@@ -66,6 +66,62 @@ impl JointKind {
     }
 }
 
+/// What each equation of a joint holds, in the order the joint adds them (module doc).
+fn equation_names(kind: JointKind, plane: Option<usize>) -> Vec<String> {
+    let axes = ["x", "y", "z"];
+    let coincide: Vec<String> = match plane {
+        None => (0..3)
+            .map(|k| format!("shared point along {}", axes[k]))
+            .collect(),
+        Some(normal) => {
+            let (u, v) = super::planar_body::in_plane(normal);
+            vec![
+                format!("shared point along {}", axes[u]),
+                format!("shared point along {}", axes[v]),
+            ]
+        }
+    };
+    let s = |x: &str| x.to_string();
+    let mut names = Vec::new();
+    match (kind, plane) {
+        (JointKind::Spherical, _) => names.extend(coincide),
+        (JointKind::Revolute, None) => {
+            names.extend(coincide);
+            names.extend([s("axis normal to B's e1"), s("axis normal to B's e2")]);
+        }
+        (JointKind::Prismatic, None) => names.extend([
+            s("axis normal to B's e1"),
+            s("axis normal to B's e2"),
+            s("A's e1 normal to B's e2"),
+            s("B's point on A's line (along e1)"),
+            s("B's point on A's line (along e2)"),
+        ]),
+        (JointKind::Fixed, None) => {
+            names.extend(coincide);
+            names.extend([
+                s("axis normal to B's e1"),
+                s("axis normal to B's e2"),
+                s("A's e1 normal to B's e2"),
+            ]);
+        }
+        (JointKind::PointOnLine, None) => names.extend([
+            s("B's point on A's line (along e1)"),
+            s("B's point on A's line (along e2)"),
+        ]),
+        (JointKind::PointOnPlane, _) => names.push(s("B's point on A's plane")),
+        (JointKind::Revolute, Some(_)) => names.extend(coincide),
+        (JointKind::Prismatic, Some(_)) => {
+            names.extend([s("no relative rotation"), s("B's point on A's line")])
+        }
+        (JointKind::Fixed, Some(_)) => {
+            names.extend(coincide);
+            names.push(s("no relative rotation"));
+        }
+        (JointKind::PointOnLine, Some(_)) => names.push(s("B's point on A's line")),
+    }
+    names
+}
+
 /// A unit vector normal to `n` (unit), and the third of the right-handed triad (n, e1, e2).
 fn triad(n: Vec3) -> (Vec3, Vec3) {
     let helper = if n[0].abs() < 0.9 {
@@ -111,10 +167,17 @@ impl System {
             });
         }
         let n = scale(1.0 / length, axis);
-        let built = match self.plane_of(&label, a, b)? {
+        let plane = self.plane_of(&label, a, b)?;
+        let built = match plane {
             None => self.joint_in_space(kind, (a, b), at, n, &label)?,
             Some(normal) => self.joint_in_plane(kind, (a, b), at, (n, normal), &label)?,
         };
+        // Each equation named by what it holds, for messages and redundancy reports.
+        for (c, what) in built.constraints.iter().zip(equation_names(kind, plane)) {
+            if let crate::constraints::Constraint::OnPoints(e) = &mut self.constraints[c.0] {
+                e.label = format!("{label}: {what}");
+            }
+        }
         self.joints += 1;
         Ok(built.constraints)
     }

@@ -21,7 +21,7 @@ pub struct System {
     id: u64,
     gravity: Vec3,
     particles: Vec<Particle>,
-    pub(super) constraints: Vec<Constraint>,
+    pub(crate) constraints: Vec<Constraint>,
     pub(crate) forces: Vec<Force>,
     pub(super) tension_only: Vec<usize>,
     /// Groups of user forces and constraints (their elements are also in `forces` and
