@@ -149,6 +149,9 @@ fn barycentric(frame: &[Vec3], at: Vec3) -> Result<Vec<f64>> {
     }
 }
 
+/// The positions or velocities of an element's points.
+pub type Points = smallvec::SmallVec<[Vec3; 8]>;
+
 /// How an element over m points reaches the particles: the union of their particles, and each
 /// point's (index in the union, weight) terms. Module doc for the chain rule.
 #[derive(Debug, Clone, PartialEq)]
@@ -203,19 +206,20 @@ impl PointMap {
         self.terms.len()
     }
 
-    /// The points' positions for the particle positions `q` (all of the system's).
+    /// The points' positions for the particle positions `q` (all of the system's), on the
+    /// stack for up to 8 points (a joint's).
     #[inline]
-    pub fn positions(&self, q: &[Vec3]) -> Vec<Vec3> {
+    pub fn positions(&self, q: &[Vec3]) -> Points {
         self.combine(q, true)
     }
 
     /// The points' velocities for the particle velocities `v`.
     #[inline]
-    pub fn velocities(&self, v: &[Vec3]) -> Vec<Vec3> {
+    pub fn velocities(&self, v: &[Vec3]) -> Points {
         self.combine(v, false)
     }
 
-    fn combine(&self, x: &[Vec3], offsets: bool) -> Vec<Vec3> {
+    fn combine(&self, x: &[Vec3], offsets: bool) -> Points {
         self.terms
             .iter()
             .zip(&self.offsets)
