@@ -106,7 +106,8 @@ impl PySystem {
                 Target::Point(p) => p,
             })
             .collect();
-        let label = format!("{label} #{}", self.inner.constraints().len());
+        // Each element's name adds its own number: "distance over points #12 (particles ...)".
+        let label = format!("{label} over points");
         self.inner
             .on_points(&points, &label, add)
             .map(|(id, _)| id)
