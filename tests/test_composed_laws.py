@@ -237,3 +237,24 @@ def test_a_law_leaving_its_domain_is_named_with_the_time():
     # The step to t = 1 needs only the value there (0, finite); the next one's end is outside.
     assert error.time == pytest.approx(1.05)
     assert error.solution.times[-1] == pytest.approx(1.0)
+
+
+def test_a_python_law_drives_a_point_of_a_body():
+    # The centre of a four-particle body follows the guide in x (a Python law) and stays at
+    # y = z = 0: the body translates without turning (nothing turns it), its centre exactly on
+    # the law, and the start is consistent because the body starts at the law's rate.
+    x0, rate, _ = guide_by_hand(0.0)
+    system = vinculo.System(gravity=(0.0, 0.0, -G))
+    inertia = np.diag([0.02, 0.03, 0.04]).tolist()
+    body = system.add_rigid_body(
+        1.5, (x0, 0.0, 0.0), inertia, velocity=(rate, 0.0, 0.0), particles=4
+    )
+    centre = body["centre"]
+    system.add_fixed_coordinate(centre, "x", laws.function(guide_by_hand, name="guide"))
+    system.add_fixed_coordinate(centre, "y", 0.0)
+    system.add_fixed_coordinate(centre, "z", 0.0)
+    solution = vinculo.simulate(system, t_end=1.0, dt=1e-2)
+    expected = [guide_by_hand(t)[0] for t in solution.times]
+    np.testing.assert_allclose(solution.point(centre)[:, 0], expected, rtol=0, atol=1e-12)
+    shift = solution.positions - solution.positions[0]
+    np.testing.assert_allclose(shift[:, :, 0] - shift[:, :1, 0], 0.0, atol=1e-9)

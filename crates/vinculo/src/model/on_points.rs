@@ -98,12 +98,14 @@ impl System {
             ids.push(scratch.add_particle(1.0, position, point.velocity(&v), fixed)?);
         }
         let result = build(&mut scratch, &ids)?;
-        if scratch.has_user_groups() {
+        // User groups act on particles (their functions see particle arrays); user laws are
+        // laws like the others and stay with their elements (noted again below).
+        if !(scratch.user_forces.is_empty() && scratch.user_constraints.is_empty()) {
             return Err(Error::InvalidParameter {
                 name: format!("elements of {label}"),
                 value: f64::NAN,
-                expected: "user groups and user laws act on particles: give particles, or \
-                           describe the element with the built-in kinds"
+                expected: "user groups act on particles: give particles, or describe the \
+                           element with the built-in kinds"
                     .into(),
             });
         }
