@@ -135,17 +135,8 @@ impl System {
     /// function failed, or a law that is not finite there (a square root of a negative value).
     /// Looks at every element: for the failure paths of a run, not every step.
     pub fn law_failure(&self, t: f64) -> Option<Error> {
-        let constraints = self
-            .constraints
-            .iter()
-            .enumerate()
-            .map(|(k, c)| (c.name(k), c.laws()));
-        let forces = self
-            .forces
-            .iter()
-            .enumerate()
-            .map(|(k, f)| (f.name(k), f.laws()));
-        constraints.chain(forces).find_map(|(what, laws)| {
+        // Names are made for the failing element alone (a run checks every element at its start).
+        let failing = |laws: Vec<&Law>| {
             laws.iter().find_map(|law| {
                 let (t, detail) = law.failure_at(t)?;
                 let user = law
@@ -153,14 +144,26 @@ impl System {
                     .iter()
                     .find(|u| u.failure().is_some())
                     .map(|u| u.name().to_string());
-                Some(Error::LawNotFinite {
-                    what: what.clone(),
-                    t,
-                    detail,
-                    user,
-                })
+                Some((t, detail, user))
             })
-        })
+        };
+        let error = |what: String, (t, detail, user)| Error::LawNotFinite {
+            what,
+            t,
+            detail,
+            user,
+        };
+        for (k, c) in self.constraints.iter().enumerate() {
+            if let Some(found) = failing(c.laws()) {
+                return Some(error(c.name(k), found));
+            }
+        }
+        for (k, f) in self.forces.iter().enumerate() {
+            if let Some(found) = failing(f.laws()) {
+                return Some(error(f.name(k), found));
+            }
+        }
+        None
     }
 
     /// Fixed distance between `a` and `b` (paper eq. 17). `length = None` takes the current distance.
