@@ -183,25 +183,24 @@ pub(crate) fn check_options(system: &System, o: &SimulationOptions) -> Result<()
             });
         }
     }
-    let constraints = system
-        .constraints()
-        .iter()
-        .enumerate()
-        .map(|(k, c)| (c.name(k), c.domain()));
-    let forces = system
-        .forces()
-        .iter()
-        .enumerate()
-        .map(|(k, f)| (f.name(k), f.domain()));
-    for (name, (start, end)) in constraints.chain(forces) {
-        if start > o.t_start || end < o.t_end {
-            return Err(Error::LawOutOfDomain {
-                what: format!("the law of {name}"),
-                start,
-                end,
-                t_start: o.t_start,
-                t_end: o.t_end,
-            });
+    // An element's name is made only when its laws do not cover the run.
+    let out_of_domain = |(start, end): (f64, f64), name: &dyn Fn() -> String| {
+        (start > o.t_start || end < o.t_end).then(|| Error::LawOutOfDomain {
+            what: format!("the law of {}", name()),
+            start,
+            end,
+            t_start: o.t_start,
+            t_end: o.t_end,
+        })
+    };
+    for (k, c) in system.constraints().iter().enumerate() {
+        if let Some(e) = out_of_domain(c.domain(), &|| c.name(k)) {
+            return Err(e);
+        }
+    }
+    for (k, f) in system.forces().iter().enumerate() {
+        if let Some(e) = out_of_domain(f.domain(), &|| f.name(k)) {
+            return Err(e);
         }
     }
     Ok(())
