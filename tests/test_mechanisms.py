@@ -408,3 +408,23 @@ def test_a_body_on_an_inclined_prismatic_joint_slides_as_a_block_on_a_ramp(parti
     for p in body["particles"]:
         shift = solution.particle(p) - solution.particle(p)[0]
         np.testing.assert_allclose(shift, np.outer(s, d), rtol=0, atol=1e-9)
+
+
+def test_a_body_with_its_orientation_held_translates_under_an_off_centre_force():
+    # An orientation joint to the ground (3 equations) leaves the three translations: a constant
+    # force F at a point off the centre, which alone would also turn the body, moves it by
+    # (F / m + g) t^2 / 2 without turning (the trapezoidal rule is exact for a constant
+    # acceleration).
+    mass, force = 2.0, np.array([3.0, -1.0, 4.0])
+    system = vinculo.System(gravity=(0.0, 0.0, -G))
+    inertia = np.diag([0.02, 0.03, 0.04]).tolist()
+    body = system.add_rigid_body(mass, (0.0, 0.0, 0.0), inertia, particles=4)
+    equations = system.add_joint("orientation", None, body, (0.0, 0.0, 0.0))
+    assert len(equations) == 3
+    system.add_force(system.point(body, (0.1, 0.05, -0.2)), tuple(force))
+    solution = vinculo.simulate(system, t_end=1.0, dt=1e-2)
+    acceleration = force / mass + np.array([0.0, 0.0, -G])
+    expected = 0.5 * np.outer(solution.times**2, acceleration)
+    for p in body["particles"]:
+        shift = solution.particle(p) - solution.particle(p)[0]
+        np.testing.assert_allclose(shift, expected, rtol=0, atol=1e-9)

@@ -345,7 +345,8 @@ class System:
         """A joint between two bodies at a world point (docs/theory/mechanisms.md).
 
         Kinds: "spherical" (a shared point, 3 equations), "revolute" (a shared point and axis,
-        5), "prismatic" (a shared line and orientation, 5), "fixed" (6), "point-on-line" (b's
+        5), "prismatic" (a shared line and orientation, 5), "fixed" (6), "orientation" (a shared
+        orientation, translations free, 3), "point-on-line" (b's
         point on a's line along the axis, 2), "point-on-plane" (b's point on a's plane normal to
         the axis, 1). Between planar bodies (or a planar body and the ground) a joint keeps its
         in-plane equations: 2 for a shared point, 1 for a shared direction or line.
@@ -357,7 +358,7 @@ class System:
             b: the second body, or None for the ground.
             at: the joint's world point at the initial configuration (m).
             axis: the joint's axis (turning axis, sliding direction, line or plane normal);
-                needed except for "spherical" and "fixed". For planar bodies a revolute axis is
+                needed except for "spherical", "fixed" and "orientation". For planar bodies a revolute axis is
                 the plane's normal, a sliding axis lies in the plane.
 
         Returns:

@@ -441,8 +441,8 @@ impl PySystem {
         Ok(self.make_point(point))
     }
 
-    /// A joint of `kind` ("spherical", "revolute", "prismatic", "fixed", "point-on-line",
-    /// "point-on-plane") between bodies a and b (None: the ground) at world point `at` with
+    /// A joint of `kind` ("spherical", "revolute", "prismatic", "fixed", "orientation",
+    /// "point-on-line", "point-on-plane") between bodies a and b (None: the ground) at world point `at` with
     /// axis `axis`; returns its equations' ConstraintIds.
     #[pyo3(signature = (kind, a, b, at, axis=None))]
     fn add_joint(
@@ -459,17 +459,21 @@ impl PySystem {
             "revolute" => JointKind::Revolute,
             "prismatic" => JointKind::Prismatic,
             "fixed" => JointKind::Fixed,
+            "orientation" => JointKind::Orientation,
             "point-on-line" => JointKind::PointOnLine,
             "point-on-plane" => JointKind::PointOnPlane,
             other => {
                 return Err(invalid(
                     "kind",
                     other,
-                    "expected 'spherical', 'revolute', 'prismatic', 'fixed', 'point-on-line' or 'point-on-plane'",
+                    "expected 'spherical', 'revolute', 'prismatic', 'fixed', 'orientation', 'point-on-line' or 'point-on-plane'",
                 ))
             }
         };
-        let needs_axis = !matches!(kind, JointKind::Spherical | JointKind::Fixed);
+        let needs_axis = !matches!(
+            kind,
+            JointKind::Spherical | JointKind::Fixed | JointKind::Orientation
+        );
         let axis = match axis {
             Some(a) => vec3(a, "axis")?,
             None if needs_axis => {

@@ -13,13 +13,14 @@
 //!   (x_B - x_A) . e1^A = 0, (x_B - x_A) . e2^A = 0 (x_B on A's line through `at` along n):
 //!   5 equations, 1 relative translation left;
 //! - fixed: spherical and the three orientation equations (6);
+//! - orientation: the three orientation equations alone (3: translations free);
 //! - point on a line of A: the two line equations; point on a plane of A (normal n): one.
 //!
 //! Between planar bodies (or a planar body and the ground) of one plane, a joint keeps only its
 //! in-plane equations: with u, v the in-plane world axes, d the joint's in-plane direction and
 //! p = e_normal x d, spherical and revolute are the two relative coordinates along u and v;
 //! prismatic is d^A . p^B = 0 and (x_B - x_A) . p^A = 0; fixed is the two coordinates and
-//! d^A . p^B = 0; point on a line (along d) is (x_B - x_A) . p^A = 0; point on a "plane" of
+//! d^A . p^B = 0; orientation is d^A . p^B = 0 alone; point on a line (along d) is (x_B - x_A) . p^A = 0; point on a "plane" of
 //! normal n (a line in the plane) is (x_B - x_A) . n^A = 0.
 //!
 //! The orientation equations hold for a small relative rotation w, e1^B = e1 + w x e1, ...:
@@ -46,6 +47,8 @@ pub enum JointKind {
     Prismatic,
     /// A shared point and orientation (6).
     Fixed,
+    /// A shared orientation, translations free (3).
+    Orientation,
     /// B's point on A's line (2).
     PointOnLine,
     /// B's point on A's plane, normal to the axis (1).
@@ -60,6 +63,7 @@ impl JointKind {
             JointKind::Revolute => "revolute joint",
             JointKind::Prismatic => "prismatic joint",
             JointKind::Fixed => "fixed joint",
+            JointKind::Orientation => "orientation joint",
             JointKind::PointOnLine => "point-on-line joint",
             JointKind::PointOnPlane => "point-on-plane joint",
         }
@@ -104,6 +108,12 @@ fn equation_names(kind: JointKind, plane: Option<usize>) -> Vec<String> {
                 s("A's e1 normal to B's e2"),
             ]);
         }
+        (JointKind::Orientation, None) => names.extend([
+            s("axis normal to B's e1"),
+            s("axis normal to B's e2"),
+            s("A's e1 normal to B's e2"),
+        ]),
+        (JointKind::Orientation, Some(_)) => names.push(s("no relative rotation")),
         (JointKind::PointOnLine, None) => names.extend([
             s("B's point on A's line (along e1)"),
             s("B's point on A's line (along e2)"),
@@ -266,6 +276,11 @@ impl System {
                     normal(s, 1, 7)?;
                     normal(s, 2, 7)?;
                 }
+                JointKind::Orientation => {
+                    normal(s, 1, 6)?;
+                    normal(s, 1, 7)?;
+                    normal(s, 2, 7)?;
+                }
                 JointKind::PointOnLine => {
                     on(s, 2)?;
                     on(s, 3)?;
@@ -293,7 +308,7 @@ impl System {
         let along_normal = (n[normal].abs() - 1.0).abs() < 1e-12;
         let turning = matches!(
             kind,
-            JointKind::Spherical | JointKind::Revolute | JointKind::Fixed
+            JointKind::Spherical | JointKind::Revolute | JointKind::Fixed | JointKind::Orientation
         );
         // The in-plane direction d of a slider or line (e_u for a joint that turns), and its
         // normal p in the plane.
@@ -351,6 +366,9 @@ impl System {
                 }
                 JointKind::Fixed => {
                     coincide(s)?;
+                    aligned(s)?;
+                }
+                JointKind::Orientation => {
                     aligned(s)?;
                 }
                 JointKind::PointOnLine => {
