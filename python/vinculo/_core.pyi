@@ -364,7 +364,7 @@ class System:
         Returns:
             The handles of its equations, one per equation, each named in messages and
             redundancy reports by the joint and what it holds ("revolute joint #1: shared point
-            along x", "...: axis normal to B's e1").
+            along x", "...: A's axis normal to B's e1").
 
         Raises:
             InvalidInputError: an unknown kind, a missing or zero axis, bodies of different

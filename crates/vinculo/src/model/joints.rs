@@ -70,66 +70,99 @@ impl JointKind {
     }
 }
 
-/// What each equation of a joint holds, in the order the joint adds them (module doc).
-fn equation_names(kind: JointKind, plane: Option<usize>) -> Vec<String> {
-    let axes = ["x", "y", "z"];
-    let coincide: Vec<String> = match plane {
-        None => (0..3)
-            .map(|k| format!("shared point along {}", axes[k]))
-            .collect(),
+/// One equation of a joint, over its points: for each body, its point at the joint, then its
+/// points one unit along each of the joint's directions (in space n, e1, e2; in a plane d, p).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Equation {
+    /// x_B - x_A = 0 along a world axis.
+    Shared(usize),
+    /// A's direction k normal to B's direction l (k, l from 1).
+    Normal(usize, usize),
+    /// x_B - x_A normal to A's direction k.
+    On(usize),
+}
+
+/// The equations of a joint (module doc), in space (`plane` None) or in the plane normal to a
+/// world axis.
+fn equations(kind: JointKind, plane: Option<usize>) -> Vec<Equation> {
+    use Equation::{Normal, On, Shared};
+    let shared = match plane {
+        None => vec![Shared(0), Shared(1), Shared(2)],
         Some(normal) => {
             let (u, v) = super::planar_body::in_plane(normal);
-            vec![
-                format!("shared point along {}", axes[u]),
-                format!("shared point along {}", axes[v]),
-            ]
+            vec![Shared(u), Shared(v)]
         }
     };
-    let s = |x: &str| x.to_string();
-    let mut names = Vec::new();
-    match (kind, plane) {
-        (JointKind::Spherical, _) => names.extend(coincide),
-        (JointKind::Revolute, None) => {
-            names.extend(coincide);
-            names.extend([s("axis normal to B's e1"), s("axis normal to B's e2")]);
-        }
-        (JointKind::Prismatic, None) => names.extend([
-            s("axis normal to B's e1"),
-            s("axis normal to B's e2"),
-            s("A's e1 normal to B's e2"),
-            s("B's point on A's line (along e1)"),
-            s("B's point on A's line (along e2)"),
-        ]),
-        (JointKind::Fixed, None) => {
-            names.extend(coincide);
-            names.extend([
-                s("axis normal to B's e1"),
-                s("axis normal to B's e2"),
-                s("A's e1 normal to B's e2"),
-            ]);
-        }
-        (JointKind::Orientation, None) => names.extend([
-            s("axis normal to B's e1"),
-            s("axis normal to B's e2"),
-            s("A's e1 normal to B's e2"),
-        ]),
-        (JointKind::Orientation, Some(_)) => names.push(s("no relative rotation")),
-        (JointKind::PointOnLine, None) => names.extend([
-            s("B's point on A's line (along e1)"),
-            s("B's point on A's line (along e2)"),
-        ]),
-        (JointKind::PointOnPlane, _) => names.push(s("B's point on A's plane")),
-        (JointKind::Revolute, Some(_)) => names.extend(coincide),
-        (JointKind::Prismatic, Some(_)) => {
-            names.extend([s("no relative rotation"), s("B's point on A's line")])
-        }
-        (JointKind::Fixed, Some(_)) => {
-            names.extend(coincide);
-            names.push(s("no relative rotation"));
-        }
-        (JointKind::PointOnLine, Some(_)) => names.push(s("B's point on A's line")),
+    // In space: the directions n, e1, e2; in a plane: d, p.
+    let (orientation, line) = match plane {
+        None => (
+            vec![Normal(1, 2), Normal(1, 3), Normal(2, 3)],
+            vec![On(2), On(3)],
+        ),
+        Some(_) => (vec![Normal(1, 2)], vec![On(2)]),
+    };
+    match kind {
+        JointKind::Spherical => shared,
+        JointKind::Revolute if plane.is_some() => shared,
+        JointKind::Revolute => [shared, vec![Normal(1, 2), Normal(1, 3)]].concat(),
+        JointKind::Prismatic => [orientation, line].concat(),
+        JointKind::Fixed => [shared, orientation].concat(),
+        JointKind::Orientation => orientation,
+        JointKind::PointOnLine => line,
+        JointKind::PointOnPlane => vec![On(1)],
     }
-    names
+}
+
+impl Equation {
+    /// What it holds, for messages, with `directions` the names of the joint's directions.
+    fn name(self, directions: &[&str]) -> String {
+        match self {
+            Equation::Shared(axis) => format!("shared point along {}", ["x", "y", "z"][axis]),
+            Equation::Normal(k, l) => format!(
+                "A's {} normal to B's {}",
+                directions[k - 1],
+                directions[l - 1]
+            ),
+            Equation::On(k) => format!(
+                "B's point in the plane through A's normal to A's {}",
+                directions[k - 1]
+            ),
+        }
+    }
+}
+
+/// The in-plane directions (d, p) of a joint between planar bodies of normal axis `normal`:
+/// d the joint's axis for a slider or a line (it must lie in the plane), e_u for a joint that
+/// turns (whose axis, for a revolute joint, must be the plane's normal), p = e_normal x d.
+fn in_plane_directions(kind: JointKind, n: Vec3, normal: usize, label: &str) -> Result<Vec<Vec3>> {
+    let (u, _) = super::planar_body::in_plane(normal);
+    let axis_name = ["x", "y", "z"][normal];
+    let turning = matches!(
+        kind,
+        JointKind::Spherical | JointKind::Revolute | JointKind::Fixed | JointKind::Orientation
+    );
+    let refuse = |expected: String| Error::InvalidVector {
+        name: format!("axis of {label}"),
+        value: n.to_vec(),
+        expected,
+    };
+    if kind == JointKind::Revolute && (n[normal].abs() - 1.0).abs() >= 1e-12 {
+        return Err(refuse(format!(
+            "a revolute joint of planar bodies turns about their plane's normal, the {axis_name} axis"
+        )));
+    }
+    let d: Vec3 = if turning {
+        std::array::from_fn(|k| if k == u { 1.0 } else { 0.0 })
+    } else if n[normal].abs() < 1e-12 {
+        n
+    } else {
+        return Err(refuse(format!(
+            "must lie in the bodies' plane (component {axis_name} = 0)"
+        )));
+    };
+    let mut e_normal = [0.0; 3];
+    e_normal[normal] = 1.0;
+    Ok(vec![d, cross(e_normal, d)])
 }
 
 /// A unit vector normal to `n` (unit), and the third of the right-handed triad (n, e1, e2).
@@ -178,14 +211,43 @@ impl System {
         }
         let n = scale(1.0 / length, axis);
         let plane = self.plane_of(&label, a, b)?;
-        let built = match plane {
-            None => self.joint_in_space(kind, (a, b), at, n, &label)?,
-            Some(normal) => self.joint_in_plane(kind, (a, b), at, (n, normal), &label)?,
+        let (directions, names): (Vec<Vec3>, &[&str]) = match plane {
+            None => {
+                let (e1, e2) = triad(n);
+                (vec![n, e1, e2], &["axis", "e1", "e2"])
+            }
+            Some(normal) => (in_plane_directions(kind, n, normal, &label)?, &["d", "p"]),
         };
+        // For each body: its point at `at`, then at `at` plus each direction.
+        let offset = |d: &Vec3| [at[0] + d[0], at[1] + d[1], at[2] + d[2]];
+        let mut points = Vec::with_capacity(2 * (1 + directions.len()));
+        for frame in [a, b] {
+            points.push(self.body_point(frame, at)?);
+            for d in &directions {
+                points.push(self.body_point(frame, offset(d))?);
+            }
+        }
+        let m = 1 + directions.len(); // B's points start at m
+        let equations = equations(kind, plane);
+        let zero = || Some(Law::Constant(0.0));
+        let (_, built) = self.on_points(&points, &label, |s, p| {
+            for &equation in &equations {
+                match equation {
+                    Equation::Shared(axis) => {
+                        s.add_relative_coordinate(p[0], p[m], axis, zero())?
+                    }
+                    Equation::Normal(k, l) => {
+                        s.add_dot_product([p[0], p[k], p[m], p[m + l]], zero())?
+                    }
+                    Equation::On(k) => s.add_dot_product([p[0], p[m], p[0], p[k]], zero())?,
+                };
+            }
+            Ok(())
+        })?;
         // Each equation named by what it holds, for messages and redundancy reports.
-        for (c, what) in built.constraints.iter().zip(equation_names(kind, plane)) {
+        for (c, equation) in built.constraints.iter().zip(&equations) {
             if let crate::constraints::Constraint::OnPoints(e) = &mut self.constraints[c.0] {
-                e.label = format!("{label}: {what}");
+                e.label = format!("{label}: {}", equation.name(names));
             }
         }
         self.joints += 1;
@@ -220,168 +282,6 @@ impl System {
             });
         }
         Ok(na.or(nb))
-    }
-
-    /// The equations of a joint in space (module doc).
-    fn joint_in_space(
-        &mut self,
-        kind: JointKind,
-        (a, b): (&[ParticleId], &[ParticleId]),
-        at: Vec3,
-        n: Vec3,
-        label: &str,
-    ) -> Result<Built> {
-        let (e1, e2) = triad(n);
-        let offset = |d: Vec3| [at[0] + d[0], at[1] + d[1], at[2] + d[2]];
-        // Points 0..3: A at `at`, +n, +e1, +e2; 4..7: the same of B.
-        let mut points = Vec::with_capacity(8);
-        for frame in [a, b] {
-            points.push(self.body_point(frame, at)?);
-            for d in [n, e1, e2] {
-                points.push(self.body_point(frame, offset(d))?);
-            }
-        }
-        let (_, built) = self.on_points(&points, label, |s, p| {
-            let coincide = |s: &mut System| -> Result<()> {
-                for axis in 0..3 {
-                    s.add_relative_coordinate(p[0], p[4], axis, Some(Law::Constant(0.0)))?;
-                }
-                Ok(())
-            };
-            // (x_B - x_A) . d^A = 0 for A's direction to point k.
-            let on = |s: &mut System, k: usize| {
-                s.add_dot_product([p[0], p[4], p[0], p[k]], Some(Law::Constant(0.0)))
-            };
-            // d^A(k) . d^B(l) = 0.
-            let normal = |s: &mut System, k: usize, l: usize| {
-                s.add_dot_product([p[0], p[k], p[4], p[l]], Some(Law::Constant(0.0)))
-            };
-            match kind {
-                JointKind::Spherical => coincide(s)?,
-                JointKind::Revolute => {
-                    coincide(s)?;
-                    normal(s, 1, 6)?;
-                    normal(s, 1, 7)?;
-                }
-                JointKind::Prismatic => {
-                    normal(s, 1, 6)?;
-                    normal(s, 1, 7)?;
-                    normal(s, 2, 7)?;
-                    on(s, 2)?;
-                    on(s, 3)?;
-                }
-                JointKind::Fixed => {
-                    coincide(s)?;
-                    normal(s, 1, 6)?;
-                    normal(s, 1, 7)?;
-                    normal(s, 2, 7)?;
-                }
-                JointKind::Orientation => {
-                    normal(s, 1, 6)?;
-                    normal(s, 1, 7)?;
-                    normal(s, 2, 7)?;
-                }
-                JointKind::PointOnLine => {
-                    on(s, 2)?;
-                    on(s, 3)?;
-                }
-                JointKind::PointOnPlane => {
-                    on(s, 1)?;
-                }
-            }
-            Ok(())
-        })?;
-        Ok(built)
-    }
-
-    /// The equations of a joint between planar bodies of normal axis `normal` (module doc):
-    /// in the plane, a shared point is 2 equations and a shared direction 1.
-    fn joint_in_plane(
-        &mut self,
-        kind: JointKind,
-        (a, b): (&[ParticleId], &[ParticleId]),
-        at: Vec3,
-        (n, normal): (Vec3, usize),
-        label: &str,
-    ) -> Result<Built> {
-        let (u, v) = super::planar_body::in_plane(normal);
-        let along_normal = (n[normal].abs() - 1.0).abs() < 1e-12;
-        let turning = matches!(
-            kind,
-            JointKind::Spherical | JointKind::Revolute | JointKind::Fixed | JointKind::Orientation
-        );
-        // The in-plane direction d of a slider or line (e_u for a joint that turns), and its
-        // normal p in the plane.
-        let d = if turning {
-            std::array::from_fn(|k| if k == u { 1.0 } else { 0.0 })
-        } else if n[normal].abs() < 1e-12 {
-            n
-        } else {
-            return Err(Error::InvalidVector {
-                name: format!("axis of {label}"),
-                value: n.to_vec(),
-                expected: format!(
-                    "must lie in the bodies' plane (component {} = 0)",
-                    ["x", "y", "z"][normal]
-                ),
-            });
-        };
-        if turning && !along_normal && kind == JointKind::Revolute {
-            return Err(Error::InvalidVector {
-                name: format!("axis of {label}"),
-                value: n.to_vec(),
-                expected: format!(
-                    "a revolute joint of planar bodies turns about their plane's normal, the {} axis",
-                    ["x", "y", "z"][normal]
-                ),
-            });
-        }
-        let mut e_normal = [0.0; 3];
-        e_normal[normal] = 1.0;
-        let p = cross(e_normal, d);
-        let offset = |x: Vec3| [at[0] + x[0], at[1] + x[1], at[2] + x[2]];
-        // Points 0..2: A at `at`, +d, +p; 3..5: the same of B.
-        let mut points = Vec::with_capacity(6);
-        for frame in [a, b] {
-            points.push(self.body_point(frame, at)?);
-            points.push(self.body_point(frame, offset(d))?);
-            points.push(self.body_point(frame, offset(p))?);
-        }
-        let (_, built) = self.on_points(&points, label, |s, q| {
-            let zero = || Some(Law::Constant(0.0));
-            let coincide = |s: &mut System| -> Result<()> {
-                s.add_relative_coordinate(q[0], q[3], u, zero())?;
-                s.add_relative_coordinate(q[0], q[3], v, zero())?;
-                Ok(())
-            };
-            // d^A . p^B = 0: no relative rotation.
-            let aligned = |s: &mut System| s.add_dot_product([q[0], q[1], q[3], q[5]], zero());
-            // (x_B - x_A) . p^A = 0: B's point on A's line along d.
-            let on_line = |s: &mut System| s.add_dot_product([q[0], q[3], q[0], q[2]], zero());
-            match kind {
-                JointKind::Spherical | JointKind::Revolute => coincide(s)?,
-                JointKind::Prismatic => {
-                    aligned(s)?;
-                    on_line(s)?;
-                }
-                JointKind::Fixed => {
-                    coincide(s)?;
-                    aligned(s)?;
-                }
-                JointKind::Orientation => {
-                    aligned(s)?;
-                }
-                JointKind::PointOnLine => {
-                    on_line(s)?;
-                }
-                JointKind::PointOnPlane => {
-                    // In the plane, a "plane" of normal n through `at` is the line along p.
-                    s.add_dot_product([q[0], q[3], q[0], q[1]], zero())?;
-                }
-            }
-            Ok(())
-        })?;
-        Ok(built)
     }
 
     /// A torque `torque(t)` (N m) about the world axis `axis` on the body `frame`, turning about
