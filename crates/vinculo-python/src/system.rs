@@ -70,6 +70,16 @@ pub struct PySystem {
     pub user_errors: crate::user_physics::PendingError,
 }
 
+/// Python handles of particles.
+fn particle_handles(ids: &[ParticleId]) -> Vec<PyParticleId> {
+    ids.iter().map(|&inner| PyParticleId { inner }).collect()
+}
+
+/// Python handles of constraints.
+fn constraint_handles(ids: &[vinculo::model::ConstraintId]) -> Vec<PyConstraintId> {
+    ids.iter().map(|c| PyConstraintId { index: c.0 }).collect()
+}
+
 /// An axis given as 0, 1, 2 or "x", "y", "z".
 fn axis_index(axis: &Bound<'_, PyAny>) -> PyResult<usize> {
     if let Ok(s) = axis.extract::<String>() {
@@ -491,7 +501,7 @@ impl PySystem {
             .inner
             .add_joint(kind, (&fa, &fb), at, axis)
             .map_err(to_py)?;
-        Ok(ids.iter().map(|c| PyConstraintId { index: c.0 }).collect())
+        Ok(constraint_handles(&ids))
     }
 
     /// A torque (N m; a number or a Law) about the world axis `axis` through `at` on `body`.
@@ -539,20 +549,10 @@ impl PySystem {
             angular_velocity,
         };
         let body = self.inner.add_planar_body(&spec).map_err(to_py)?;
-        let ids: Vec<PyParticleId> = body
-            .particles
-            .iter()
-            .map(|&inner| PyParticleId { inner })
-            .collect();
         let d = PyDict::new(py);
-        d.set_item("particles", ids.clone())?;
-        d.set_item("frame", ids)?;
-        let constraints: Vec<PyConstraintId> = body
-            .constraints
-            .iter()
-            .map(|c| PyConstraintId { index: c.0 })
-            .collect();
-        d.set_item("constraints", constraints)?;
+        d.set_item("particles", particle_handles(&body.particles))?;
+        d.set_item("frame", particle_handles(&body.particles))?;
+        d.set_item("constraints", constraint_handles(&body.constraints))?;
         d.set_item("normal", ["x", "y", "z"][body.normal])?;
         Ok(d)
     }
@@ -570,17 +570,9 @@ impl PySystem {
             .collect::<PyResult<Vec<_>>>()?;
         let cluster = self.inner.add_rigid_cluster(&ids).map_err(to_py)?;
         let d = PyDict::new(py);
-        let handles = |v: &[ParticleId]| -> Vec<PyParticleId> {
-            v.iter().map(|&inner| PyParticleId { inner }).collect()
-        };
-        d.set_item("particles", handles(&ids))?;
-        d.set_item("frame", handles(&cluster.frame))?;
-        let constraints: Vec<PyConstraintId> = cluster
-            .constraints
-            .iter()
-            .map(|c| PyConstraintId { index: c.0 })
-            .collect();
-        d.set_item("constraints", constraints)?;
+        d.set_item("particles", particle_handles(&ids))?;
+        d.set_item("frame", particle_handles(&cluster.frame))?;
+        d.set_item("constraints", constraint_handles(&cluster.constraints))?;
         Ok(d)
     }
 
@@ -635,9 +627,7 @@ impl PySystem {
                 .collect::<PyResult<_>>()?,
             point_mass_fraction,
         };
-        let ids = |v: &[ParticleId]| -> Vec<PyParticleId> {
-            v.iter().map(|&inner| PyParticleId { inner }).collect()
-        };
+        let ids = particle_handles;
         match particles {
             7 => {}
             4 => {
@@ -650,12 +640,7 @@ impl PySystem {
                     .point_in(&body.particles, spec.centre)
                     .map_err(to_py)?;
                 d.set_item("centre", self.make_point(centre))?;
-                let constraints: Vec<PyConstraintId> = body
-                    .constraints
-                    .iter()
-                    .map(|c| PyConstraintId { index: c.0 })
-                    .collect();
-                d.set_item("constraints", constraints)?;
+                d.set_item("constraints", constraint_handles(&body.constraints))?;
                 d.set_item("axes", body.axes.map(|r| r.to_vec()).to_vec())?;
                 return Ok(d);
             }
@@ -674,12 +659,7 @@ impl PySystem {
         d.set_item("points", ids(&body.points))?;
         d.set_item("particles", ids(&body.particles))?;
         d.set_item("frame", ids(&body.frame()))?;
-        let constraints: Vec<PyConstraintId> = body
-            .constraints
-            .iter()
-            .map(|c| PyConstraintId { index: c.0 })
-            .collect();
-        d.set_item("constraints", constraints)?;
+        d.set_item("constraints", constraint_handles(&body.constraints))?;
         d.set_item("axes", body.axes.map(|r| r.to_vec()).to_vec())?;
         Ok(d)
     }
