@@ -76,8 +76,6 @@ def test_tangent_defaults_and_bad_values_raise_typed_errors():
         system.add_line_hydrodynamics(n, diameter=0.1, length=1.0, tangent=(a,))
     with pytest.raises(InvalidInputError, match="CdAx"):
         system.add_line_hydrodynamics(n, diameter=0.1, length=1.0, cdax=float("nan"))
-    with pytest.raises(InvalidInputError, match="current"):
-        system.add_line_hydrodynamics(n, diameter=0.1, length=1.0, current=(0.0, 1.0))
     other = vinculo.System().add_particle(1.0, (0.0, 0.0, 0.0))
     with pytest.raises(UnknownHandleError):
         system.add_seabed_contact(n, depth=DEPTH, diameter=0.1, length=1.0, tangent=(a, other))

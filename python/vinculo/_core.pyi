@@ -717,17 +717,19 @@ class System:
         caax: float = 0.0,
         density: float = 1025.0,
         tangent: tuple[ParticleId, ParticleId] | None = None,
-        current: Vector | None = None,
     ) -> ForceId:
         """Buoyancy, drag and added mass of a line node in water, MoorDyn's model in the line's
-        local frame (docs/theory/seabed-and-line-loads.md).
+        local frame (docs/theory/seabed-and-line-loads.md; in waves docs/theory/ocean.md).
 
-        With the volume ``V = pi d^2 / 4 l`` and the velocity relative to the current
-        ``r = current - v`` split into its parts along (``r_a``) and across (``r_n``) the line:
-        buoyancy ``rho V g`` upwards, normal drag ``1/2 rho cd d l |r_n| r_n``, axial drag
-        ``1/2 rho cdax pi d l |r_a| r_a``. The added mass is MoorDyn's
-        ``rho V (ca (I - t t^T) + caax t t^T)``: ``ca rho V`` across the line and ``caax rho V``
-        along it (without a tangent, ``ca rho V`` in every direction).
+        With the volume ``V = pi d^2 / 4 l`` and the velocity relative to the water
+        ``r = u - v`` (``u`` the flow of the system's water, :meth:`set_water`) split into its
+        parts along (``r_a``) and across (``r_n``) the line: buoyancy ``rho V g`` upwards, normal
+        drag ``1/2 rho cd d l |r_n| r_n``, axial drag ``1/2 rho cdax pi d l |r_a| r_a``, and the
+        water's acceleration ``a`` gives ``rho V ((1 + ca) a_n + (1 + caax) a_a)``. The added
+        mass is MoorDyn's ``rho V (ca (I - t t^T) + caax t t^T)``: ``ca rho V`` across the line
+        and ``caax rho V`` along it (without a tangent, ``ca rho V`` in every direction). In
+        water with a free surface the loads (not the added mass) are scaled by the node's wet
+        fraction ``clamp((eta - z) / d + 1/2, 0, 1)``.
 
         Arguments:
             node: the line node.
@@ -740,7 +742,6 @@ class System:
             density: water density rho (kg/m^3, > 0).
             tangent: (a, b): the line's direction at the node, from particle a to b, as for
                 ``add_seabed_contact``; None: drag with ``cd`` in every direction.
-            current: a uniform current (m/s, 3 numbers); None: still water.
 
         Returns:
             The force's handle.
@@ -749,6 +750,14 @@ class System:
             InvalidInputError: a value outside its domain, or a tangent that is not two
                 different particles.
             UnknownHandleError: a handle of another system.
+        """
+    def set_water(self, water: Water) -> None:
+        """Put the line elements (added before and after) in ``water``: its current, waves and
+        free surface. Build it with :class:`vinculo.ocean.Sea` (``Sea.water()``); until then a
+        system's water is still water that fills all space.
+
+        Arguments:
+            water: the water.
         """
     def set_tension_only(self, constraint: ConstraintId) -> None:
         """Declare a distance constraint a string: runs stop with NegativeTensionError when it
@@ -903,6 +912,63 @@ class RunResult:
         it, of the ``vinculo.errors`` class the core's error selects, with the partial
         ``vinculo.Solution`` as its ``solution`` attribute and, for a failed user function, the
         user's exception as its ``__cause__``."""
+
+class Water:
+    """The core's water: a current, linear wave components and a free surface at z = eta
+    (z up, still-water level z = 0, seabed z = -depth). Build it with
+    :class:`vinculo.ocean.Sea`; see docs/theory/ocean.md for the equations."""
+
+    def __init__(self, depth: float, g: float, amplitudes: npt.NDArray[np.float64],
+                 omegas: npt.NDArray[np.float64], directions: npt.NDArray[np.float64],
+                 phases: npt.NDArray[np.float64], current_kind: str,
+                 current_velocity: npt.NDArray[np.float64],
+                 current_heights: npt.NDArray[np.float64], current_exponent: float,
+                 stretching_name: str, free_surface: bool) -> None:
+        """Arguments:
+            depth: water depth (m, > 0; inf: deep water).
+            g: gravity (m/s^2).
+            amplitudes: wave amplitudes (m).
+            omegas: angular frequencies (rad/s).
+            directions: directions of travel (rad from x towards y).
+            phases: phases (rad).
+            current_kind: "uniform", "power" or "table".
+            current_velocity: (n, 3) velocities (m/s): one for "uniform" and "power" (at the
+                surface), one per height for "table".
+            current_heights: the table's heights (m, increasing).
+            current_exponent: the power law's exponent.
+            stretching_name: "wheeler" or "vertical".
+            free_surface: whether the water has a free surface (False: it fills all space).
+
+        Raises:
+            InvalidInputError: a value outside its domain, named.
+        """
+    @property
+    def wave_numbers(self) -> npt.NDArray[np.float64]:
+        """The components' wave numbers k (rad/m), roots of omega^2 = g k tanh(k h)."""
+    def flow(self, points: npt.NDArray[np.float64], t: float,
+             gradients: bool = False) -> dict[str, npt.NDArray[np.float64]]:
+        """The flow at many points at one time.
+
+        Arguments:
+            points: (n, 3) positions (m).
+            t: time (s).
+            gradients: also return ``velocity_gradient`` (n, 3, 3).
+
+        Returns:
+            ``velocity`` and ``acceleration`` (n, 3), ``pressure`` (n,: the waves' dynamic
+            pressure over the density, m^2/s^2), ``elevation`` (n,: eta above each point).
+        """
+    def elevation(self, xy: npt.NDArray[np.float64],
+                  t: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        """The surface elevation (m), (len(t), len(xy)).
+
+        Arguments:
+            xy: (n, 2) horizontal positions (m).
+            t: (m,) times (s).
+
+        Returns:
+            The elevation at each time and position.
+        """
 
 def solve_statics(system: System, tolerance: float = 1e-9, max_iterations: int = 1000,
                   t: float = 0.0, newton_first: bool = True

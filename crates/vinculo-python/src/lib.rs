@@ -11,6 +11,7 @@ mod statics;
 mod stepping;
 mod system;
 mod user_physics;
+mod water;
 
 use pyo3::prelude::*;
 
@@ -27,6 +28,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<stepping::PySnapshot>()?;
     m.add_class::<run::PyRunSettings>()?;
     m.add_class::<run_result::PyRunResult>()?;
+    m.add_class::<water::PyWater>()?;
     m.add_function(wrap_pyfunction!(run::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(run::time_simulate, m)?)?;
     m.add_function(wrap_pyfunction!(statics::solve_statics, m)?)?;

@@ -737,7 +737,8 @@ impl PySystem {
     }
 
     /// Buoyancy, drag and added mass of a line node in water (MoorDyn's Cd, CdAx, Ca, CaAx).
-    #[pyo3(signature = (node, *, diameter, length, cd=0.0, cdax=0.0, ca=0.0, caax=0.0, density=1025.0, tangent=None, current=None))]
+    /// In the system's water (`set_water`; still water everywhere by default).
+    #[pyo3(signature = (node, *, diameter, length, cd=0.0, cdax=0.0, ca=0.0, caax=0.0, density=1025.0, tangent=None))]
     #[allow(clippy::too_many_arguments)]
     fn add_line_hydrodynamics(
         &mut self,
@@ -750,7 +751,6 @@ impl PySystem {
         caax: f64,
         density: f64,
         tangent: Option<&Bound<'_, PyAny>>,
-        current: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<PyForceId> {
         let n = self.particle(node)?;
         let tangent = self.tangent(tangent)?;
@@ -762,16 +762,18 @@ impl PySystem {
             cdax,
             ca,
             caax,
-            current: current
-                .map(|c| vec3(c, "current"))
-                .transpose()?
-                .unwrap_or([0.0; 3]),
         };
         let id = self
             .inner
             .add_line_hydrodynamics(n, tangent, &spec)
             .map_err(to_py)?;
         Ok(PyForceId { index: id.0 })
+    }
+
+    /// Puts the line elements (those added before and after) in `water` (a `vinculo._core.Water`,
+    /// made by `vinculo.ocean.Sea`): its current, waves and free surface.
+    fn set_water(&mut self, water: PyRef<'_, crate::water::PyWater>) {
+        self.inner.set_water(water.inner.clone());
     }
 
     /// Forces computed by one Python function for a whole group of elements at once.

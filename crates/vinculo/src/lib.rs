@@ -60,6 +60,7 @@ pub mod solution;
 pub mod statics;
 pub mod step_control;
 pub mod user;
+pub mod water;
 
 pub use error::{Error, Result};
 pub use linear::SparseSolver;

@@ -8,6 +8,7 @@
 
 use vinculo::forces::SeabedFriction;
 use vinculo::model::{LineHydroSpec, ParticleId, SeabedSpec, System};
+use vinculo::water::{Current, Water};
 use vinculo::{simulate, SimulationOptions, Solution};
 
 const G: f64 = 9.80665;
@@ -41,7 +42,6 @@ fn node(z: f64, v: [f64; 3], cd: f64, ca: f64) -> (System, ParticleId, (Particle
         cdax: 0.0,
         ca,
         caax: 0.0,
-        current: [0.0; 3],
     };
     s.add_line_hydrodynamics(n, Some((a, b)), &hydro).unwrap();
     (s, n, (a, b))
@@ -225,9 +225,12 @@ fn node_in_a_current_settles_where_the_spring_carries_the_drag() {
             cdax,
             ca: 0.0,
             caax: 0.0,
-            current,
         };
         s.add_line_hydrodynamics(n, Some((a, b)), &hydro).unwrap();
+        // Water everywhere (no surface at the node's z = 0), moving at U.
+        let mut water = Water::everywhere(G);
+        water.current = Current::Uniform(current);
+        s.set_water(water);
         let sol = run(&s, 20.0, 1e-2);
         let x = sol.position(sol.len() - 1, 2)[direction];
         // The drag on the node at rest in the current U: 1/2 rho C A U^2.

@@ -1,23 +1,32 @@
 //! Hydrodynamic loads on a node of a lumped-mass line, in the line's local frame, with
-//! MoorDyn's conventions (`docs/theory/seabed-and-line-loads.md`).
+//! MoorDyn's conventions (`docs/theory/seabed-and-line-loads.md`; in waves and currents
+//! `docs/theory/ocean.md`).
 //!
 //! The node stands for a length l of line of diameter d (half a segment each side), volume
-//! V = pi d^2 / 4 l. With the water density rho, gravity g, a uniform current U, the node's
-//! velocity v and the tangent t ([`super::line_node`]), the relative velocity r = U - v splits
-//! into its axial part r_a = t (t . r) and its normal part r_n = r - r_a, and
+//! V = pi d^2 / 4 l. With the water density rho, gravity g, the water's velocity u and local
+//! acceleration a at the node ([`crate::water::Water::flow`]), the node's velocity v and the
+//! tangent t ([`super::line_node`]), the relative velocity r = u - v splits into its axial part
+//! r_a = t (t . r) and its normal part r_n = r - r_a, the water's acceleration likewise into
+//! a_a and a_n, and
 //!
 //! ```text
-//! f = -rho V g                                      buoyancy (g the gravity vector)
-//!   + 1/2 rho Cd    d l    |r_n| r_n                normal drag
-//!   + 1/2 rho CdAx pi d l  |r_a| r_a                axial drag (MoorDyn v2: the area pi d l)
+//! f = F [ -rho V g                                  buoyancy (g the gravity vector)
+//!       + 1/2 rho Cd    d l    |r_n| r_n            normal drag
+//!       + 1/2 rho CdAx pi d l  |r_a| r_a            axial drag (MoorDyn v2: the area pi d l)
+//!       + rho V ((1 + Ca) a_n + (1 + CaAx) a_a) ]   Froude-Krylov and the water's share of
+//!                                                   the added mass (MoorDyn v2)
 //! ```
 //!
 //! (MoorDyn-F `Line_GetStateDeriv`: `Dp = 0.25 rhoW Cdn d (l_i + l_{i+1}) |Vp| Vp`,
 //! `Dq = 0.25 rhoW Cdt pi d (l_i + l_{i+1}) |Vq| Vq`; the node length is (l_i + l_{i+1})/2.)
+//! F is the node's wet fraction: 1 in water that fills all space (the default); where the water
+//! has a free surface, F = clamp((eta - z) / d + 1/2, 0, 1) with eta the elevation above the
+//! node, which takes the node out of the water over its diameter.
 //!
 //! Added mass: MoorDyn adds rho V (Ca (I - t t^T) + CaAx t t^T) to the node's mass matrix.
 //! It is split in two: the isotropic part Ca rho V joins the particle's scalar inertia
-//! ([`LineHydro::added_mass`], constant during a run), and the axial correction
+//! ([`LineHydro::added_mass`], constant during a run, the whole of it also for a node that
+//! is partly out of the water), and the axial correction
 //!
 //! ```text
 //! C(q) = -(Ca - CaAx) rho V t t^T                  (t at the positions the forces use)
@@ -25,21 +34,26 @@
 //!
 //! is added to the node's mass block by the step problems ([`LineHydro::axial_excess`] gives
 //! (Ca - CaAx) rho V; `assembly/axial_added_mass.rs` places it), so that the node's inertia is
-//! m + Ca rho V across the line and m + CaAx rho V along it. Still water or a uniform current:
-//! the fluid's acceleration is zero, so there is no Froude-Krylov term besides buoyancy.
+//! m + Ca rho V across the line and m + CaAx rho V along it.
 //!
 //! Jacobian: with D(x) = c (|x| I + x x^T / |x|) the derivative of c |x| x (0 at x = 0),
-//! P = I - t t^T and dr_a/dt = t r^T + (t . r) I:
+//! P = I - t t^T, dr_a/dt = t r^T + (t . r) I, B = D_n P + D_a t t^T, the water's gradients
+//! G_u = du/dx, G_a = da/dx at the node and f_w the bracket above:
 //!
 //! ```text
-//! df/dv = -D_n(r_n) P - D_a(r_a) t t^T
-//! df/dt = -D_n(r_n) dr_a/dt + D_a(r_a) dr_a/dt       (then dt/dq from line_node)
+//! df/dv = -F B
+//! df/dt = F [ (D_a - D_n) dr_a/dt + rho V (CaAx - Ca) (t a^T + (t . a) I) ]   (then dt/dq)
+//! df/dx = F [ B G_u + rho V ((1 + Ca) P + (1 + CaAx) t t^T) G_a ] + f_w (grad F)^T
 //! ```
+//!
+//! where x is the node's own position and grad F = (grad eta, -1) / d inside the ramp of F.
 
-use super::line_node::{axial_part_by_tangent, LineNode};
+use super::line_node::{axial_part_by_tangent, mul, LineNode};
 use super::Jacobian;
 use crate::local::Rows;
 use crate::math::{add, add_mat, diag, dot, norm, outer, scale, scale_mat, sub, Mat3, Vec3};
+use crate::water::{Flow, Water};
+use std::sync::Arc;
 
 /// Hydrodynamic loads on one line node.
 #[derive(Debug, Clone, PartialEq)]
@@ -60,8 +74,8 @@ pub struct LineHydro {
     pub ca: f64,
     /// Axial added-mass coefficient CaAx.
     pub caax: f64,
-    /// Uniform current U (m/s).
-    pub current: Vec3,
+    /// The water: its current and waves, and whether it has a free surface.
+    pub water: Arc<Water>,
     /// Gravity of the system (m/s^2).
     pub gravity: Vec3,
 }
@@ -118,19 +132,73 @@ impl LineHydro {
         (base * self.cd, base * std::f64::consts::PI * self.cdax)
     }
 
-    /// Buoyancy and drag on the node.
-    pub(crate) fn node_force(&self, q: &[Vec3], v: &[Vec3]) -> Vec3 {
+    /// The water's flow at the node (none in still water that fills all space).
+    fn flow(&self, q: &[Vec3], t: f64, gradients: bool) -> Option<Flow> {
+        let w = &*self.water;
+        (w.free_surface || !w.is_still()).then(|| w.flow(q[self.node.node()], t, gradients))
+    }
+
+    /// The wet fraction F and, inside its ramp, its gradient (module documentation).
+    fn wet_fraction(&self, z: f64, flow: Option<&Flow>) -> (f64, Option<Vec3>) {
+        match flow {
+            Some(f) if self.water.free_surface => {
+                let s = (f.elevation - z) / self.diameter + 0.5;
+                if s >= 1.0 {
+                    (1.0, None)
+                } else if s <= 0.0 {
+                    (0.0, None)
+                } else {
+                    let [ex, ey] = f.elevation_gradient;
+                    let d = self.diameter;
+                    (s, Some([ex / d, ey / d, -1.0 / d]))
+                }
+            }
+            _ => (1.0, None),
+        }
+    }
+
+    /// The loads on the node over its wet fraction (the bracket of the module documentation).
+    fn wet_force(&self, q: &[Vec3], v: &[Vec3], flow: Option<&Flow>) -> Vec3 {
         let buoyancy = scale(-self.density * self.volume(), self.gravity);
-        let r = sub(self.current, v[self.node.node()]);
+        let u = flow.map_or([0.0; 3], |f| f.velocity);
+        let r = sub(u, v[self.node.node()]);
         let (cn, ca) = self.drag_factors();
-        let drag = match self.node.tangent(q) {
+        let tangent = self.node.tangent(q);
+        let drag = match &tangent {
             Some(tg) => {
                 let ra = scale(dot(tg.t, r), tg.t);
                 add(quadratic(cn, sub(r, ra)), quadratic(ca, ra))
             }
             None => quadratic(cn, r),
         };
-        add(buoyancy, drag)
+        let mut f = add(buoyancy, drag);
+        if let Some(flow) = flow {
+            f = add(
+                f,
+                self.inertia_force(tangent.as_ref().map(|tg| tg.t), flow.acceleration),
+            );
+        }
+        f
+    }
+
+    /// rho V ((1 + Ca) a_n + (1 + CaAx) a_a) = rho V ((1 + Ca) a + (CaAx - Ca) t (t . a)).
+    fn inertia_force(&self, t: Option<Vec3>, a: Vec3) -> Vec3 {
+        let m = self.density * self.volume();
+        let f = scale(m * (1.0 + self.ca), a);
+        match t {
+            Some(t) => add(f, scale(m * (self.caax - self.ca) * dot(t, a), t)),
+            None => f,
+        }
+    }
+
+    /// Buoyancy, drag and the water's inertia force on the node at time `t`.
+    pub(crate) fn node_force(&self, q: &[Vec3], v: &[Vec3], t: f64) -> Vec3 {
+        let flow = self.flow(q, t, false);
+        let (wet, _) = self.wet_fraction(q[self.node.node()][2], flow.as_ref());
+        if wet == 0.0 {
+            return [0.0; 3];
+        }
+        scale(wet, self.wet_force(q, v, flow.as_ref()))
     }
 
     /// The axial correction of the node's mass block at positions `q`, C = -e t t^T with
@@ -170,21 +238,33 @@ impl LineHydro {
         self.density * self.volume() * dot(self.gravity, q[self.node.node()])
     }
 
-    pub(crate) fn force(&self, q: &[Vec3], v: &[Vec3], _t: f64) -> Rows {
-        self.node.rows(self.node_force(q, v))
+    pub(crate) fn force(&self, q: &[Vec3], v: &[Vec3], t: f64) -> Rows {
+        self.node.rows(self.node_force(q, v, t))
     }
 
     pub(crate) fn add_jacobian(
         &self,
         q: &[Vec3],
         v: &[Vec3],
-        _t: f64,
+        t: f64,
         dq: &mut Jacobian,
         dv: &mut Jacobian,
     ) {
-        let r = sub(self.current, v[self.node.node()]);
+        let flow = self.flow(q, t, true);
+        let (wet, wet_gradient) = self.wet_fraction(q[self.node.node()][2], flow.as_ref());
+        if let Some(g) = wet_gradient {
+            // f_w (grad F)^T on the node's own position.
+            let fw = self.wet_force(q, v, flow.as_ref());
+            dq[0][0] = add_mat(dq[0][0], outer(1.0, fw, g));
+        }
+        if wet == 0.0 {
+            return;
+        }
+        let u = flow.as_ref().map_or([0.0; 3], |f| f.velocity);
+        let r = sub(u, v[self.node.node()]);
         let (cn, ca) = self.drag_factors();
-        match self.node.tangent(q) {
+        // B = D_n P + D_a t t^T (df/dv = -F B, df/du = F B).
+        let b = match self.node.tangent(q) {
             Some(tg) => {
                 // The products with P = I - t t^T and t t^T as products with t (module
                 // documentation): D_n P + D_a t t^T = D_n + (D_a t - D_n t) t^T, and with
@@ -196,15 +276,34 @@ impl LineHydro {
                 let da = quadratic_derivative(ca, ra);
                 let m = add_mat(da, scale_mat(-1.0, dn));
                 let mt = mat_vec(&m, t);
-                // dr/dv = -I
-                let df_dv = add_mat(scale_mat(-1.0, dn), outer(-1.0, mt, t));
-                dv[0][0] = add_mat(dv[0][0], df_dv);
-                let df_dt = add_mat(outer(1.0, mt, r), scale_mat(along, m));
-                tg.add_chain(df_dt, dq);
+                let mut df_dt = add_mat(outer(1.0, mt, r), scale_mat(along, m));
+                if let Some(f) = &flow {
+                    let e = self.density * self.volume() * (self.caax - self.ca);
+                    df_dt = add_mat(
+                        df_dt,
+                        scale_mat(e, axial_part_by_tangent(t, f.acceleration)),
+                    );
+                }
+                tg.add_chain(scale_mat(wet, df_dt), dq);
+                add_mat(dn, outer(1.0, mt, t))
             }
-            None => {
-                dv[0][0] = add_mat(dv[0][0], scale_mat(-1.0, quadratic_derivative(cn, r)));
-            }
+            None => quadratic_derivative(cn, r),
+        };
+        dv[0][0] = add_mat(dv[0][0], scale_mat(-wet, b));
+        if let Some(f) = &flow {
+            let m = self.density * self.volume();
+            let inertia = match self.node.tangent(q) {
+                Some(tg) => add_mat(
+                    diag(m * (1.0 + self.ca)),
+                    outer(m * (self.caax - self.ca), tg.t, tg.t),
+                ),
+                None => diag(m * (1.0 + self.ca)),
+            };
+            let dx = add_mat(
+                mul(b, f.velocity_gradient),
+                mul(inertia, f.acceleration_gradient),
+            );
+            dq[0][0] = add_mat(dq[0][0], scale_mat(wet, dx));
         }
     }
 }
@@ -214,7 +313,9 @@ mod tests {
     use super::super::{fd, Force};
     use super::*;
 
-    fn element(tangent: Option<[usize; 2]>, current: Vec3) -> LineHydro {
+    use crate::water::{Current, Stretching, WaveSpec};
+
+    fn element(tangent: Option<[usize; 2]>, water: Water) -> LineHydro {
         LineHydro {
             node: LineNode::new(1, tangent),
             density: 1025.0,
@@ -224,23 +325,125 @@ mod tests {
             cdax: 0.08,
             ca: 1.0,
             caax: 0.5,
-            current,
+            water: Arc::new(water),
             gravity: [0.0, 0.0, -9.80665],
         }
     }
 
+    fn in_current(current: Vec3) -> Water {
+        let mut w = Water::everywhere(9.80665);
+        w.current = Current::Uniform(current);
+        w
+    }
+
+    /// Two wave components and a sheared current, 40 m deep, its surface at eta.
+    fn sea(stretching: Stretching) -> Water {
+        let waves = [
+            WaveSpec {
+                amplitude: 1.0,
+                omega: 0.8,
+                direction: 0.3,
+                phase: 0.2,
+            },
+            WaveSpec {
+                amplitude: 0.4,
+                omega: 1.3,
+                direction: -0.5,
+                phase: 1.1,
+            },
+        ];
+        let current = Current::PowerLaw {
+            surface: [0.5, 0.2, 0.0],
+            exponent: 1.0 / 7.0,
+            depth: 40.0,
+        };
+        Water::new(40.0, 9.80665, current, &waves, stretching).unwrap()
+    }
+
     /// The analytic Jacobian equals central differences of the force, for an interior node, an
-    /// end node (its tangent from itself), a node without a tangent, in still water and in a
-    /// current.
+    /// end node (its tangent from itself), a node without a tangent, in still water, in a
+    /// current, and in waves (deep below the surface, near a crest with Wheeler's and vertical
+    /// stretching, and half out of the water).
     #[test]
     fn jacobian_matches_finite_differences() {
         let q = vec![[-2.0, 0.4, -30.0], [0.1, 0.0, -29.2], [2.2, -0.3, -27.9]];
         let v = vec![[0.1, 0.2, 0.0], [0.3, -0.7, 0.4], [0.0, 0.0, 0.5]];
-        for current in [[0.0; 3], [0.6, 0.2, 0.0]] {
+        let t = 0.8;
+        let waters = [in_current([0.0; 3]), in_current([0.6, 0.2, 0.0])];
+        for water in waters {
             for tangent in [Some([0, 2]), Some([1, 2]), Some([0, 1]), None] {
-                let f = Force::LineHydro(Box::new(element(tangent, current)));
-                fd::check(&f, &q, &v, 0.0);
+                let f = Force::LineHydro(Box::new(element(tangent, water.clone())));
+                fd::check(&f, &q, &v, t);
             }
+        }
+        for stretching in [Stretching::Wheeler, Stretching::Vertical] {
+            let w = sea(stretching);
+            let (eta, _, _) = w.surface(0.1, 0.0, t);
+            // Below, at mid-crest (eta > 0 here), partly out of the water (not at z = eta
+            // itself, where Wheeler's stretching has a kink).
+            for z in [-29.2, 0.5 * eta, eta - 0.3 * 0.09, eta + 0.2 * 0.09] {
+                let mut q = q.clone();
+                for p in q.iter_mut() {
+                    p[2] += z + 29.2;
+                }
+                for tangent in [Some([0, 2]), None] {
+                    let f = Force::LineHydro(Box::new(element(tangent, w.clone())));
+                    fd::check(&f, &q, &v, t);
+                }
+            }
+        }
+    }
+
+    /// In waves, a node held still deep under a regular wave feels the Froude-Krylov and added
+    /// mass force rho V (1 + Ca) a of the water's acceleration across the line, rho V (1 + CaAx)
+    /// a along it (MoorDyn v2), beside its buoyancy; out of the water it feels nothing, and half
+    /// out of it half of everything.
+    #[test]
+    fn inertia_force_and_wet_fraction_in_waves() {
+        let wave = WaveSpec {
+            amplitude: 0.5,
+            omega: 1.0,
+            direction: 0.0,
+            phase: 0.0,
+        };
+        let still = Current::none();
+        let w = Water::new(f64::INFINITY, 9.80665, still, &[wave], Stretching::Vertical).unwrap();
+        // Line along y: the wave's x and z accelerations are across it.
+        let e = element(Some([0, 2]), w.clone());
+        let z: f64 = -3.0;
+        let q = vec![[0.0, -1.0, z], [0.0, 0.0, z], [0.0, 1.0, z]];
+        let (t, rest): (f64, Vec<Vec3>) = (0.9, vec![[0.0; 3]; 3]);
+        let k = 1.0 / 9.80665;
+        let decay = (k * z).exp();
+        // Deep water: a_x = a w^2 e^{kz} sin(-w t), a_z = -a w^2 e^{kz} cos(-w t) (airy.rs).
+        let (ax, az) = (0.5 * decay * (-t).sin(), -0.5 * decay * (-t).cos());
+        let (ux, uz) = (0.5 * decay * (-t).cos(), 0.5 * decay * (-t).sin());
+        let m = 1025.0 * e.volume();
+        let f = e.node_force(&q, &rest, t);
+        // The node at rest sees r = u: the normal drag 1/2 rho Cd d l |u| u (u is across).
+        let speed = ux.hypot(uz);
+        let drag = 0.5 * 1025.0 * 1.2 * 0.09 * 2.5 * speed;
+        let fx = m * 2.0 * ax + drag * ux;
+        let fz = m * 2.0 * az + drag * uz + m * 9.80665;
+        assert!((f[0] - fx).abs() < 1e-10 * fx.abs(), "{} {fx}", f[0]);
+        assert!((f[2] - fz).abs() < 1e-10 * fz.abs(), "{} {fz}", f[2]);
+        // Above the crest: dry; at the surface: half wet.
+        let (eta, _, _) = w.surface(0.0, 0.0, t);
+        let lift = |dz: f64| {
+            q.iter()
+                .map(|p| [p[0], p[1], p[2] - z + dz])
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(e.node_force(&lift(eta + 0.05), &rest, t), [0.0; 3]);
+        let half = e.node_force(&lift(eta), &rest, t);
+        let mut at_surface = e.clone();
+        at_surface.water = Arc::new(Water {
+            free_surface: false,
+            ..w
+        });
+        let full = at_surface.node_force(&lift(eta), &rest, t);
+        for i in 0..3 {
+            assert!((half[i] - 0.5 * full[i]).abs() < 1e-12 * full[i].abs().max(1.0));
         }
     }
 
@@ -249,12 +452,12 @@ mod tests {
     /// along it, 1/2 rho CdAx pi d l u^2.
     #[test]
     fn buoyancy_and_drag_match_moordyn_closed_forms() {
-        let e = element(Some([0, 2]), [0.0; 3]);
+        let e = element(Some([0, 2]), in_current([0.0; 3]));
         let q = vec![[-1.0, 0.0, -30.0], [0.0, 0.0, -30.0], [1.0, 0.0, -30.0]];
         let rest = vec![[0.0; 3]; 3];
         let vol = std::f64::consts::PI * 0.09 * 0.09 / 4.0 * 2.5;
         let b = 1025.0 * 9.80665 * vol;
-        let f = e.node_force(&q, &rest);
+        let f = e.node_force(&q, &rest, 0.0);
         assert!((f[2] - b).abs() < 1e-12 * b && f[0] == 0.0 && f[1] == 0.0);
         // The buoyancy is minus the gradient of its potential rho V g . q.
         let mut up = q.clone();
@@ -263,11 +466,11 @@ mod tests {
         let u = 0.7;
         let mut v = rest.clone();
         v[1] = [0.0, u, 0.0];
-        let f = e.node_force(&q, &v);
+        let f = e.node_force(&q, &v, 0.0);
         let normal = 0.5 * 1025.0 * 1.2 * 0.09 * 2.5 * u * u;
         assert!((f[1] + normal).abs() < 1e-12 * normal, "{f:?}");
         v[1] = [u, 0.0, 0.0];
-        let f = e.node_force(&q, &v);
+        let f = e.node_force(&q, &v, 0.0);
         let axial = 0.5 * 1025.0 * 0.08 * std::f64::consts::PI * 0.09 * 2.5 * u * u;
         assert!((f[0] + axial).abs() < 1e-12 * axial, "{f:?}");
     }

@@ -29,7 +29,6 @@ pub(crate) fn line_node_between_fixed_neighbours() -> (System, crate::model::Par
         cdax: 0.0,
         ca: 1.0,
         caax: 0.25,
-        current: [0.0; 3],
     };
     s.add_line_hydrodynamics(n, Some((a, b)), &spec).unwrap();
     (s, n, 1025.0 * std::f64::consts::PI * 0.08 * 0.08 / 4.0)
@@ -137,10 +136,12 @@ pub(crate) fn line_in_water() -> System {
             cdax: 0.1,
             ca: 1.0,
             caax: if i == 3 { 1.6 } else { 0.3 },
-            current: [0.2, 0.1, 0.0],
         };
         s.add_line_hydrodynamics(p, Some(tangent), &spec).unwrap();
     }
+    let mut water = crate::water::Water::everywhere(9.81);
+    water.current = crate::water::Current::Uniform([0.2, 0.1, 0.0]);
+    s.set_water(water);
     s
 }
 

@@ -3,9 +3,8 @@
 
 use super::particle::{ForceId, ParticleId};
 use super::System;
-use crate::error::{finite, finite_vector, non_negative, positive, Error, Result};
+use crate::error::{finite, non_negative, positive, Error, Result};
 use crate::forces::{Force, LineHydro, LineNode, SeabedContact, SeabedFriction};
-use crate::math::Vec3;
 
 /// A flat seabed and its contact law, MoorDyn's parameters, for [`System::add_seabed_contact`].
 #[derive(Debug, Clone, PartialEq)]
@@ -45,8 +44,6 @@ pub struct LineHydroSpec {
     pub ca: f64,
     /// Axial added-mass coefficient CaAx (>= 0).
     pub caax: f64,
-    /// Uniform current (m/s).
-    pub current: Vec3,
 }
 
 impl System {
@@ -122,7 +119,8 @@ impl System {
     }
 
     /// Buoyancy, normal and axial drag and added mass of line node `node` in water, with
-    /// MoorDyn's coefficients, on the velocity relative to a uniform current. `tangent` as for
+    /// MoorDyn's coefficients, on the velocity relative to the system's water
+    /// ([`System::set_water`]: still water everywhere by default). `tangent` as for
     /// [`System::add_seabed_contact`] (`None`: isotropic drag with Cd). See [`LineHydro`] for
     /// the equations and the added mass.
     pub fn add_line_hydrodynamics(
@@ -143,7 +141,7 @@ impl System {
             cdax: non_negative(field("axial drag coefficient CdAx"), spec.cdax)?,
             ca: non_negative(field("normal added-mass coefficient Ca"), spec.ca)?,
             caax: non_negative(field("axial added-mass coefficient CaAx"), spec.caax)?,
-            current: finite_vector(field("current"), spec.current)?,
+            water: self.water.clone(),
             gravity: self.gravity(),
             node: element_node,
         };

@@ -33,6 +33,8 @@ pub struct System {
     pub(super) user_laws: Vec<(String, crate::laws::UserLaw)>,
     /// How many joints were added (their number in messages).
     pub(super) joints: usize,
+    /// The water the line elements are in ([`System::set_water`]).
+    pub(super) water: std::sync::Arc<crate::water::Water>,
 }
 
 impl System {
@@ -58,6 +60,7 @@ impl System {
             user_constraints: Vec::new(),
             user_laws: Vec::new(),
             joints: 0,
+            water: std::sync::Arc::new(crate::water::Water::everywhere(crate::math::norm(gravity))),
         })
     }
 
@@ -592,6 +595,23 @@ impl System {
     /// Gravity vector.
     pub fn gravity(&self) -> Vec3 {
         self.gravity
+    }
+
+    /// The water the line elements are in: still water that fills all space until
+    /// [`System::set_water`] gives another.
+    pub fn water(&self) -> &crate::water::Water {
+        &self.water
+    }
+
+    /// Puts the system's line elements ([`System::add_line_hydrodynamics`], those added before
+    /// and after) in `water`: its current and waves, and its free surface.
+    pub fn set_water(&mut self, water: crate::water::Water) {
+        self.water = std::sync::Arc::new(water);
+        for f in &mut self.forces {
+            if let Force::LineHydro(h) = f {
+                h.water = self.water.clone();
+            }
+        }
     }
 
     /// The particles.
