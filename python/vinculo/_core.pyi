@@ -751,9 +751,55 @@ class System:
                 different particles.
             UnknownHandleError: a handle of another system.
         """
+    def add_floating_body(
+        self,
+        body: dict[str, Any] | Sequence[ParticleId],
+        hull: Any,
+        *,
+        origin: Vector | None = None,
+        axis: Vector | None = None,
+        density: float = 1025.0,
+        ca: float = 0.0,
+        cd: float = 0.0,
+        drag_area: float = 0.0,
+        added_mass: float | None = None,
+        layers: int = 40,
+    ) -> ForceId:
+        """The water's loads on a rigid body from its instantaneous submerged volume
+        (docs/theory/ocean.md, "Floating bodies").
+
+        The hull is cut into ``layers`` horizontal layers and each layer into 24 cells, points
+        of the body. Each cell carries ``F rho dV ((1 + ca) a - g)`` (buoyancy, Froude-Krylov
+        and the water's share of the added-mass force; ``a`` the water's local acceleration on
+        the body's axis at the cell's layer) and its share of the drag
+        ``1/2 rho cd A |u - v| (u - v)``, with ``F`` its wet fraction under the local surface
+        (the exact share of its layer's volume below the waterline; 1 in water without a
+        surface), so that the restoring in heave, roll and pitch follows from the geometry. The
+        added mass joins the centre particle's inertia (translation only).
+
+        Arguments:
+            body: a rigid body (``add_rigid_body``'s dict) or 4 of its particles.
+            hull: a :class:`vinculo.ocean.Hull`, in the body's frame.
+            origin: where the hull's origin is now (m); None: the body's centre particle.
+            axis: the hull's axis (its z) now; None: (0, 0, 1).
+            density: water density (kg/m^3).
+            ca: added-mass coefficient.
+            cd: drag coefficient.
+            drag_area: the drag's frontal area A (m^2).
+            added_mass: the body's added mass (kg); None: ``ca rho V0``, V0 the hull's volume
+                below z = 0 now.
+            layers: layers over the hull's height.
+
+        Returns:
+            The force's handle.
+
+        Raises:
+            InvalidInputError: a bad hull, value or frame, or an added mass without a centre
+                particle to carry it.
+        """
     def set_water(self, water: Water) -> None:
-        """Put the line elements (added before and after) in ``water``: its current, waves and
-        free surface. Build it with :class:`vinculo.ocean.Sea` (``Sea.water()``); until then a
+        """Put the line elements and floating bodies (added before and after) in ``water``:
+        its current, waves and free surface. Build it with :class:`vinculo.ocean.Sea` (``Sea.water()``); until then a
         system's water is still water that fills all space.
 
         Arguments:

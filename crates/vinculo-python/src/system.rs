@@ -770,8 +770,66 @@ impl PySystem {
         Ok(PyForceId { index: id.0 })
     }
 
-    /// Puts the line elements (those added before and after) in `water` (a `vinculo._core.Water`,
-    /// made by `vinculo.ocean.Sea`): its current, waves and free surface.
+    /// The water's loads on a rigid body from its submerged volume (see the stub).
+    #[pyo3(signature = (body, hull, *, origin=None, axis=None, density=1025.0, ca=0.0, cd=0.0, drag_area=0.0, added_mass=None, layers=40))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_floating_body(
+        &mut self,
+        body: &Bound<'_, PyAny>,
+        hull: &Bound<'_, PyAny>,
+        origin: Option<&Bound<'_, PyAny>>,
+        axis: Option<&Bound<'_, PyAny>>,
+        density: f64,
+        ca: f64,
+        cd: f64,
+        drag_area: f64,
+        added_mass: Option<f64>,
+        layers: usize,
+    ) -> PyResult<PyForceId> {
+        let frame = self.frame(Some(body), "body")?;
+        let centre = match body.cast::<PyDict>() {
+            Ok(d) => match d.get_item("centre")? {
+                Some(c) => c.extract::<PyRef<'_, PyParticleId>>().ok().map(|c| c.inner),
+                None => None,
+            },
+            Err(_) => None,
+        };
+        let hull = crate::water::hull(hull)?;
+        let origin = match origin {
+            Some(o) => vec3(o, "origin")?,
+            None => match centre {
+                Some(c) => self.inner.particles()[self.inner.check(c).map_err(to_py)?].position,
+                None => {
+                    return Err(invalid(
+                        "origin",
+                        "None",
+                        "give the hull's origin (m) for a body without a centre particle",
+                    ))
+                }
+            },
+        };
+        let spec = vinculo::model::FloatingSpec {
+            origin,
+            axis: axis
+                .map(|a| vec3(a, "axis"))
+                .transpose()?
+                .unwrap_or([0.0, 0.0, 1.0]),
+            density,
+            ca,
+            cd,
+            drag_area,
+            added_mass,
+            layers,
+        };
+        let id = self
+            .inner
+            .add_floating_body(&frame, centre, &hull, &spec)
+            .map_err(to_py)?;
+        Ok(PyForceId { index: id.0 })
+    }
+
+    /// Puts the line elements and floating bodies (those added before and after) in `water`
+    /// (a `vinculo._core.Water`, made by `vinculo.ocean.Sea`): its current, waves and surface.
     fn set_water(&mut self, water: PyRef<'_, crate::water::PyWater>) {
         self.inner.set_water(water.inner.clone());
     }

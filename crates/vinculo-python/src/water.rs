@@ -216,3 +216,49 @@ impl PyWater {
         Ok(out.into_pyarray(py))
     }
 }
+
+/// A hull from `vinculo.ocean.Hull.sections()`: a list of ("frustum", bottom, top, r_bottom,
+/// r_top) and ("sphere", centre, radius) tuples.
+pub fn hull(obj: &Bound<'_, PyAny>) -> PyResult<vinculo::model::Hull> {
+    let sections = obj.call_method0("sections").unwrap_or_else(|_| obj.clone());
+    let items: Vec<Bound<'_, PyAny>> = sections.extract().map_err(|_| {
+        invalid(
+            "hull",
+            obj.repr().map(|r| r.to_string()).unwrap_or_default(),
+            "give a vinculo.ocean.Hull",
+        )
+    })?;
+    let mut out = Vec::with_capacity(items.len());
+    for item in items {
+        let bad = || {
+            invalid(
+                "hull section",
+                item.repr().map(|r| r.to_string()).unwrap_or_default(),
+                "give (\"frustum\", bottom, top, r_bottom, r_top) or (\"sphere\", centre, radius)",
+            )
+        };
+        let kind: String = item
+            .get_item(0)
+            .and_then(|k| k.extract())
+            .map_err(|_| bad())?;
+        let number = |i: usize| -> PyResult<f64> {
+            item.get_item(i)
+                .and_then(|k| k.extract())
+                .map_err(|_| bad())
+        };
+        out.push(match kind.as_str() {
+            "frustum" => vinculo::model::HullSection::Frustum {
+                bottom: number(1)?,
+                top: number(2)?,
+                r_bottom: number(3)?,
+                r_top: number(4)?,
+            },
+            "sphere" => vinculo::model::HullSection::Sphere {
+                centre: number(1)?,
+                radius: number(2)?,
+            },
+            _ => return Err(bad()),
+        });
+    }
+    Ok(vinculo::model::Hull { sections: out })
+}

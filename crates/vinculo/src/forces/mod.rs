@@ -24,6 +24,7 @@ mod applied;
 mod bending;
 mod couple;
 mod drag;
+mod floating_body;
 mod line_hydro;
 mod line_node;
 mod morison;
@@ -36,6 +37,7 @@ pub use applied::AppliedForce;
 pub use bending::Bending;
 pub use couple::Couple;
 pub use drag::{LinearDrag, QuadraticDrag};
+pub use floating_body::{FloatingBody, HullCell, HullLayer};
 pub use line_hydro::LineHydro;
 pub use line_node::LineNode;
 pub use morison::{Morison, MorisonSpec};
@@ -71,6 +73,8 @@ pub enum Force {
     SeabedContact(Box<SeabedContact>),
     /// Buoyancy and drag on a line node, in the line's local frame.
     LineHydro(Box<LineHydro>),
+    /// The water's loads on a rigid body from its submerged volume.
+    FloatingBody(Box<FloatingBody>),
     /// A torque about a world axis, as a couple on two points of a body.
     Couple(Box<Couple>),
     /// A force of another kind over points fixed in bodies or in the ground.
@@ -90,6 +94,7 @@ macro_rules! dispatch {
             Force::Bending($f) => $e,
             Force::SeabedContact($f) => $e,
             Force::LineHydro($f) => $e,
+            Force::FloatingBody($f) => $e,
             Force::Couple($f) => $e,
             Force::OnPoints($f) => $e,
             Force::User($f) => $e,
@@ -216,6 +221,7 @@ impl Force {
         match self {
             Force::Morison(f) => Some((f.particles[0], f.added_mass())),
             Force::LineHydro(f) => Some((f.node.node(), f.added_mass())),
+            Force::FloatingBody(f) => f.added_mass(),
             _ => None,
         }
     }
@@ -250,6 +256,7 @@ impl Force {
             Force::Bending(_) => format!("bending #{index} (particles {p:?})"),
             Force::SeabedContact(_) => format!("seabed contact #{index} (node {})", p[0]),
             Force::LineHydro(_) => format!("line hydrodynamics #{index} (node {})", p[0]),
+            Force::FloatingBody(_) => format!("floating body #{index} (particles {p:?})"),
             Force::Couple(_) => format!("torque #{index} (particles {p:?})"),
             Force::OnPoints(f) => format!("{} #{index} (particles {p:?})", f.label),
             Force::User(f) => format!(

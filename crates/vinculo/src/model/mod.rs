@@ -2,6 +2,7 @@
 //! rigid bodies built from particles.
 
 mod cluster;
+pub mod hull;
 mod joints;
 mod line_loads;
 mod on_points;
@@ -14,6 +15,7 @@ mod tetrahedron_body;
 pub mod user_groups;
 
 pub use cluster::RigidCluster;
+pub use hull::{FloatingSpec, Hull, HullSection};
 pub use joints::JointKind;
 pub use line_loads::{LineHydroSpec, SeabedSpec};
 pub use on_points::{Built, OnPointsId};

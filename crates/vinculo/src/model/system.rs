@@ -603,13 +603,16 @@ impl System {
         &self.water
     }
 
-    /// Puts the system's line elements ([`System::add_line_hydrodynamics`], those added before
-    /// and after) in `water`: its current and waves, and its free surface.
+    /// Puts the system's line elements ([`System::add_line_hydrodynamics`]) and floating
+    /// bodies ([`System::add_floating_body`]), those added before and after, in `water`: its
+    /// current and waves, and its free surface.
     pub fn set_water(&mut self, water: crate::water::Water) {
         self.water = std::sync::Arc::new(water);
         for f in &mut self.forces {
-            if let Force::LineHydro(h) = f {
-                h.water = self.water.clone();
+            match f {
+                Force::LineHydro(h) => h.water = self.water.clone(),
+                Force::FloatingBody(b) => b.water = self.water.clone(),
+                _ => {}
             }
         }
     }

@@ -122,6 +122,16 @@ impl WaveComponent {
         )
     }
 
+    /// The Hessian of the elevation at (x, y, t): -a k^2 cos(theta) e e^T.
+    pub fn surface_hessian(&self, x: f64, y: f64, t: f64) -> [[f64; 2]; 2] {
+        let c = -self.amplitude * self.k * self.k * self.angle(x, y, t).cos();
+        let e = self.direction;
+        [
+            [c * e[0] * e[0], c * e[0] * e[1]],
+            [c * e[1] * e[0], c * e[1] * e[1]],
+        ]
+    }
+
     /// Adds this component's flow at (x, y, z, t) to `flow` (gradients too when `gradients`).
     pub fn add_flow(
         &self,

@@ -171,6 +171,20 @@ impl Water {
         out
     }
 
+    /// The Hessian of the elevation at (x, y, t) (horizontal second derivatives).
+    pub fn surface_hessian(&self, x: f64, y: f64, t: f64) -> [[f64; 2]; 2] {
+        let mut out = [[0.0; 2]; 2];
+        for c in &self.waves {
+            let h = c.surface_hessian(x, y, t);
+            for i in 0..2 {
+                for j in 0..2 {
+                    out[i][j] += h[i][j];
+                }
+            }
+        }
+        out
+    }
+
     /// The flow at `point` and time `t` (gradients only when `gradients`).
     pub fn flow(&self, point: Vec3, t: f64, gradients: bool) -> Flow {
         let mut flow = Flow::default();
