@@ -797,6 +797,25 @@ class System:
             InvalidInputError: a bad hull, value or frame, or an added mass without a centre
                 particle to carry it.
         """
+    def element_forces(self, forces: Sequence[ForceId | int],
+                       positions: npt.NDArray[np.float64], velocities: npt.NDArray[np.float64],
+                       times: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        """The force each force element exerts on the particles it acts on (a line element's
+        node alone), at stored states: a line end's hydrodynamic and seabed loads, for the
+        force of the line on its end point.
+
+        Arguments:
+            forces: the elements (handles or indices).
+            positions: (m, n, 3) positions (m) of the system's n particles.
+            velocities: (m, n, 3) velocities (m/s).
+            times: (m,) times (s).
+
+        Returns:
+            (m, k, 3) forces (N), one per time and element.
+
+        Raises:
+            InvalidInputError: arrays of the wrong shape, or an element that is not one.
+        """
     def set_water(self, water: Water) -> None:
         """Put the line elements and floating bodies (added before and after) in ``water``:
         its current, waves and free surface. Build it with :class:`vinculo.ocean.Sea` (``Sea.water()``); until then a
@@ -969,7 +988,7 @@ class Water:
                  phases: npt.NDArray[np.float64], current_kind: str,
                  current_velocity: npt.NDArray[np.float64],
                  current_heights: npt.NDArray[np.float64], current_exponent: float,
-                 stretching_name: str, free_surface: bool) -> None:
+                 stretching_name: str, free_surface: bool, ramp: float = 0.0) -> None:
         """Arguments:
             depth: water depth (m, > 0; inf: deep water).
             g: gravity (m/s^2).
@@ -984,6 +1003,7 @@ class Water:
             current_exponent: the power law's exponent.
             stretching_name: "wheeler" or "vertical".
             free_surface: whether the water has a free surface (False: it fills all space).
+            ramp: the waves grow over this time (s) by (1 - cos(pi t / ramp)) / 2.
 
         Raises:
             InvalidInputError: a value outside its domain, named.

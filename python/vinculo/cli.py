@@ -157,6 +157,9 @@ def _build_parser() -> argparse.ArgumentParser:
     from vinculo.mooring.cli import add_mooring_parser
 
     add_mooring_parser(commands)
+    from vinculo.ocean.cli import add_moored_buoy_parser
+
+    add_moored_buoy_parser(commands)
     return parser
 
 

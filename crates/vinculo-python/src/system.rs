@@ -1002,6 +1002,62 @@ impl PySystem {
         Array1::from_iter(self.inner.particles().iter().map(|p| p.fixed)).into_pyarray(py)
     }
 
+    /// The force each of the force elements `forces` (handles or indices) exerts on the
+    /// particles it acts on, at each of the states `positions` and `velocities` (m, n, 3) at
+    /// `times` (m,): an (m, k, 3) array (see the stub).
+    fn element_forces<'py>(
+        &self,
+        py: Python<'py>,
+        forces: Vec<Bound<'py, PyAny>>,
+        positions: numpy::PyReadonlyArray3<'py, f64>,
+        velocities: numpy::PyReadonlyArray3<'py, f64>,
+        times: numpy::PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<Bound<'py, numpy::PyArray3<f64>>> {
+        let (q, v, t) = (
+            positions.as_array(),
+            velocities.as_array(),
+            times.as_array(),
+        );
+        let n = self.inner.particles().len();
+        if q.shape() != [t.len(), n, 3] || v.shape() != q.shape() {
+            return Err(invalid(
+                "positions and velocities",
+                format!(
+                    "shapes {:?} and {:?} for {} times",
+                    q.shape(),
+                    v.shape(),
+                    t.len()
+                ),
+                &format!("give (times, {n}, 3) arrays of this system's states"),
+            ));
+        }
+        let indices = forces
+            .iter()
+            .map(|f| match f.extract::<PyRef<'_, PyForceId>>() {
+                Ok(id) => Ok(id.index),
+                Err(_) => f.extract::<usize>().map_err(|_| {
+                    invalid("forces", f.to_string(), "give ForceIds or force indices")
+                }),
+            })
+            .collect::<PyResult<Vec<usize>>>()?;
+        let mut out = numpy::ndarray::Array3::<f64>::zeros((t.len(), indices.len(), 3));
+        let row = |a: &numpy::ndarray::ArrayView3<'_, f64>, j: usize| -> Vec<[f64; 3]> {
+            (0..n)
+                .map(|i| [a[[j, i, 0]], a[[j, i, 1]], a[[j, i, 2]]])
+                .collect()
+        };
+        for j in 0..t.len() {
+            let (qj, vj) = (row(&q, j), row(&v, j));
+            for (k, &f) in indices.iter().enumerate() {
+                let value = self.inner.element_force(f, &qj, &vj, t[j]).map_err(to_py)?;
+                for c in 0..3 {
+                    out[[j, k, c]] = value[c];
+                }
+            }
+        }
+        Ok(out.into_pyarray(py))
+    }
+
     /// Initial positions (n, 3).
     fn initial_positions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         positions_array(py, &self.inner.initial_positions())

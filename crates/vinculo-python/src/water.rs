@@ -69,7 +69,7 @@ impl PyWater {
     /// heights, the power law's exponent), the stretching above the still-water level, and
     /// whether the water has a free surface at z = eta (False: it fills all space).
     #[new]
-    #[pyo3(signature = (depth, g, amplitudes, omegas, directions, phases, current_kind, current_velocity, current_heights, current_exponent, stretching_name, free_surface))]
+    #[pyo3(signature = (depth, g, amplitudes, omegas, directions, phases, current_kind, current_velocity, current_heights, current_exponent, stretching_name, free_surface, ramp=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         depth: f64,
@@ -84,6 +84,7 @@ impl PyWater {
         current_exponent: f64,
         stretching_name: &str,
         free_surface: bool,
+        ramp: f64,
     ) -> PyResult<Self> {
         let (a, w, d, p) = (
             amplitudes.as_array(),
@@ -122,6 +123,7 @@ impl PyWater {
         let mut inner =
             Water::new(depth, g, current, &waves, stretching(stretching_name)?).map_err(to_py)?;
         inner.free_surface = free_surface;
+        inner.ramp = vinculo::error::non_negative("ramp time of the waves", ramp).map_err(to_py)?;
         Ok(PyWater { inner })
     }
 

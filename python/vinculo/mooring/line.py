@@ -119,8 +119,11 @@ class Line:
         unstretched_length: its unstretched length at t = 0 (m).
         water: the water it is in.
         name: a name for messages.
-        end_loads: the constant loads (weight and buoyancy of the half segments, N) that the
-            line puts on its end particles A and B.
+        end_loads: the weights of the half segments at ends A and B (N), which the line puts
+            on its end particles.
+        system: the system the line is in (for its end elements' loads).
+        end_elements: the force elements on the end nodes A and B (hydrodynamics and seabed
+            contact), whose loads the line also puts on its end particles.
         damping: the dashpot coefficient BA / l of each segment (N s/m; 0: none).
         length_law: the line's unstretched length as a law of time (a winch), or None when it
             is :attr:`unstretched_length` at all times.
@@ -139,6 +142,8 @@ class Line:
     damping: float = 0.0
     length_law: Any = None
     bending: float = 0.0
+    system: Any = None
+    end_elements: tuple[list[Any], list[Any]] = field(default_factory=lambda: ([], []))
 
     def tensions(self, solution: Any) -> np.ndarray:
         """The segments' tensions: the elastic part, plus the axial damping's
@@ -185,11 +190,14 @@ class Line:
         return self.line_type.ea * (stretched - segment) / segment
 
     def end_forces(self, solution: Any) -> tuple[np.ndarray, np.ndarray]:
-        """The forces of the line on its end particles A and B: the end segments' tensions along
-        them, the weight and buoyancy of the half segments at the ends, and, for a line with
-        bending stiffness, the force of the bending element next to each end on it (the shear
-        that carries part of the line's weight: the second difference's force
-        ``-EI / l^3 (q_0 - 2 q_1 + q_2)``, ``forces/bending.rs``).
+        """The forces of the line on its end particles A and B, as MoorDyn reports a point's
+        force from its lines' end nodes: the end segments' tensions along them, the weight of
+        the half segments at the ends, the loads of the water and the seabed on the end nodes
+        (buoyancy, drag, Froude-Krylov, seabed contact and friction, at the stored states), and,
+        for a line with bending stiffness, the force of the bending element next to each end
+        on it (the shear that carries part of the line's weight: the second difference's force
+        ``-EI / l^3 (q_0 - 2 q_1 + q_2)``, ``forces/bending.rs``). Not included: the end
+        node's inertia, ``-(m + m_a) a``, which MoorDyn adds for a coupled point.
 
         Arguments:
             solution: a :class:`vinculo.Solution` or a static equilibrium.
@@ -208,7 +216,24 @@ class Line:
             n = self.nodes
             on_a = on_a - self.bending * (q[:, n[0]] - 2.0 * q[:, n[1]] + q[:, n[2]])
             on_b = on_b - self.bending * (q[:, n[-1]] - 2.0 * q[:, n[-2]] + q[:, n[-3]])
-        return on_a + self.end_loads[0], on_b + self.end_loads[1]
+        on_a, on_b = on_a + self.end_loads[0], on_b + self.end_loads[1]
+        if self.system is not None and (self.end_elements[0] or self.end_elements[1]):
+            times = getattr(solution, "times", None)
+            if times is None:  # an equilibrium: at rest at its time
+                times = np.array([float(getattr(solution, "t", 0.0))])
+                velocities = np.zeros_like(q)
+            else:
+                times = np.asarray(times, dtype=float)
+                velocities = np.asarray(solution.velocities, dtype=float).reshape(q.shape)
+            for k, elements in enumerate(self.end_elements):
+                if elements:
+                    loads = self.system.element_forces(elements, np.ascontiguousarray(q),
+                                                       np.ascontiguousarray(velocities), times)
+                    if k == 0:
+                        on_a = on_a + loads.sum(axis=1)
+                    else:
+                        on_b = on_b + loads.sum(axis=1)
+        return on_a, on_b
 
     def laid_length(self, positions: Any, seabed_z: float) -> float:
         """The length of line lying on the seabed (unstretched).
@@ -363,26 +388,27 @@ def add_line(system: Any, end_a: int, end_b: int, line_type: LineType,
     if line_type.ei > 0.0:
         for k in range(1, segments):
             system.add_bending(handle[k - 1], handle[k], handle[k + 1], line_type.ei, segment)
+    end_elements: tuple[list[Any], list[Any]] = ([], [])
     for k, node in enumerate(handle):
         end = k in (0, segments)
         piece = 0.5 * segment if end else segment
         tangent = (handle[max(k - 1, 0)], handle[min(k + 1, segments)])
-        system.add_line_hydrodynamics(
+        elements = end_elements[0 if k == 0 else 1] if end else []
+        elements.append(system.add_line_hydrodynamics(
             node, diameter=line_type.diameter, length=piece, cd=line_type.cd,
             cdax=line_type.cdax, ca=line_type.ca, caax=line_type.caax, density=water.density,
-            tangent=tangent)
+            tangent=tangent))
         if seabed is not None:
-            system.add_seabed_contact(
+            elements.append(system.add_seabed_contact(
                 node, depth=water.depth, diameter=line_type.diameter, length=piece,
                 kbot=seabed.kbot, cbot=seabed.cbot, tangent=tangent, friction=seabed.friction,
                 axial_friction=seabed.axial_friction, friction_damping=seabed.friction_damping,
-                static_dynamic_scale=seabed.static_dynamic_scale)
+                static_dynamic_scale=seabed.static_dynamic_scale))
         if end:
             system.add_force(node, tuple(float(c) for c in 0.5 * mass * gravity))
-    half = 0.5 * segment
-    displaced = water.density * math.pi * line_type.diameter**2 / 4.0 * half
-    load = (line_type.mass_per_length * half - displaced) * gravity
+    load = line_type.mass_per_length * 0.5 * segment * gravity
     return Line(nodes=nodes, segments=links, line_type=line_type, unstretched_length=length0,
                 water=water, name=name, end_loads=(load, load.copy()), damping=damping,
+                system=system, end_elements=end_elements,
                 length_law=unstretched_length if isinstance(unstretched_length, Law) else None,
                 bending=line_type.ei / segment**3 if line_type.ei > 0.0 and segments >= 2 else 0.0)

@@ -119,7 +119,8 @@ def _check_motion(model: MoorDynFile, motion: Motion | None) -> None:
 
 
 def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, *,
-                solve: bool = True, **statics_options: Any) -> MooringModel:
+                solve: bool = True, couple: bool = True,
+                **statics_options: Any) -> MooringModel:
     """Build the vinculo model of a MoorDyn file and put it in static equilibrium.
 
     Arguments:
@@ -127,6 +128,8 @@ def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, 
         motion: the coupled points' motion (None: they stay at the file's positions); the
             statics uses their positions at t = 0.
         solve: solve the static equilibrium and start the system from it.
+        couple: hold the coupled points on the motion (or where the file puts them); False:
+            leave them free particles for the caller to attach (to a floating body).
         **statics_options: passed to :func:`vinculo.mooring.statics.solve_statics`
             (``tolerance``, ``max_iterations``).
 
@@ -153,6 +156,9 @@ def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, 
         mass = max(point.mass, _POINT_MASS_FLOOR)
         if point.attachment == "fixed":
             points.append(system.add_particle(mass, point.position, fixed=True))
+            continue
+        if point.attachment == "coupled" and not couple:
+            points.append(system.add_particle(mass, point.position))
             continue
         if point.attachment == "coupled":
             laws = motion.laws[coupled_index] if motion is not None else point.position

@@ -106,6 +106,8 @@ class Sea:
             a crest (docs/theory/ocean.md).
         density: water density (kg/m^3).
         g: gravity (m/s^2), for the dispersion relation.
+        ramp: the waves grow from nothing over this time (s) by ``(1 - cos(pi t / ramp)) / 2``,
+            so that a run from still-water equilibrium meets no sudden load (0: none).
     """
 
     depth: float
@@ -114,6 +116,7 @@ class Sea:
     stretching: Literal["wheeler", "vertical"] = "wheeler"
     density: float = 1025.0
     g: float = 9.80665
+    ramp: float = 0.0
 
     @classmethod
     def regular(cls, height: float, period: float, depth: float, *, direction: float = 0.0,
@@ -127,7 +130,7 @@ class Sea:
             depth: water depth (m).
             direction: direction of travel (rad from x towards y).
             phase: phase (rad).
-            **options: ``current``, ``stretching``, ``density``, ``g``.
+            **options: ``current``, ``stretching``, ``density``, ``g``, ``ramp``.
 
         Returns:
             The sea.
@@ -160,7 +163,7 @@ class Sea:
             directions: direction bins with spreading.
             omega_range: the frequency band (rad/s); default 0.5 to 4 times the peak
                 frequency (more than 99.7 % of the variance for gamma from 1 to 7).
-            **options: ``current``, ``stretching``, ``density``, ``g``.
+            **options: ``current``, ``stretching``, ``density``, ``g``, ``ramp``.
 
         Returns:
             The sea.
@@ -193,7 +196,8 @@ class Sea:
                            np.ascontiguousarray(w.phases, dtype=float), self.current.kind,
                            np.ascontiguousarray(self.current.velocity, dtype=float),
                            np.ascontiguousarray(self.current.heights, dtype=float),
-                           float(self.current.exponent), self.stretching, True)
+                           float(self.current.exponent), self.stretching, True,
+                           float(self.ramp))
 
     @property
     def wave_numbers(self) -> np.ndarray:

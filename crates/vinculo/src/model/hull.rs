@@ -223,7 +223,8 @@ pub struct FloatingSpec {
     /// Frontal area A of the drag (m^2, >= 0).
     pub drag_area: f64,
     /// The body's added mass (kg); None: Ca rho V0, V0 the volume under the still-water level
-    /// (the whole hull in water without a surface) at the start.
+    /// at the start in the system's water (the whole hull in water without a surface),
+    /// computed again when the water changes ([`System::set_water`]).
     pub added_mass: Option<f64>,
     /// Layers over the hull's height (>= 1).
     pub layers: usize,
@@ -299,7 +300,6 @@ impl System {
         let shapes = hull.layers(spec.layers);
         let mut layers = Vec::with_capacity(shapes.len());
         let mut cells = Vec::with_capacity(shapes.len() * RINGS * SECTORS);
-        let mut below = 0.0;
         for (l, s) in shapes.iter().enumerate() {
             let centre_point = at(0.0, 0.0, s.z);
             // The share of the layer's volume below a waterline at u of its thickness,
@@ -326,21 +326,12 @@ impl System {
                         volume: dv,
                         layer: l,
                     });
-                    // The displaced volume at the start, by the same wet fractions as the
-                    // element, in still water.
-                    let wet = if self.water.free_surface {
-                        let layer = layers.last().expect("pushed above");
-                        layer.fill_fraction((-p[2]) / s.thickness + 0.5).0
-                    } else {
-                        1.0
-                    };
-                    below += wet * dv;
                 }
             }
         }
         let added_mass = match spec.added_mass {
             Some(m) => non_negative(what("added mass"), m)?,
-            None => ca * density * below,
+            None => ca * density * hull.volume(), // the default, set below from the water
         };
         let added = match (centre, added_mass > 0.0) {
             (Some(c), _) => Some((self.check(c)?, added_mass)),
@@ -362,7 +353,7 @@ impl System {
             self.check(frame[3])?,
         ];
         let volume = hull.volume();
-        let element = FloatingBody {
+        let mut element = FloatingBody {
             frame: frame_indices,
             cells,
             layers,
@@ -370,9 +361,11 @@ impl System {
             ca,
             drag: 0.5 * density * cd * area / volume,
             added,
+            added_from_volume: spec.added_mass.is_none(),
             water: self.water.clone(),
             gravity: self.gravity(),
         };
+        element.default_added_mass(&self.initial_positions());
         self.forces.push(Force::FloatingBody(Box::new(element)));
         Ok(ForceId(index))
     }

@@ -605,16 +605,44 @@ impl System {
 
     /// Puts the system's line elements ([`System::add_line_hydrodynamics`]) and floating
     /// bodies ([`System::add_floating_body`]), those added before and after, in `water`: its
-    /// current and waves, and its free surface.
+    /// current and waves, and its free surface. A floating body's default added mass, Ca rho V0,
+    /// follows: V0 is the volume below the new water's still-water level at the start.
     pub fn set_water(&mut self, water: crate::water::Water) {
         self.water = std::sync::Arc::new(water);
+        let q = self.initial_positions();
         for f in &mut self.forces {
             match f {
                 Force::LineHydro(h) => h.water = self.water.clone(),
-                Force::FloatingBody(b) => b.water = self.water.clone(),
+                Force::FloatingBody(b) => {
+                    b.water = self.water.clone();
+                    b.default_added_mass(&q);
+                }
                 _ => {}
             }
         }
+    }
+
+    /// The force that force element `index` exerts on the particles it acts on
+    /// ([`Force::acting`]: a line element's node alone) at positions `q`, velocities `v` and
+    /// time `t`, summed: the element's share of the load on those particles (a line end's
+    /// hydrodynamic and seabed loads, for the force of the line on its end point).
+    pub fn element_force(&self, index: usize, q: &[Vec3], v: &[Vec3], t: f64) -> Result<Vec3> {
+        let force = self
+            .forces
+            .get(index)
+            .ok_or_else(|| Error::InvalidParameter {
+                name: "force element".into(),
+                value: index as f64,
+                expected: format!("this system has {} force elements", self.forces.len()),
+            })?;
+        let rows = force.force(q, v, t);
+        let mut f = [0.0; 3];
+        for row in rows.iter().take(force.acting()) {
+            for k in 0..3 {
+                f[k] += row[k];
+            }
+        }
+        Ok(f)
     }
 
     /// The particles.

@@ -69,6 +69,10 @@ pub struct Water {
     /// Whether the water has its free surface at z = eta (above it there is no water); false
     /// for water that fills all space ([`Water::everywhere`]).
     pub free_surface: bool,
+    /// The waves grow from nothing over this time (s; 0: full from the start): every wave
+    /// quantity is multiplied by s(t) = (1 - cos(pi t / T)) / 2 for t < T, so that a run
+    /// started from still-water equilibrium meets no sudden load.
+    pub ramp: f64,
 }
 
 /// The flow at one point and time (module documentation).
@@ -101,6 +105,7 @@ impl Water {
             waves: Vec::new(),
             stretching: Stretching::Wheeler,
             free_surface: false,
+            ramp: 0.0,
         }
     }
 
@@ -150,12 +155,25 @@ impl Water {
             waves,
             stretching,
             free_surface: true,
+            ramp: 0.0,
         })
     }
 
     /// Whether the water is still (no current, no waves): its flow is zero everywhere.
     pub fn is_still(&self) -> bool {
         self.waves.is_empty() && self.current.is_zero()
+    }
+
+    /// The ramp factor s(t) of the waves and its rate ([`Water::ramp`]).
+    pub fn ramp_factor(&self, t: f64) -> (f64, f64) {
+        if self.ramp <= 0.0 || t >= self.ramp {
+            return (1.0, 0.0);
+        }
+        if t <= 0.0 {
+            return (0.0, 0.0);
+        }
+        let w = std::f64::consts::PI / self.ramp;
+        (0.5 * (1.0 - (w * t).cos()), 0.5 * w * (w * t).sin())
     }
 
     /// The elevation eta, its horizontal gradient and its rate at (x, y, t).
@@ -168,17 +186,23 @@ impl Water {
             out.1[1] += g[1];
             out.2 += r;
         }
-        out
+        let (s, ds) = self.ramp_factor(t);
+        (
+            s * out.0,
+            [s * out.1[0], s * out.1[1]],
+            s * out.2 + ds * out.0,
+        )
     }
 
     /// The Hessian of the elevation at (x, y, t) (horizontal second derivatives).
     pub fn surface_hessian(&self, x: f64, y: f64, t: f64) -> [[f64; 2]; 2] {
         let mut out = [[0.0; 2]; 2];
+        let (s, _) = self.ramp_factor(t);
         for c in &self.waves {
             let h = c.surface_hessian(x, y, t);
             for i in 0..2 {
                 for j in 0..2 {
-                    out[i][j] += h[i][j];
+                    out[i][j] += s * h[i][j];
                 }
             }
         }
@@ -204,12 +228,18 @@ impl Water {
                     &mut lin,
                 );
             }
-            flow.velocity = lin.velocity;
-            flow.acceleration = lin.acceleration;
-            flow.pressure = lin.pressure;
+            // The ramp: s u, s a + s' u, s p, and the gradients likewise.
+            let (s, ds) = self.ramp_factor(t);
+            flow.velocity = lin.velocity.map(|u| s * u);
+            flow.acceleration =
+                std::array::from_fn(|i| s * lin.acceleration[i] + ds * lin.velocity[i]);
+            flow.pressure = s * lin.pressure;
             if gradients {
-                flow.velocity_gradient = chain(&lin.velocity_gradient, jac);
-                flow.acceleration_gradient = chain(&lin.acceleration_gradient, jac);
+                let gu = chain(&lin.velocity_gradient, jac);
+                let ga = chain(&lin.acceleration_gradient, jac);
+                flow.velocity_gradient = gu.map(|r| r.map(|g| s * g));
+                flow.acceleration_gradient =
+                    std::array::from_fn(|i| std::array::from_fn(|j| s * ga[i][j] + ds * gu[i][j]));
             }
         }
         let (u, du) = self.current.velocity(point[2]);
@@ -382,6 +412,33 @@ mod tests {
         assert_eq!(at_crest.velocity, linear.velocity);
         let bottom = waves_only.flow([x, y, -40.0], t, false);
         assert!(bottom.velocity[2].abs() < 1e-15);
+    }
+
+    /// With a ramp, the acceleration is the time derivative of the ramped velocity, the rate
+    /// of the elevation that of the ramped elevation (central differences), and the waves are
+    /// whole after the ramp.
+    #[test]
+    fn ramped_waves_keep_their_derivatives() {
+        let mut w = sea(Stretching::Vertical);
+        w.current = Current::none();
+        w.ramp = 6.0;
+        let p = [2.0, 1.0, -5.0];
+        let h = 1e-6;
+        for t in [0.7, 3.0, 5.9] {
+            let f = w.flow(p, t, false);
+            let (fp, fm) = (w.flow(p, t + h, false), w.flow(p, t - h, false));
+            for i in 0..3 {
+                let dudt = (fp.velocity[i] - fm.velocity[i]) / (2.0 * h);
+                assert!((dudt - f.acceleration[i]).abs() < 1e-7, "t {t} du{i}/dt");
+            }
+            let (_, _, rate) = w.surface(p[0], p[1], t);
+            let fd = (w.surface(p[0], p[1], t + h).0 - w.surface(p[0], p[1], t - h).0) / (2.0 * h);
+            assert!((fd - rate).abs() < 1e-7);
+        }
+        let mut whole = w.clone();
+        whole.ramp = 0.0;
+        assert_eq!(w.flow(p, 6.5, true), whole.flow(p, 6.5, true));
+        assert_eq!(w.flow(p, 0.0, false).velocity, [0.0; 3]);
     }
 
     #[test]

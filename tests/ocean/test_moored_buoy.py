@@ -1,0 +1,80 @@
+"""The moored-buoy study: its RAO sweep against the closed-form heave response of a floating
+vertical cylinder, its coupled statics against the balance of forces, its case file errors.
+
+Heave of a free-floating vertical cylinder (radius R, draft T, waterplane A = pi R^2) in
+deep-water regular waves of amplitude a and frequency omega (k = omega^2 / g), with the loads
+of vinculo's floating body (docs/theory/ocean.md): the hydrostatic force of the surface
+rho g A eta, and the Froude-Krylov and added-mass share rho (1 + Ca) A of the water's vertical
+acceleration -a omega^2 e^{kz} cos(theta) integrated over -T < z < 0, together
+rho g A a cos(theta) [e^{-kT} - Ca (1 - e^{-kT})] (omega^2 / k = g). With the restoring
+rho g A z and the inertia (m + m_a) z'', m_a = Ca rho A T, the heave RAO is
+
+    |Z / a| = |e^{-kT} - Ca (1 - e^{-kT})| / |1 - (m + m_a) omega^2 / (rho g A)|.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from vinculo.errors import InvalidInputError
+from vinculo.ocean import Sea, cylinder
+from vinculo.ocean import moored_buoy as mb
+
+RHO, G = 1025.0, 9.80665
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "moored_buoy"
+
+
+def test_heave_rao_of_a_floating_cylinder_against_the_closed_form():
+    radius, draft, ca = 1.0, 2.0, 0.5
+    area = math.pi * radius**2
+    mass = RHO * area * draft
+    # The centre of gravity at half draft, on the still-water equilibrium.
+    case = mb.MooredBuoyCase(
+        mass=mass, centre=(0.0, 0.0, -draft / 2),
+        inertia=np.diag([mass * (3 * radius**2 + 4.0**2) / 12] * 2 + [mass * radius**2 / 2]),
+        hull=cylinder(radius, -draft / 2, 3.0 - draft / 2), sea=Sea(depth=math.inf), ca=ca)
+    periods = (6.0, 9.0, 14.0)
+    table = mb.rao(case, periods=periods, height=0.2, cycles=6)
+    for period, heave in zip(periods, table.amplitude[:, 2], strict=True):
+        omega = 2 * math.pi / period
+        k = omega**2 / G
+        decay = math.exp(-k * draft)
+        expected = abs(decay - ca * (1 - decay)) / abs(
+            1 - (mass + ca * mass) * omega**2 / (RHO * G * area))
+        assert heave == pytest.approx(expected, rel=0.01), (period, heave, expected)
+
+
+def test_moored_statics_balance_buoyancy_weight_and_mooring():
+    """At the coupled equilibrium the buoy's buoyancy carries its weight and the vertical pull
+    of the lines at its fairleads (the lines' end forces at the fairleads, from the same
+    statics): rho g V_submerged = m g + sum F_z (the buoy is a wall-sided cylinder, heeled a
+    little by the current: V is pi R^2 times the length of its axis below z = 0)."""
+    case = mb.read_case(EXAMPLES / "surface_buoy.toml")
+    built = mb.build(case)
+    positions = built.statics.positions
+    centre = positions[built.body["centre"].index]
+    axis = mb._rotation(positions[None], built.body)[0][:, 2]
+    keel = centre - 1.5 * axis  # the hull's bottom is 1.5 m below the centre
+    buoyancy = RHO * G * math.pi * 1.5**2 * (-keel[2] / axis[2])
+    pull = 0.0
+    for line, end in zip(built.lines, built.fairleads, strict=True):
+        forces = line.end_forces(built.statics)
+        pull += -forces[end][0][2]  # the line's force on the fairlead, downwards
+    # The current's drag is horizontal; the statics tolerance 1e-9 of the length scale.
+    assert buoyancy == pytest.approx(case.mass * G + pull, rel=1e-6)
+    assert pull > 0.0
+
+
+def test_case_file_errors_name_the_file_and_entry(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[buoy]\nmass = 100.0\ncentre = [0, 0]\n')
+    with pytest.raises(InvalidInputError, match=r"bad.toml \[buoy\]: centre"):
+        mb.read_case(bad)
+    bad.write_text('[buoy]\nmass = 100.0\ncentre = [0, 0, 0]\ninertia = [1, 1, 1]\n'
+                   'hull = [{ kind = "box", radius = 1 }]\n[sea]\ndepth = 10.0\n')
+    with pytest.raises(InvalidInputError, match="hull section 1: kind = 'box'"):
+        mb.read_case(bad)
