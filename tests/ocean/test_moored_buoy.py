@@ -15,6 +15,7 @@ rho g A z and the inertia (m + m_a) z'', m_a = Ca rho A T, the heave RAO is
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -58,7 +59,7 @@ def test_moored_statics_balance_buoyancy_weight_and_mooring():
     positions = built.statics.positions
     centre = positions[built.body["centre"].index]
     axis = mb._rotation(positions[None], built.body)[0][:, 2]
-    keel = centre - 1.5 * axis  # the hull's bottom is 1.5 m below the centre
+    keel = centre - 0.8 * axis  # the hull's bottom is 0.8 m below the centre
     buoyancy = RHO * G * math.pi * 1.5**2 * (-keel[2] / axis[2])
     pull = 0.0
     for line, end in zip(built.lines, built.fairleads, strict=True):
@@ -78,3 +79,31 @@ def test_case_file_errors_name_the_file_and_entry(tmp_path):
                    'hull = [{ kind = "box", radius = 1 }]\n[sea]\ndepth = 10.0\n')
     with pytest.raises(InvalidInputError, match="hull section 1: kind = 'box'"):
         mb.read_case(bad)
+
+
+def test_cli_runs_the_submerged_buoy_and_writes_its_results(tmp_path, capsys):
+    """``vinculo moored-buoy`` on the case study's buoy in an open basin: its static string
+    tension is the sphere's net buoyancy, (rho V - m) g = (1000 pi 0.1^3 / 6 - 0.19199) 9.81
+    = 3.2531 N (the string's own weight, 1.6e-4 kg, and buoyancy change it by 5e-4 N), and
+    the files are written."""
+    from vinculo import cli
+
+    out = tmp_path / "out"
+    code = cli.main(["moored-buoy", str(EXAMPLES / "submerged_buoy.toml"), "--t-end", "2",
+                     "--output", str(out), "--no-progress"])
+    assert code == 0
+    text = capsys.readouterr().out
+    match = re.search(r"fairlead tension ([0-9.]+) N", text)
+    assert match and float(match.group(1)) == pytest.approx(3.2531, abs=1e-3)
+    for name in ("run.nc", "run.csv", "motions.png"):
+        assert (out / name).stat().st_size > 0
+
+
+def test_cli_rejects_a_bad_case_with_code_2(tmp_path, capsys):
+    from vinculo import cli
+
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[buoy]\nmass = -1\n")
+    assert cli.main(["moored-buoy", str(bad), "--output", str(tmp_path / "o")]) == 2
+    assert "bad.toml [buoy]" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()

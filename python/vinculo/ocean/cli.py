@@ -75,6 +75,8 @@ def _moored_buoy(args: argparse.Namespace, parser: argparse.ArgumentParser) -> i
     print(f"run: t = 0 to {result.times[-1]:g} s, {result.solution.num_steps} steps, "
           f"{result.cpu_time:.3g} s CPU", flush=True)
     after = result.times >= case.sea.ramp
+    if not after.any():  # a run shorter than the waves' ramp: all of it
+        after[:] = True
     names = ("surge", "heave", "pitch")
     for k, name in zip((0, 2, 4), names, strict=True):
         series = result.motions[after, k]

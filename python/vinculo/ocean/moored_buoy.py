@@ -243,7 +243,10 @@ def build(case: MooredBuoyCase, *, solve: bool = True) -> Built:
         case: the case.
         solve: put it in static equilibrium (in still water, the current included). A
             free-floating buoy (no mooring file) has no stiffness in surge, sway and yaw, so
-            no equilibrium to solve for: it starts where the case puts it.
+            no equilibrium to solve for: it starts where the case puts it. A buoy whose lines
+            hold no yaw (one line on its axis) has a neutral yaw, which leaves the equilibrium
+            equations singular: it is then solved with the yaw held by one more constraint,
+            and the system (without it) starts from that equilibrium.
 
     Returns:
         The built system.
@@ -252,9 +255,31 @@ def build(case: MooredBuoyCase, *, solve: bool = True) -> Built:
         InvalidInputError: a bad case or mooring file.
         ConvergenceError: when the static equilibrium is not found.
     """
+    from vinculo.errors import ConvergenceError
+    from vinculo.mooring.statics import solve_statics
+
+    built = _assemble(case)
+    if solve and built.lines:
+        # The equilibrium in the current without waves; the run's water comes after.
+        still = replace(case.sea, waves=Sea(case.sea.depth).waves).water()
+        built.system.set_water(still)
+        try:
+            built.statics = solve_statics(built.system)
+        except ConvergenceError:
+            held = _assemble(case, hold_yaw=True)
+            held.system.set_water(still)
+            built.statics = solve_statics(held.system)
+            built.statics.apply(built.system)
+    built.system.set_water(case.sea.water())
+    return built
+
+
+def _assemble(case: MooredBuoyCase, hold_yaw: bool = False) -> Built:
+    """The system of :func:`build`, not solved; ``hold_yaw`` keeps one horizontal axis of the
+    body in its vertical plane, (v - c) . n = 0 with n the horizontal normal of that plane
+    (which holds the yaw and leaves roll and pitch free)."""
     import vinculo
     from vinculo.mooring.model import build_model
-    from vinculo.mooring.statics import solve_statics
 
     if case.mooring is not None:
         model = build_model(case.mooring, solve=False, couple=False)
@@ -274,19 +299,21 @@ def build(case: MooredBuoyCase, *, solve: bool = True) -> Built:
         point = system.point(body, tuple(float(c) for c in q0[particle.index]))
         for axis in range(3):
             system.add_relative_coordinate(point, particle, axis, 0.0)
+    if hold_yaw:
+        centre = q0[body["centre"].index]
+        arms = [q0[v.index] - centre for v in body["vertices"][::2]]
+        arm = min(arms, key=lambda a: abs(a[2]) / np.linalg.norm(a))  # the most horizontal
+        normal = np.array([-arm[1], arm[0], 0.0]) / math.hypot(arm[0], arm[1])
+        origin = system.point(None, (0.0, 0.0, 0.0))
+        tip = system.point(None, tuple(float(c) for c in normal))
+        vertex = body["vertices"][2 * [id(a) for a in arms].index(id(arm))]
+        system.add_dot_product(body["centre"], vertex, origin, tip, 0.0)
     fairleads: list[int | None] = []
     if model is not None:
         for row in model.file.lines:
             fairleads.append(1 if row.attach_b in coupled else 0 if row.attach_a in coupled
                              else None)
-    built = Built(case=case, system=system, body=body, lines=list(lines), fairleads=fairleads)
-    if solve and lines:
-        # The equilibrium in the current without waves; the run's water comes after.
-        still = replace(case.sea, waves=Sea(case.sea.depth).waves)
-        system.set_water(still.water())
-        built.statics = solve_statics(system)
-    system.set_water(case.sea.water())
-    return built
+    return Built(case=case, system=system, body=body, lines=list(lines), fairleads=fairleads)
 
 
 @dataclass
@@ -545,9 +572,11 @@ def _plots(result: MooredBuoyRun, spectra: dict[str, tuple[np.ndarray, np.ndarra
     ax[2].plot(t, np.degrees(result.motions[:, 3]), label="roll")
     ax[2].set_ylabel("angle (deg)")
     ax[2].legend(loc="upper right")
+    kilo = np.abs(result.tensions).max(initial=0.0) >= 1e3
     for k, line in enumerate(result.built.lines):
-        ax[3].plot(t, result.tensions[:, k, 0] / 1e3, label=f"{line.name} fairlead")
-    ax[3].set_ylabel("tension (kN)")
+        ax[3].plot(t, result.tensions[:, k, 0] / (1e3 if kilo else 1.0),
+                   label=f"{line.name} fairlead")
+    ax[3].set_ylabel("tension (kN)" if kilo else "tension (N)")
     ax[3].set_xlabel("time (s)")
     if result.built.lines:
         ax[3].legend(loc="upper right", fontsize="small")

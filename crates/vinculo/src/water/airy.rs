@@ -38,6 +38,8 @@ pub struct WaveComponent {
     pub direction: [f64; 2],
     /// Phase eps (rad).
     pub phase: f64,
+    /// e^{-2 k h} (0 in deep water), for the depth profiles.
+    pub deep: f64,
 }
 
 /// The wave number k of angular frequency `omega` in depth `depth` (infinite: deep water) under
@@ -73,12 +75,14 @@ struct Profiles {
     k: f64,
 }
 
-fn profiles(k: f64, z: f64, depth: f64) -> Profiles {
+/// The profiles at height `z` for the wave number `k` and `deep` = e^{-2kh}: with
+/// up = e^{kz}, e^{-k(z+2h)} = deep / up (one exponential a point and component).
+fn profiles(k: f64, z: f64, deep: f64) -> Profiles {
     let up = (k * z).exp();
-    let (down, deep) = if depth.is_finite() {
-        ((-k * (z + 2.0 * depth)).exp(), (-2.0 * k * depth).exp())
+    let down = if deep > 0.0 && up > 0.0 {
+        deep / up
     } else {
-        (0.0, 0.0)
+        0.0
     };
     Profiles {
         c: (up + down) / (1.0 - deep),
@@ -104,6 +108,25 @@ pub struct LinearFlow {
 }
 
 impl WaveComponent {
+    /// The component of amplitude `amplitude` (m), angular frequency `omega` (rad/s),
+    /// direction of travel `direction` (rad from x towards y) and phase `phase` (rad) in water
+    /// of depth `depth` (infinite: deep) under gravity `g`.
+    pub fn new(amplitude: f64, omega: f64, direction: f64, phase: f64, depth: f64, g: f64) -> Self {
+        let k = wave_number(omega, depth, g);
+        WaveComponent {
+            amplitude,
+            omega,
+            k,
+            direction: [direction.cos(), direction.sin()],
+            phase,
+            deep: if depth.is_finite() {
+                (-2.0 * k * depth).exp()
+            } else {
+                0.0
+            },
+        }
+    }
+
     /// The phase angle theta at horizontal position (x, y) and time t.
     #[inline]
     pub fn angle(&self, x: f64, y: f64, t: f64) -> f64 {
@@ -133,17 +156,23 @@ impl WaveComponent {
     }
 
     /// Adds this component's flow at (x, y, z, t) to `flow` (gradients too when `gradients`).
-    pub fn add_flow(
+    pub fn add_flow(&self, point: Vec3, t: f64, g: f64, gradients: bool, flow: &mut LinearFlow) {
+        let angle = self.angle(point[0], point[1], t).sin_cos();
+        self.add_flow_at(angle, point[2], g, gradients, flow);
+    }
+
+    /// [`WaveComponent::add_flow`] with the phase angle's (sin, cos) at the point and time
+    /// already known (the angle does not depend on z: a sum of components computes it once
+    /// for the elevation and the flow), at height `z`.
+    pub fn add_flow_at(
         &self,
-        point: Vec3,
-        t: f64,
-        depth: f64,
+        (sin, cos): (f64, f64),
+        z: f64,
         g: f64,
         gradients: bool,
         flow: &mut LinearFlow,
     ) {
-        let (sin, cos) = self.angle(point[0], point[1], t).sin_cos();
-        let p = profiles(self.k, point[2], depth);
+        let p = profiles(self.k, z, self.deep);
         let (a, w, k) = (self.amplitude, self.omega, self.k);
         let e = [self.direction[0], self.direction[1], 0.0];
         let (uh, uz) = (a * w * p.c * cos, a * w * p.s * sin);
@@ -187,20 +216,12 @@ mod tests {
     const G: f64 = 9.81;
 
     fn component(depth: f64) -> WaveComponent {
-        let omega = 2.0 * std::f64::consts::PI / 8.0;
-        let b = 0.6_f64;
-        WaveComponent {
-            amplitude: 1.5,
-            omega,
-            k: wave_number(omega, depth, G),
-            direction: [b.cos(), b.sin()],
-            phase: 0.3,
-        }
+        WaveComponent::new(1.5, 2.0 * std::f64::consts::PI / 8.0, 0.6, 0.3, depth, G)
     }
 
-    fn flow_at(c: &WaveComponent, x: Vec3, t: f64, depth: f64) -> LinearFlow {
+    fn flow_at(c: &WaveComponent, x: Vec3, t: f64) -> LinearFlow {
         let mut f = LinearFlow::default();
-        c.add_flow(x, t, depth, G, true, &mut f);
+        c.add_flow(x, t, G, true, &mut f);
         f
     }
 
@@ -233,7 +254,7 @@ mod tests {
         for depth in [12.0, 60.0, f64::INFINITY] {
             let c = component(depth);
             for (x, t) in [([3.0, -2.0, -4.0], 0.7), ([-10.0, 5.0, 0.0], 3.1)] {
-                let f = flow_at(&c, x, t, depth);
+                let f = flow_at(&c, x, t);
                 let g = f.velocity_gradient;
                 let scale = c.amplitude * c.omega * c.k;
                 let div = g[0][0] + g[1][1] + g[2][2];
@@ -244,7 +265,7 @@ mod tests {
             }
             let (x, y, t) = (4.0, 1.0, 2.2);
             let (eta, _, rate) = c.surface(x, y, t);
-            let f = flow_at(&c, [x, y, 0.0], t, depth);
+            let f = flow_at(&c, [x, y, 0.0], t);
             assert!((rate - f.velocity[2]).abs() < 1e-13);
             assert!((f.pressure - G * eta).abs() < 1e-12);
         }
@@ -256,13 +277,13 @@ mod tests {
         let depth = 25.0;
         let c = component(depth);
         let (x, t) = ([2.0, -1.0, -3.0], 1.3);
-        let f = flow_at(&c, x, t, depth);
+        let f = flow_at(&c, x, t);
         let h = 1e-5;
         for j in 0..3 {
             let (mut xp, mut xm) = (x, x);
             xp[j] += h;
             xm[j] -= h;
-            let (fp, fm) = (flow_at(&c, xp, t, depth), flow_at(&c, xm, t, depth));
+            let (fp, fm) = (flow_at(&c, xp, t), flow_at(&c, xm, t));
             for i in 0..3 {
                 let du = (fp.velocity[i] - fm.velocity[i]) / (2.0 * h);
                 let da = (fp.acceleration[i] - fm.acceleration[i]) / (2.0 * h);
@@ -273,7 +294,7 @@ mod tests {
                 );
             }
         }
-        let (fp, fm) = (flow_at(&c, x, t + h, depth), flow_at(&c, x, t - h, depth));
+        let (fp, fm) = (flow_at(&c, x, t + h), flow_at(&c, x, t - h));
         for i in 0..3 {
             let dudt = (fp.velocity[i] - fm.velocity[i]) / (2.0 * h);
             assert!((dudt - f.acceleration[i]).abs() < 1e-8, "du{i}/dt");
@@ -294,11 +315,11 @@ mod tests {
     fn seabed_and_deep_water_limits() {
         let depth = 15.0;
         let c = component(depth);
-        let f = flow_at(&c, [1.0, 2.0, -depth], 0.4, depth);
+        let f = flow_at(&c, [1.0, 2.0, -depth], 0.4);
         assert!(f.velocity[2].abs() < 1e-15);
         let deep = component(f64::INFINITY);
         let z = -7.0;
-        let f = flow_at(&deep, [0.0, 0.0, z], 0.0, f64::INFINITY);
+        let f = flow_at(&deep, [0.0, 0.0, z], 0.0);
         let th = deep.phase;
         let expected = deep.amplitude * deep.omega * (deep.k * z).exp() * th.cos();
         let horizontal = f.velocity[0].hypot(f.velocity[1]);

@@ -137,15 +137,14 @@ impl Water {
             .enumerate()
             .map(|(i, w)| {
                 let name = |f: &str| format!("{f} of wave component #{i}");
-                let omega = positive(name("angular frequency"), w.omega)?;
-                let direction = finite(name("direction"), w.direction)?;
-                Ok(WaveComponent {
-                    amplitude: non_negative(name("amplitude"), w.amplitude)?,
-                    omega,
-                    k: wave_number(omega, depth, g),
-                    direction: [direction.cos(), direction.sin()],
-                    phase: finite(name("phase"), w.phase)?,
-                })
+                Ok(WaveComponent::new(
+                    non_negative(name("amplitude"), w.amplitude)?,
+                    positive(name("angular frequency"), w.omega)?,
+                    finite(name("direction"), w.direction)?,
+                    finite(name("phase"), w.phase)?,
+                    depth,
+                    g,
+                ))
             })
             .collect::<Result<Vec<_>>>()?;
         Ok(Water {
@@ -213,20 +212,26 @@ impl Water {
     pub fn flow(&self, point: Vec3, t: f64, gradients: bool) -> Flow {
         let mut flow = Flow::default();
         if !self.waves.is_empty() {
-            let (eta, slope, _) = self.surface(point[0], point[1], t);
+            // The components' phase angles, once: for the elevation, then the flow.
+            let (s, _) = self.ramp_factor(t);
+            let mut angles =
+                smallvec::SmallVec::<[(f64, f64); 64]>::with_capacity(self.waves.len());
+            let (mut eta, mut slope) = (0.0, [0.0; 2]);
+            for c in &self.waves {
+                let (sin, cos) = c.angle(point[0], point[1], t).sin_cos();
+                angles.push((sin, cos));
+                eta += c.amplitude * cos;
+                let d = -c.amplitude * c.k * sin;
+                slope[0] += d * c.direction[0];
+                slope[1] += d * c.direction[1];
+            }
+            let (eta, slope) = (s * eta, [s * slope[0], s * slope[1]]);
             flow.elevation = eta;
             flow.elevation_gradient = slope;
             let (zs, jac) = self.stretched(point[2], eta, slope);
             let mut lin = LinearFlow::default();
-            for c in &self.waves {
-                c.add_flow(
-                    [point[0], point[1], zs],
-                    t,
-                    self.depth,
-                    self.g,
-                    gradients,
-                    &mut lin,
-                );
+            for (c, &angle) in self.waves.iter().zip(&angles) {
+                c.add_flow_at(angle, zs, self.g, gradients, &mut lin);
             }
             // The ramp: s u, s a + s' u, s p, and the gradients likewise.
             let (s, ds) = self.ramp_factor(t);
@@ -407,7 +412,7 @@ mod tests {
         let at_crest = waves_only.flow([x, y, eta], t, false);
         let mut linear = LinearFlow::default();
         for c in &w.waves {
-            c.add_flow([x, y, 0.0], t, w.depth, w.g, false, &mut linear);
+            c.add_flow([x, y, 0.0], t, w.g, false, &mut linear);
         }
         assert_eq!(at_crest.velocity, linear.velocity);
         let bottom = waves_only.flow([x, y, -40.0], t, false);
