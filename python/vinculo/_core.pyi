@@ -824,6 +824,19 @@ class System:
         Arguments:
             water: the water.
         """
+    def set_slack(self, constraint: ConstraintId) -> None:
+        """Let an elastic segment go slack: shorter than its unstretched length it carries no
+        tension and no compression, ``T = max(0, EA (|d| - L) / L)``, as MoorDyn's segments
+        (docs/theory/moorings.md). Mooring lines (``vinculo.mooring``) are made of such
+        segments.
+
+        Arguments:
+            constraint: an elastic segment of finite EA (``add_elastic_distance``).
+
+        Raises:
+            InvalidInputError: a constraint that is not such a segment, or not one of this
+                system's.
+        """
     def set_tension_only(self, constraint: ConstraintId) -> None:
         """Declare a distance constraint a string: runs stop with NegativeTensionError when it
         would have to push.

@@ -88,13 +88,17 @@ def test_damping_ratio_of_a_segment_is_moordyns():
     kind = LineType("rope", diameter=0.01, mass_per_length=w, ea=ea, ba=-zeta)
     s = vinculo.System(gravity=(0.0, 0.0, 0.0))
     top = s.add_particle(1.0, (0.0, 0.0, 0.0), fixed=True)
-    # Released 1 cm below its rest length: the segment pulls it up.
-    weight = s.add_particle(mass, (0.0, 0.0, -length - 0.01))
+    # A preload of 2e4 N stretches it by 0.1 m, so that it stays taut (a MoorDyn segment goes
+    # slack rather than push); released 1 cm below that equilibrium, it is pulled back up.
+    preload = 2.0e4
+    rest = length + preload * length / ea
+    weight = s.add_particle(mass, (0.0, 0.0, -rest - 0.01))
+    s.add_force(weight, (0.0, 0.0, -preload))
     add_line(s, top.index, weight.index, kind, length, 1, Water(depth=100.0, density=1e-9))
     omega = math.sqrt(ea / (length * mass))
     period = 2.0 * math.pi / omega
     sol = vinculo.simulate(s, 6.0 * period, period / 400.0)
-    z = sol.particle(weight)[:, 2] + length
+    z = sol.particle(weight)[:, 2] + rest
     peaks = [abs(z[k]) for k in range(1, len(z) - 1)
              if abs(z[k]) >= abs(z[k - 1]) and abs(z[k]) > abs(z[k + 1]) and z[k] < 0.0]
     decrement = np.log(peaks[0] / peaks[1])

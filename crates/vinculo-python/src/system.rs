@@ -923,6 +923,21 @@ impl PySystem {
         ))
     }
 
+    /// Lets an elastic segment go slack instead of pushing (see the stub).
+    fn set_slack(&mut self, constraint: &Bound<'_, PyAny>) -> PyResult<()> {
+        let c = constraint.cast::<PyConstraintId>().map_err(|_| {
+            invalid(
+                "constraint",
+                constraint.repr().map(|r| r.to_string()).unwrap_or_default(),
+                "expected a ConstraintId returned by System.add_elastic_distance",
+            )
+        })?;
+        let index = c.get().index;
+        self.inner
+            .set_slack(vinculo::model::ConstraintId(index))
+            .map_err(to_py)
+    }
+
     /// Declares a distance constraint a string: a run stops with NegativeTensionError when it
     /// would have to push.
     fn set_tension_only(&mut self, constraint: &Bound<'_, PyAny>) -> PyResult<()> {

@@ -189,7 +189,10 @@ fn rest_right_hand_side(
     }
     for (c, con) in system.constraints().iter().enumerate() {
         ws.r[m3 + c] = if compliant && con.is_compliant() {
-            -con.residual(q, t) / (con.compliance(t) * ws.scales[c] * ws.mass_ref)
+            // The tension of the stretch, none for a slack segment shorter than its length.
+            let phi = con.residual(q, t);
+            let phi = if con.can_slack() { phi.min(0.0) } else { phi };
+            -phi / (con.compliance(t) * ws.scales[c] * ws.mass_ref)
         } else {
             -ws.scales[c] * con.gamma(q, v, t)
         };

@@ -110,6 +110,11 @@ impl Index3Rule for StaticRule<'_> {
     /// (a finely divided line with bending stiffness at depth) puts its round-off above any
     /// tolerance that suits the rest of the model.
     const ROUND_OFF_REACH: f64 = f64::INFINITY;
+    /// The equilibrium keeps every segment's compliant row: a segment lying on the seabed at
+    /// its unstretched length in the first iterate would otherwise leave its nodes without
+    /// stiffness along it, and Newton's method from the catenary start would fail; compressed
+    /// segments are refused (and buckled down by the continuation) on their own.
+    const SLACK: bool = false;
 
     #[inline(always)]
     fn kinematics(&self, _i: usize, q: &Vec3) -> (Vec3, Vec3, Vec3) {

@@ -179,7 +179,8 @@ class Line:
         return tension
 
     def _elastic_tensions(self, positions: np.ndarray, times: np.ndarray) -> np.ndarray:
-        """``EA (|d| - l(t)) / l(t)`` of every segment at every stored time."""
+        """``max(0, EA (|d| - l(t)) / l(t))`` of every segment at every stored time: the
+        segments go slack rather than push (MoorDyn's; :meth:`vinculo.System.set_slack`)."""
         q = positions.reshape(-1, positions.shape[-2], 3)[:, self.nodes]
         stretched = np.linalg.norm(q[:, 1:] - q[:, :-1], axis=2)
         if self.length_law is None:
@@ -187,7 +188,7 @@ class Line:
         else:
             lengths = np.array([float(self.length_law(float(t))) for t in times])
         segment = (lengths / len(self.segments))[:, None]
-        return self.line_type.ea * (stretched - segment) / segment
+        return np.maximum(0.0, self.line_type.ea * (stretched - segment) / segment)
 
     def end_forces(self, solution: Any) -> tuple[np.ndarray, np.ndarray]:
         """The forces of the line on its end particles A and B, as MoorDyn reports a point's
@@ -381,6 +382,10 @@ def add_line(system: Any, end_a: int, end_b: int, line_type: LineType,
     links = [system.add_elastic_distance(handle[k], handle[k + 1], length_law, line_type.ea,
                                          share)
              for k in range(segments)]
+    if math.isfinite(line_type.ea):
+        # MoorDyn's segments go slack instead of pushing (docs/theory/moorings.md).
+        for link in links:
+            system.set_slack(link)
     damping = _damping(line_type, segment)
     if damping > 0.0:
         for k in range(segments):

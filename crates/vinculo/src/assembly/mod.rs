@@ -267,7 +267,11 @@ impl Layout {
         let row = if con.is_compliant() {
             let compliance = con.compliance(at.t_eval);
             values.add(self.constraint_diagonal[c], s * s * compliance / at.sigma);
-            s * (-at.hessian / at.sigma)
+            if at.is_slack(con, c) {
+                0.0
+            } else {
+                s * (-at.hessian / at.sigma)
+            }
         } else {
             s
         };

@@ -88,6 +88,8 @@ pub struct ResidualTerms<'a> {
     pub end_weight: f64,
     /// Phi_k(q_n, t_n) of each compliant constraint at the step's start (0 for the others).
     pub start_phi: &'a [f64],
+    /// Whether slack segments go slack in this problem ([`crate::integrators::Index3Rule::SLACK`]).
+    pub slack: bool,
 }
 
 /// Where and with which weights one step's Jacobian is evaluated (besides the mass block).
@@ -114,18 +116,39 @@ pub struct JacobianTerms<'a> {
     pub lambda: &'a [f64],
     /// Scale of each constraint row.
     pub scales: &'a [f64],
+    /// w = dq_e/dq, as in [`ResidualTerms`].
+    pub end_weight: f64,
+    /// Phi_k(q_n, t_n) of each compliant constraint at the step's start, as in
+    /// [`ResidualTerms`].
+    pub start_phi: &'a [f64],
+    /// As in [`ResidualTerms`].
+    pub slack: bool,
+}
+
+/// The stretch measure of compliant constraint `c`'s row, w Phi(q_end, t_end) + (1 - w)
+/// Phi(q_n, t_n), from Phi(q_end, t_end) = `phi`.
+#[inline(always)]
+fn stretch_row(end_weight: f64, start_phi: &[f64], c: usize, phi: f64) -> f64 {
+    end_weight * phi + (1.0 - end_weight) * start_phi[c]
 }
 
 impl ResidualTerms<'_> {
     /// The (unscaled) row of constraint `c` (`con`) whose residual at the step's end is `phi`:
     /// `phi` for an exact constraint; for a compliant one (`docs/theory/moorings.md`)
     /// w Phi(q_end, t_end) + (1 - w) Phi(q_n, t_n) + c(t_e) lambda, the stretch at the
-    /// evaluation point where its multiplier, the tension, acts.
+    /// evaluation point where its multiplier, the tension, acts; a slack segment's row
+    /// (`constraints/elastic_distance.rs`) is c(t_e) lambda alone while that stretch measure
+    /// is positive (shorter than its length).
     #[inline(always)]
     pub fn row(&self, con: &crate::constraints::Constraint, c: usize, phi: f64) -> f64 {
         if con.is_compliant() {
-            let w = self.end_weight;
-            w * phi + (1.0 - w) * self.start_phi[c] + con.compliance(self.t_eval) * self.lambda[c]
+            let psi = stretch_row(self.end_weight, self.start_phi, c, phi);
+            let held = if self.slack && con.can_slack() && psi > 0.0 {
+                0.0
+            } else {
+                psi
+            };
+            held + con.compliance(self.t_eval) * self.lambda[c]
         } else {
             phi
         }
@@ -139,6 +162,19 @@ impl ResidualTerms<'_> {
 }
 
 impl JacobianTerms<'_> {
+    /// True when compliant constraint `c` (`con`) is a slack segment shorter than its length
+    /// at this iterate: its row then does not depend on the positions ([`ResidualTerms::row`]).
+    pub fn is_slack(&self, con: &crate::constraints::Constraint, c: usize) -> bool {
+        self.slack
+            && con.can_slack()
+            && stretch_row(
+                self.end_weight,
+                self.start_phi,
+                c,
+                con.residual(self.q_end, self.t_end),
+            ) > 0.0
+    }
+
     /// True when the Phi_q rows are evaluated where the -Phi_q^T columns are.
     pub fn same_point(&self) -> bool {
         std::ptr::eq(self.q_eval, self.q_end) && self.t_eval.to_bits() == self.t_end.to_bits()

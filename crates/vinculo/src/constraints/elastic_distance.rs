@@ -19,6 +19,13 @@
 //! tension's row, and EA = infinity (c = 0) is the exact distance |d| = L. The compliance is a
 //! length per newton, so the matrix stays bounded as EA grows: its only entry that depends on EA
 //! tends to zero, whereas a penalty spring's stiffness EA/L would grow without bound.
+//!
+//! A segment that can go slack (MoorDyn's segments, `slack`) carries no compression: its
+//! tension is T = max(0, EA (|d| - L)/L), so its equation is `c T - max(0, Phi) = 0` (`Phi`
+//! here the stretch measure of the row, `assembly/parallel.rs`): `Phi + c T = 0` while
+//! stretched, `c T = 0` (T = 0, no force, no dependence on q) while shorter than L. The
+//! switch is where T = 0, so the tension is continuous; its derivative jumps there (the step
+//! that crosses it is first order locally, as MoorDyn's is).
 
 use super::Hessian;
 use crate::laws::Law;
@@ -36,6 +43,8 @@ pub struct ElasticDistance {
     pub share: f64,
     /// The axial stiffness EA (N); infinity: inextensible.
     pub ea: f64,
+    /// Whether the segment goes slack (tension 0) instead of pushing when shorter than L.
+    pub slack: bool,
 }
 
 /// The unit vector u, the length |d| and the projector I - u u^T over |d|.
@@ -125,6 +134,7 @@ mod tests {
             length: Law::polynomial(vec![1.4, 0.4, -0.6]).unwrap(),
             share: 0.5,
             ea: 1e5,
+            slack: false,
         }));
         let q = [[0.1, 0.2, -0.3], [9.0, 9.0, 9.0], [0.5, -0.4, 0.25]];
         let v = [[0.3, -1.0, 0.2], [0.0; 3], [-0.6, 0.1, 0.9]];
@@ -139,6 +149,7 @@ mod tests {
             length: Law::Constant(4.0),
             share: 0.5,
             ea: 4e6,
+            slack: false,
         };
         assert_eq!(e.compliance(0.0), 2.0 / 4e6);
         e.ea = f64::INFINITY;

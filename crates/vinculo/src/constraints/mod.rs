@@ -247,6 +247,16 @@ impl Constraint {
         }
     }
 
+    /// True for an elastic segment that goes slack instead of pushing
+    /// ([`crate::model::System::set_slack`]).
+    pub fn can_slack(&self) -> bool {
+        match self {
+            Constraint::ElasticDistance(c) => c.slack && c.ea.is_finite(),
+            Constraint::OnPoints(c) => c.inner.can_slack(),
+            _ => false,
+        }
+    }
+
     /// True when the constraint's equation has a compliance (its row gets a diagonal entry).
     pub fn is_compliant(&self) -> bool {
         match self {

@@ -102,6 +102,10 @@ pub trait Index3Rule: Sync {
     /// The largest ratio of the residual's round-off to the tolerance at which Newton stops at
     /// that round-off ([`NewtonProblem::round_off_reach`](super::newton::NewtonProblem::round_off_reach)).
     const ROUND_OFF_REACH: f64 = super::newton::ROUND_OFF_REACH;
+    /// True when slack segments ([`crate::model::System::set_slack`]) go slack in this
+    /// problem; false: their rows stay the compliant ones (the static equilibrium, which
+    /// refuses compressed segments by itself, `statics.rs`).
+    const SLACK: bool = true;
     /// (v_{n+1}, q_e, v_e) of particle `i` at the iterate `q` (q_e and v_e unused when
     /// [`Index3Rule::AT_END`]).
     fn kinematics(&self, i: usize, q: &Vec3) -> (Vec3, Vec3, Vec3);

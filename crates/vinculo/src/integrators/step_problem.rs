@@ -144,6 +144,7 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
             scales: self.scales,
             end_weight: -rule.weights(point.sigma).2 / point.sigma,
             start_phi: &b.start_phi,
+            slack: R::SLACK,
         };
         let (system, layout, inertia) = (self.system, self.layout, self.inertia);
         let (particles, g) = (system.particles(), system.gravity());
@@ -187,6 +188,9 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
             sigma: point.sigma,
             lambda: &b.lambda,
             scales: self.scales,
+            end_weight: -rule.weights(point.sigma).2 / point.sigma,
+            start_phi: &b.start_phi,
+            slack: R::SLACK,
         };
         let inertia = self.inertia;
         let mass = |i: usize| rule.mass_diagonal(point.sigma, inertia[i]);
@@ -434,6 +438,57 @@ mod tests {
         s.add_elastic_distance(c, d, (Law::Constant(0.8), 1.0), f64::INFINITY)
             .unwrap();
         s
+    }
+
+    /// The elastic chain with both elastic segments able to go slack, the first one longer
+    /// (0.7 m) than its particles' distance (0.55 m): slack, the second stretched.
+    fn slack_chain() -> System {
+        use crate::laws::Law;
+        use crate::model::ConstraintId;
+        let mut s = System::new([0.1, -0.2, -9.81]);
+        let a = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
+        let b = s
+            .add_particle(0.7, [0.5, 0.1, -0.2], [0.3, 0.1, 0.0], false)
+            .unwrap();
+        let c = s
+            .add_particle(1.3, [0.9, -0.1, -0.4], [-0.2, 0.4, 0.1], false)
+            .unwrap();
+        let slack = s
+            .add_elastic_distance(a, b, (Law::Constant(0.7), 1.0), 2e3)
+            .unwrap();
+        let taut = s
+            .add_elastic_distance(b, c, (Law::Constant(0.45), 1.0), 2e3)
+            .unwrap();
+        for k in [slack, taut] {
+            s.set_slack(ConstraintId(k.0)).unwrap();
+        }
+        s
+    }
+
+    /// A slack segment's row is c lambda alone (no position terms), a stretched one's the
+    /// compliant row: the Jacobian equals finite differences of the residual in both states,
+    /// for both rules, with the sparse LU's and the tree elimination's layouts.
+    #[test]
+    fn slack_segments_jacobian_matches_finite_differences() {
+        let s = slack_chain();
+        let (q_n, v_n) = (s.initial_positions(), s.initial_velocities());
+        for (dense_limit, solver) in [(0, SparseSolver::SparseLu), (0, SparseSolver::Auto)] {
+            let mut ws = StepWorkspace::with_solver(&s, dense_limit, solver);
+            perturbed_iterate(&mut ws, &q_n);
+            ws.state.lambda.truncate(2);
+            let layout = ws.layout.clone();
+            let mut state = RuleState::new(&q_n);
+            let rule = GeneralizedTrapezoidal { alpha: 0.6 };
+            let (mut problem, _) = problem_at(rule, &s, &mut ws, &mut state, start(&q_n, &v_n));
+            assert_jacobian_matches(&mut problem, &layout);
+            let mut ws = StepWorkspace::with_solver(&s, dense_limit, solver);
+            perturbed_iterate(&mut ws, &q_n);
+            ws.state.lambda.truncate(2);
+            let mut state = alpha_state(q_n.len());
+            let rule = GeneralizedAlpha { rho_inf: 0.6 };
+            let (mut problem, _) = problem_at(rule, &s, &mut ws, &mut state, start(&q_n, &v_n));
+            assert_jacobian_matches(&mut problem, &layout);
+        }
     }
 
     /// The Jacobian with compliant rows (the compliance on the multipliers' diagonal, a winch's

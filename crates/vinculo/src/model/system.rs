@@ -241,6 +241,7 @@ impl System {
             length,
             share,
             ea,
+            slack: false,
         })))
     }
 
@@ -531,6 +532,32 @@ impl System {
                 name: format!("tension-only constraint ({})", other.name(c.0)),
                 value: c.0 as f64,
                 expected: "must be a distance constraint (a string can only be a distance)".into(),
+            }),
+            None => Err(Error::InvalidParameter {
+                name: "constraint handle".into(),
+                value: c.0 as f64,
+                expected: format!(
+                    "must be one of the system's {} constraints",
+                    self.constraints.len()
+                ),
+            }),
+        }
+    }
+
+    /// Lets elastic segment `c` go slack: shorter than its unstretched length it carries no
+    /// tension (and no compression), as MoorDyn's segments (`docs/theory/moorings.md`).
+    pub fn set_slack(&mut self, c: ConstraintId) -> Result<()> {
+        match self.constraints.get_mut(c.0) {
+            Some(Constraint::ElasticDistance(e)) if e.ea.is_finite() => {
+                e.slack = true;
+                Ok(())
+            }
+            Some(other) => Err(Error::InvalidParameter {
+                name: format!("slack segment ({})", other.name(c.0)),
+                value: c.0 as f64,
+                expected: "must be an elastic segment of finite EA (add_elastic_distance); an \
+                           inextensible string is made tension-only with set_tension_only"
+                    .into(),
             }),
             None => Err(Error::InvalidParameter {
                 name: "constraint handle".into(),
