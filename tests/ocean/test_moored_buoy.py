@@ -107,3 +107,23 @@ def test_cli_rejects_a_bad_case_with_code_2(tmp_path, capsys):
     assert cli.main(["moored-buoy", str(bad), "--output", str(tmp_path / "o")]) == 2
     assert "bad.toml [buoy]" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+def test_case_with_a_measured_record_reproduces_it_at_the_buoy(tmp_path):
+    # A record of regular waves at the buoy's position, read from the case's CSV: the elevation
+    # the run sees there is the record (its Fourier components reproduce its samples).
+    t = np.arange(0.0, 40.0, 0.25)
+    eta = 0.3 * np.cos(2 * np.pi * t / 8.0) + 0.1 * np.sin(2 * np.pi * t / 5.0)
+    np.savetxt(tmp_path / "eta.csv", np.column_stack([t, eta]), delimiter=",",
+               header="time,elevation", comments="")
+    text = (EXAMPLES / "submerged_buoy.toml").read_text()
+    text = text.replace('file = "tether.txt"', f'file = "{EXAMPLES / "tether.txt"}"')
+    text = text.replace('waves = { kind = "regular", height = 0.02, period = 1.0 }',
+                        'waves = { kind = "record", file = "eta.csv" }\ncurrent = { kind = '
+                        '"table", z = [-0.4, 0.0], velocity = [[0.0, 0, 0], [0.02, 0, 0]] }')
+    text = text.replace("ramp = 5.0", "ramp = 0.0")
+    case_file = tmp_path / "case.toml"
+    case_file.write_text(text)
+    case = mb.read_case(case_file)
+    np.testing.assert_allclose(case.sea.elevation(t), eta - eta.mean(), atol=1e-10)
+    assert case.sea.current.kind == "table"

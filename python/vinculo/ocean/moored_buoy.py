@@ -12,8 +12,9 @@ three chains and the submerged buoy of the case study in an open basin):
   points of the buoy, where the file puts them with the buoy at its ``centre``; its depth,
   density and gravity are the sea's;
 - ``[sea]``: ``waves`` (``{kind = "regular", height, period}``, ``{kind = "jonswap", hs, tp,
-  gamma, seed, components}``, or none), ``direction``, ``current`` (``{kind = "uniform" |
-  "power", velocity}``), ``stretching``, ``ramp`` (s);
+  gamma, seed, components, spreading, directions}``, ``{kind = "record", file}`` (a measured
+  elevation at the buoy: CSV of time and elevation), or none), ``direction``, ``current``
+  (``{kind = "uniform" | "power" | "table", velocity, z}``), ``stretching``, ``ramp`` (s);
 - ``[run]``: ``t_end``, ``dt``; ``[rao]``: ``periods``, ``height``, ``cycles``.
 
 :func:`build` makes the system (the buoy, its floating-body loads, the lines in the same water,
@@ -38,6 +39,7 @@ import tomllib
 from vinculo.errors import InvalidInputError
 from vinculo.ocean.hull import Hull, cylinder, frustum, sphere
 from vinculo.ocean.sea import Current, Sea
+from vinculo.ocean.spectra import from_elevation
 
 __all__ = ["Built", "MooredBuoyCase", "MooredBuoyRun", "RaoTable", "build", "rao", "read_case",
            "run", "write"]
@@ -123,7 +125,8 @@ def _hull(sections: Any, where: str) -> Hull:
     return hull
 
 
-def _sea(table: dict[str, Any], depth: float, density: float, g: float, where: str) -> Sea:
+def _sea(table: dict[str, Any], depth: float, density: float, g: float, where: str,
+         folder: Path) -> Sea:
     waves = table.get("waves")
     direction = math.radians(_number(table, "direction", where, 0.0))
     options: dict[str, Any] = {"density": density, "g": g,
@@ -138,9 +141,11 @@ def _sea(table: dict[str, Any], depth: float, density: float, g: float, where: s
         elif kind == "power":
             options["current"] = Current.power_law(velocity,
                                                    _number(current, "exponent", where, 1 / 7))
+        elif kind == "table":
+            options["current"] = Current.table(current.get("z", []), velocity)
         else:
-            raise InvalidInputError(f"{where}: current kind = {kind!r}: give \"uniform\" or "
-                                    "\"power\"", name="current", value=kind)
+            raise InvalidInputError(f"{where}: current kind = {kind!r}: give \"uniform\", "
+                                    "\"power\" or \"table\"", name="current", value=kind)
     if waves is None:
         return Sea(depth, **options)
     kind = waves.get("kind")
@@ -149,12 +154,28 @@ def _sea(table: dict[str, Any], depth: float, density: float, g: float, where: s
                            depth, direction=direction, **options)
     if kind in ("jonswap", "pierson-moskowitz"):
         gamma = 1.0 if kind == "pierson-moskowitz" else _number(waves, "gamma", where, 3.3)
+        spreading = waves.get("spreading")
         return Sea.irregular(_number(waves, "hs", where), _number(waves, "tp", where), depth,
                              gamma=gamma, seed=int(waves.get("seed", 0)),
                              count=int(waves.get("components", 100)), direction=direction,
-                             **options)
-    raise InvalidInputError(f"{where}: waves kind = {kind!r}: give \"regular\", \"jonswap\" or "
-                            "\"pierson-moskowitz\"", name="waves", value=kind)
+                             spreading_exponent=None if spreading is None else float(spreading),
+                             directions=int(waves.get("directions", 9)), **options)
+    if kind == "record":
+        # A measured elevation at the buoy's position: CSV of time (s) and elevation (m).
+        record = folder / str(waves.get("file", ""))
+        try:
+            data = np.loadtxt(record, delimiter=",", skiprows=1, ndmin=2)
+        except (OSError, ValueError) as e:
+            raise InvalidInputError(f"{where}: waves record {record}: {e}: give a CSV file "
+                                    "with a header line, then rows of time (s), elevation (m)",
+                                    name="file", value=str(record)) from e
+        if data.shape[1] < 2:
+            raise InvalidInputError(f"{where}: waves record {record} has {data.shape[1]} "
+                                    "column: give time (s), elevation (m)", name="file",
+                                    value=str(record))
+        return Sea(depth, from_elevation(data[:, 0], data[:, 1], direction), **options)
+    raise InvalidInputError(f"{where}: waves kind = {kind!r}: give \"regular\", \"jonswap\", "
+                            "\"pierson-moskowitz\" or \"record\"", name="waves", value=kind)
 
 
 def read_case(path: str | Path) -> MooredBuoyCase:
@@ -203,7 +224,7 @@ def read_case(path: str | Path) -> MooredBuoyCase:
     return MooredBuoyCase(
         mass=_number(buoy, "mass", where), centre=tuple(float(c) for c in centre),
         inertia=inertia, hull=_hull(buoy.get("hull"), where),
-        sea=_sea(data.get("sea", {}), depth, density, g, f"{path} [sea]"),
+        sea=_sea(data.get("sea", {}), depth, density, g, f"{path} [sea]", path.parent),
         mooring=mooring_path, ca=_number(buoy, "ca", where, 0.0),
         cd=_number(buoy, "cd", where, 0.0), drag_area=_number(buoy, "drag_area", where, 0.0),
         layers=int(buoy.get("layers", 40)),
