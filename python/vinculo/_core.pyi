@@ -751,6 +751,25 @@ class System:
                 different particles.
             UnknownHandleError: a handle of another system.
         """
+    def add_damping_matrix(self, particles: Sequence[ParticleId],
+                           matrix: npt.NDArray[np.float64]) -> ForceId:
+        """A linear velocity coupling ``f = -D v`` over any number of particles: a damping
+        matrix, or a linear first-order system ``x' = A x + B u`` whose states are the
+        velocities of auxiliary particles of mass ``mu`` (rows ``mu (A x + B u)``), as the
+        radiation memory of :mod:`vinculo.ocean.bem`.
+
+        Arguments:
+            particles: the n particles, each once.
+            matrix: D, (3n, 3n) (N s/m): row 3p + k is the force component k on particle p,
+                column 3r + l the velocity component l of particle r.
+
+        Returns:
+            The force's handle.
+
+        Raises:
+            InvalidInputError: a matrix of the wrong size or with non-finite entries, a
+                particle given twice.
+        """
     def add_floating_body(
         self,
         body: dict[str, Any] | Sequence[ParticleId],

@@ -770,6 +770,29 @@ impl PySystem {
         Ok(PyForceId { index: id.0 })
     }
 
+    /// A linear velocity coupling f = -D v over particles (see the stub).
+    fn add_damping_matrix(
+        &mut self,
+        particles: Vec<Bound<'_, PyAny>>,
+        matrix: numpy::PyReadonlyArray2<'_, f64>,
+    ) -> PyResult<PyForceId> {
+        let ids = particles
+            .iter()
+            .map(|p| self.particle(p))
+            .collect::<PyResult<Vec<_>>>()?;
+        let m = matrix.as_array();
+        if m.nrows() != m.ncols() {
+            return Err(invalid(
+                "matrix",
+                format!("an array of shape {:?}", m.shape()),
+                "give a square (3n, 3n) matrix",
+            ));
+        }
+        let flat: Vec<f64> = m.iter().copied().collect();
+        let id = self.inner.add_damping_matrix(&ids, &flat).map_err(to_py)?;
+        Ok(PyForceId { index: id.0 })
+    }
+
     /// The water's loads on a rigid body from its submerged volume (see the stub).
     #[pyo3(signature = (body, hull, *, origin=None, axis=None, density=1025.0, ca=0.0, cd=0.0, drag_area=0.0, added_mass=None, layers=40))]
     #[allow(clippy::too_many_arguments)]

@@ -23,6 +23,7 @@
 mod applied;
 mod bending;
 mod couple;
+mod damping_matrix;
 mod drag;
 mod floating_body;
 mod line_hydro;
@@ -36,6 +37,7 @@ pub mod user;
 pub use applied::AppliedForce;
 pub use bending::Bending;
 pub use couple::Couple;
+pub use damping_matrix::DampingMatrix;
 pub use drag::{LinearDrag, QuadraticDrag};
 pub use floating_body::{FloatingBody, HullCell, HullLayer};
 pub use line_hydro::LineHydro;
@@ -75,6 +77,8 @@ pub enum Force {
     LineHydro(Box<LineHydro>),
     /// The water's loads on a rigid body from its submerged volume.
     FloatingBody(Box<FloatingBody>),
+    /// A linear velocity coupling f = -D v over any number of particles.
+    DampingMatrix(Box<DampingMatrix>),
     /// A torque about a world axis, as a couple on two points of a body.
     Couple(Box<Couple>),
     /// A force of another kind over points fixed in bodies or in the ground.
@@ -95,6 +99,7 @@ macro_rules! dispatch {
             Force::SeabedContact($f) => $e,
             Force::LineHydro($f) => $e,
             Force::FloatingBody($f) => $e,
+            Force::DampingMatrix($f) => $e,
             Force::Couple($f) => $e,
             Force::OnPoints($f) => $e,
             Force::User($f) => $e,
@@ -257,6 +262,7 @@ impl Force {
             Force::SeabedContact(_) => format!("seabed contact #{index} (node {})", p[0]),
             Force::LineHydro(_) => format!("line hydrodynamics #{index} (node {})", p[0]),
             Force::FloatingBody(_) => format!("floating body #{index} (particles {p:?})"),
+            Force::DampingMatrix(_) => format!("damping matrix #{index} (particles {p:?})"),
             Force::Couple(_) => format!("torque #{index} (particles {p:?})"),
             Force::OnPoints(f) => format!("{} #{index} (particles {p:?})", f.label),
             Force::User(f) => format!(

@@ -477,6 +477,54 @@ impl System {
         Ok(ForceId(index))
     }
 
+    /// A linear velocity coupling f = -D v over `particles` ([`crate::forces::DampingMatrix`]):
+    /// `matrix` row-major, (3n)^2 entries, row 3p + k the force component k on particle p,
+    /// column 3r + l the velocity component l of particle r.
+    pub fn add_damping_matrix(
+        &mut self,
+        particles: &[ParticleId],
+        matrix: &[f64],
+    ) -> Result<ForceId> {
+        let index = self.forces.len();
+        let indices = particles
+            .iter()
+            .map(|&p| self.check(p))
+            .collect::<Result<Vec<_>>>()?;
+        let n = 3 * indices.len();
+        if n == 0 || matrix.len() != n * n {
+            return Err(Error::InvalidParameter {
+                name: format!("matrix of damping matrix #{index}"),
+                value: matrix.len() as f64,
+                expected: format!(
+                    "needs (3 x {} particles)^2 = {} entries, row-major",
+                    indices.len(),
+                    n * n
+                ),
+            });
+        }
+        for (k, &d) in matrix.iter().enumerate() {
+            crate::error::finite(
+                format!("entry ({}, {}) of damping matrix #{index}", k / n, k % n),
+                d,
+            )?;
+        }
+        for (a, &p) in indices.iter().enumerate() {
+            if indices[..a].contains(&p) {
+                return Err(Error::SameParticle {
+                    what: format!("damping matrix #{index} (each particle once)"),
+                    particle: p,
+                });
+            }
+        }
+        self.forces.push(Force::DampingMatrix(Box::new(
+            crate::forces::DampingMatrix {
+                particles: indices,
+                matrix: matrix.to_vec(),
+            },
+        )));
+        Ok(ForceId(index))
+    }
+
     /// Quadratic drag f = -c |v| v on `p`.
     pub fn add_quadratic_drag(&mut self, p: ParticleId, coefficient: f64) -> Result<ForceId> {
         let i = self.check(p)?;
