@@ -44,6 +44,19 @@ impl PyConstraintId {
     }
 }
 
+/// The constraint of a `ConstraintId` handle (`made_by` names the methods that return one, for
+/// the error).
+fn constraint_id(obj: &Bound<'_, PyAny>, made_by: &str) -> PyResult<vinculo::model::ConstraintId> {
+    let c = obj.cast::<PyConstraintId>().map_err(|_| {
+        invalid(
+            "constraint",
+            obj.repr().map(|r| r.to_string()).unwrap_or_default(),
+            &format!("expected a ConstraintId returned by {made_by}"),
+        )
+    })?;
+    Ok(vinculo::model::ConstraintId(c.get().index))
+}
+
 /// Handle to a force element.
 #[pyclass(name = "ForceId", module = "vinculo._core", frozen, eq, hash)]
 #[derive(Clone, Copy, PartialEq, Eq, Hash)]
@@ -948,33 +961,15 @@ impl PySystem {
 
     /// Lets an elastic segment go slack instead of pushing (see the stub).
     fn set_slack(&mut self, constraint: &Bound<'_, PyAny>) -> PyResult<()> {
-        let c = constraint.cast::<PyConstraintId>().map_err(|_| {
-            invalid(
-                "constraint",
-                constraint.repr().map(|r| r.to_string()).unwrap_or_default(),
-                "expected a ConstraintId returned by System.add_elastic_distance",
-            )
-        })?;
-        let index = c.get().index;
-        self.inner
-            .set_slack(vinculo::model::ConstraintId(index))
-            .map_err(to_py)
+        let c = constraint_id(constraint, "System.add_elastic_distance")?;
+        self.inner.set_slack(c).map_err(to_py)
     }
 
     /// Declares a distance constraint a string: a run stops with NegativeTensionError when it
     /// would have to push.
     fn set_tension_only(&mut self, constraint: &Bound<'_, PyAny>) -> PyResult<()> {
-        let c = constraint.cast::<PyConstraintId>().map_err(|_| {
-            invalid(
-                "constraint",
-                constraint.repr().map(|r| r.to_string()).unwrap_or_default(),
-                "expected a ConstraintId returned by System.add_distance or add_distance_to_point",
-            )
-        })?;
-        let index = c.get().index;
-        self.inner
-            .set_tension_only(vinculo::model::ConstraintId(index))
-            .map_err(to_py)
+        let c = constraint_id(constraint, "System.add_distance or add_distance_to_point")?;
+        self.inner.set_tension_only(c).map_err(to_py)
     }
 
     /// Lengths of the constraints (m; NaN for constraints that are not distances).

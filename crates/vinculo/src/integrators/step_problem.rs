@@ -470,23 +470,36 @@ mod tests {
     /// for both rules, with the sparse LU's and the tree elimination's layouts.
     #[test]
     fn slack_segments_jacobian_matches_finite_differences() {
-        let s = slack_chain();
+        let solvers = [(0, SparseSolver::SparseLu), (0, SparseSolver::Auto)];
+        assert_compliant_jacobians_match(&slack_chain(), 2, &solvers);
+    }
+
+    /// For each layout in `solvers`, the Jacobian of a chain of compliant segments with its
+    /// first `multipliers` multipliers non-zero against finite differences of the residual,
+    /// for the trapezoidal rule (alpha = 0.6) and generalised-alpha (rho_inf = 0.6).
+    fn assert_compliant_jacobians_match(
+        s: &System,
+        multipliers: usize,
+        solvers: &[(usize, SparseSolver)],
+    ) {
         let (q_n, v_n) = (s.initial_positions(), s.initial_velocities());
-        for (dense_limit, solver) in [(0, SparseSolver::SparseLu), (0, SparseSolver::Auto)] {
-            let mut ws = StepWorkspace::with_solver(&s, dense_limit, solver);
-            perturbed_iterate(&mut ws, &q_n);
-            ws.state.lambda.truncate(2);
+        for &(dense_limit, solver) in solvers {
+            let workspace = || {
+                let mut ws = StepWorkspace::with_solver(s, dense_limit, solver);
+                perturbed_iterate(&mut ws, &q_n);
+                ws.state.lambda.truncate(multipliers);
+                ws
+            };
+            let mut ws = workspace();
             let layout = ws.layout.clone();
             let mut state = RuleState::new(&q_n);
             let rule = GeneralizedTrapezoidal { alpha: 0.6 };
-            let (mut problem, _) = problem_at(rule, &s, &mut ws, &mut state, start(&q_n, &v_n));
+            let (mut problem, _) = problem_at(rule, s, &mut ws, &mut state, start(&q_n, &v_n));
             assert_jacobian_matches(&mut problem, &layout);
-            let mut ws = StepWorkspace::with_solver(&s, dense_limit, solver);
-            perturbed_iterate(&mut ws, &q_n);
-            ws.state.lambda.truncate(2);
+            let mut ws = workspace();
             let mut state = alpha_state(q_n.len());
             let rule = GeneralizedAlpha { rho_inf: 0.6 };
-            let (mut problem, _) = problem_at(rule, &s, &mut ws, &mut state, start(&q_n, &v_n));
+            let (mut problem, _) = problem_at(rule, s, &mut ws, &mut state, start(&q_n, &v_n));
             assert_jacobian_matches(&mut problem, &layout);
         }
     }
@@ -498,29 +511,12 @@ mod tests {
     #[test]
     fn elastic_segments_jacobian_matches_finite_differences() {
         let s = elastic_chain();
-        let (q_n, v_n) = (s.initial_positions(), s.initial_velocities());
         let solvers = [
             (0, SparseSolver::SparseLu),
             (1000, SparseSolver::SparseLu),
             (0, SparseSolver::Auto),
         ];
-        for (dense_limit, solver) in solvers {
-            let mut ws = StepWorkspace::with_solver(&s, dense_limit, solver);
-            perturbed_iterate(&mut ws, &q_n);
-            ws.state.lambda.truncate(3);
-            let layout = ws.layout.clone();
-            let mut state = RuleState::new(&q_n);
-            let rule = GeneralizedTrapezoidal { alpha: 0.6 };
-            let (mut problem, _) = problem_at(rule, &s, &mut ws, &mut state, start(&q_n, &v_n));
-            assert_jacobian_matches(&mut problem, &layout);
-            let mut ws = StepWorkspace::with_solver(&s, dense_limit, solver);
-            perturbed_iterate(&mut ws, &q_n);
-            ws.state.lambda.truncate(3);
-            let mut state = alpha_state(q_n.len());
-            let rule = GeneralizedAlpha { rho_inf: 0.6 };
-            let (mut problem, _) = problem_at(rule, &s, &mut ws, &mut state, start(&q_n, &v_n));
-            assert_jacobian_matches(&mut problem, &layout);
-        }
+        assert_compliant_jacobians_match(&s, 3, &solvers);
         assert_parallel_assembly_is_serial(&s, GeneralizedTrapezoidal { alpha: 0.6 });
     }
 

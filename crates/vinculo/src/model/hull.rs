@@ -104,24 +104,11 @@ impl HullSection {
         }
     }
 
-    /// The volume between heights z0 and z1 inside the section.
+    /// The volume between heights z0 and z1 inside the section: (z1 - z0) times the mean of
+    /// the quadratic area, a0 + a1 / 2 + a2 / 3 (exact for both kinds).
     fn volume_between(&self, z0: f64, z1: f64) -> f64 {
-        match *self {
-            HullSection::Frustum {
-                bottom,
-                top,
-                r_bottom,
-                r_top,
-            } => {
-                let r = |z: f64| r_bottom + (r_top - r_bottom) * (z - bottom) / (top - bottom);
-                let (a, b) = (r(z0), r(z1));
-                PI * (z1 - z0) * (a * a + a * b + b * b) / 3.0
-            }
-            HullSection::Sphere { centre, radius } => {
-                let (u0, u1) = (z0 - centre, z1 - centre);
-                PI * (radius * radius * (u1 - u0) - (u1.powi(3) - u0.powi(3)) / 3.0)
-            }
-        }
+        let [a0, a1, a2] = self.area_between(z0, z1);
+        (z1 - z0) * (a0 + a1 / 2.0 + a2 / 3.0)
     }
 }
 

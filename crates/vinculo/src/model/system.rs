@@ -581,14 +581,19 @@ impl System {
                 value: c.0 as f64,
                 expected: "must be a distance constraint (a string can only be a distance)".into(),
             }),
-            None => Err(Error::InvalidParameter {
-                name: "constraint handle".into(),
-                value: c.0 as f64,
-                expected: format!(
-                    "must be one of the system's {} constraints",
-                    self.constraints.len()
-                ),
-            }),
+            None => Err(self.unknown_constraint(c)),
+        }
+    }
+
+    /// The error for a constraint handle that is not one of this system's.
+    fn unknown_constraint(&self, c: ConstraintId) -> Error {
+        Error::InvalidParameter {
+            name: "constraint handle".into(),
+            value: c.0 as f64,
+            expected: format!(
+                "must be one of the system's {} constraints",
+                self.constraints.len()
+            ),
         }
     }
 
@@ -607,14 +612,7 @@ impl System {
                            inextensible string is made tension-only with set_tension_only"
                     .into(),
             }),
-            None => Err(Error::InvalidParameter {
-                name: "constraint handle".into(),
-                value: c.0 as f64,
-                expected: format!(
-                    "must be one of the system's {} constraints",
-                    self.constraints.len()
-                ),
-            }),
+            None => Err(self.unknown_constraint(c)),
         }
     }
 
