@@ -249,6 +249,7 @@ impl Constraint {
 
     /// True for an elastic segment that goes slack instead of pushing
     /// ([`crate::model::System::set_slack`]).
+    #[inline]
     pub fn can_slack(&self) -> bool {
         match self {
             Constraint::ElasticDistance(c) => c.slack && c.ea.is_finite(),
@@ -258,6 +259,7 @@ impl Constraint {
     }
 
     /// True when the constraint's equation has a compliance (its row gets a diagonal entry).
+    #[inline]
     pub fn is_compliant(&self) -> bool {
         match self {
             Constraint::ElasticDistance(c) => c.ea.is_finite(),

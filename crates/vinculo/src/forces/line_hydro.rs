@@ -133,12 +133,14 @@ impl LineHydro {
     }
 
     /// The water's flow at the node (none in still water that fills all space).
+    #[inline(always)]
     fn flow(&self, q: &[Vec3], t: f64, gradients: bool) -> Option<Flow> {
         let w = &*self.water;
         (w.free_surface || !w.is_still()).then(|| w.flow(q[self.node.node()], t, gradients))
     }
 
     /// The wet fraction F and, inside its ramp, its gradient (module documentation).
+    #[inline(always)]
     fn wet_fraction(&self, z: f64, flow: Option<&Flow>) -> (f64, Option<Vec3>) {
         match flow {
             Some(f) if self.water.free_surface => {
@@ -158,6 +160,7 @@ impl LineHydro {
     }
 
     /// The loads on the node over its wet fraction (the bracket of the module documentation).
+    #[inline(always)]
     fn wet_force(&self, q: &[Vec3], v: &[Vec3], flow: Option<&Flow>) -> Vec3 {
         let buoyancy = scale(-self.density * self.volume(), self.gravity);
         let u = flow.map_or([0.0; 3], |f| f.velocity);
@@ -182,6 +185,7 @@ impl LineHydro {
     }
 
     /// rho V ((1 + Ca) a_n + (1 + CaAx) a_a) = rho V ((1 + Ca) a + (CaAx - Ca) t (t . a)).
+    #[inline(always)]
     fn inertia_force(&self, t: Option<Vec3>, a: Vec3) -> Vec3 {
         let m = self.density * self.volume();
         let f = scale(m * (1.0 + self.ca), a);
@@ -192,6 +196,7 @@ impl LineHydro {
     }
 
     /// Buoyancy, drag and the water's inertia force on the node at time `t`.
+    #[inline(always)]
     pub(crate) fn node_force(&self, q: &[Vec3], v: &[Vec3], t: f64) -> Vec3 {
         let flow = self.flow(q, t, false);
         let (wet, _) = self.wet_fraction(q[self.node.node()][2], flow.as_ref());

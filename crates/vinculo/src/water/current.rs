@@ -40,6 +40,7 @@ impl Current {
     }
 
     /// Whether the current is zero everywhere.
+    #[inline]
     pub fn is_zero(&self) -> bool {
         match self {
             Current::Uniform(u) => *u == [0.0; 3],

@@ -159,6 +159,7 @@ impl Water {
     }
 
     /// Whether the water is still (no current, no waves): its flow is zero everywhere.
+    #[inline]
     pub fn is_still(&self) -> bool {
         self.waves.is_empty() && self.current.is_zero()
     }
