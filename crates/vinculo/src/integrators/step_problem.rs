@@ -416,11 +416,8 @@ mod tests {
         }
     }
 
-    /// An elastic chain: a fixed anchor, three free particles, segments of EA = 2e3 N (one
-    /// paid out by a winch law), and one inextensible elastic segment (EA = infinity).
-    fn elastic_chain() -> System {
-        use crate::laws::Law;
-        let mut s = System::new([0.1, -0.2, -9.81]);
+    /// A fixed anchor and two free particles, moving, of the elastic chains below.
+    fn chain_particles(s: &mut System) -> [crate::model::ParticleId; 3] {
         let a = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
         let b = s
             .add_particle(0.7, [0.5, 0.1, -0.2], [0.3, 0.1, 0.0], false)
@@ -428,6 +425,15 @@ mod tests {
         let c = s
             .add_particle(1.3, [0.9, -0.1, -0.4], [-0.2, 0.4, 0.1], false)
             .unwrap();
+        [a, b, c]
+    }
+
+    /// An elastic chain: a fixed anchor, three free particles, segments of EA = 2e3 N (one
+    /// paid out by a winch law), and one inextensible elastic segment (EA = infinity).
+    fn elastic_chain() -> System {
+        use crate::laws::Law;
+        let mut s = System::new([0.1, -0.2, -9.81]);
+        let [a, b, c] = chain_particles(&mut s);
         let d = s
             .add_particle(0.4, [1.2, 0.6, -0.1], [0.0, -0.3, 0.5], false)
             .unwrap();
@@ -440,19 +446,13 @@ mod tests {
         s
     }
 
-    /// The elastic chain with both elastic segments able to go slack, the first one longer
-    /// (0.7 m) than its particles' distance (0.55 m): slack, the second stretched.
+    /// The elastic chain's first two segments able to go slack, the first one longer (0.7 m)
+    /// than its particles' distance (0.55 m): slack, the second stretched.
     fn slack_chain() -> System {
         use crate::laws::Law;
         use crate::model::ConstraintId;
         let mut s = System::new([0.1, -0.2, -9.81]);
-        let a = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
-        let b = s
-            .add_particle(0.7, [0.5, 0.1, -0.2], [0.3, 0.1, 0.0], false)
-            .unwrap();
-        let c = s
-            .add_particle(1.3, [0.9, -0.1, -0.4], [-0.2, 0.4, 0.1], false)
-            .unwrap();
+        let [a, b, c] = chain_particles(&mut s);
         let slack = s
             .add_elastic_distance(a, b, (Law::Constant(0.7), 1.0), 2e3)
             .unwrap();
