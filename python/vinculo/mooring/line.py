@@ -226,10 +226,10 @@ class Line:
             else:
                 times = np.asarray(times, dtype=float)
                 velocities = np.asarray(solution.velocities, dtype=float).reshape(q.shape)
+            q, velocities = np.ascontiguousarray(q), np.ascontiguousarray(velocities)
             for k, elements in enumerate(self.end_elements):
                 if elements:
-                    loads = self.system.element_forces(elements, np.ascontiguousarray(q),
-                                                       np.ascontiguousarray(velocities), times)
+                    loads = self.system.element_forces(elements, q, velocities, times)
                     if k == 0:
                         on_a = on_a + loads.sum(axis=1)
                     else:

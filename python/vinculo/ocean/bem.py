@@ -21,6 +21,7 @@ coupling (``System.add_damping_matrix``). The wave excitation (Froude-Krylov and
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -218,8 +219,7 @@ def fit_radiation(coefficients: HeaveCoefficients, order: int = 4,
                            added_mass_infinite=coefficients.added_mass_infinite,
                            fit_error=0.0)
     error = float(np.max(np.abs(model.kernel(w) - k)) / np.max(np.abs(k)))
-    return RadiationModel(a=model.a, b=model.b, c=model.c,
-                          added_mass_infinite=model.added_mass_infinite, fit_error=error)
+    return dataclasses.replace(model, fit_error=error)
 
 
 def add_heave_radiation(system: Any, body: dict[str, Any], model: RadiationModel,

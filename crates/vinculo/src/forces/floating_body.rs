@@ -143,7 +143,7 @@ impl FloatingBody {
     /// The water at every layer centre (gradients only when `gradients`).
     fn layer_water(&self, q: &[Vec3], t: f64, gradients: bool) -> Vec<LayerWater> {
         let w = &*self.water;
-        let moving = !w.is_still() || w.free_surface;
+        let moving = w.needs_flow();
         self.layers
             .iter()
             .map(|l| {

@@ -136,7 +136,8 @@ impl LineHydro {
     #[inline(always)]
     fn flow(&self, q: &[Vec3], t: f64, gradients: bool) -> Option<Flow> {
         let w = &*self.water;
-        (w.free_surface || !w.is_still()).then(|| w.flow(q[self.node.node()], t, gradients))
+        w.needs_flow()
+            .then(|| w.flow(q[self.node.node()], t, gradients))
     }
 
     /// The wet fraction F and, inside its ramp, its gradient (module documentation).
@@ -269,7 +270,8 @@ impl LineHydro {
         let r = sub(u, v[self.node.node()]);
         let (cn, ca) = self.drag_factors();
         // B = D_n P + D_a t t^T (df/dv = -F B, df/du = F B).
-        let b = match self.node.tangent(q) {
+        let tangent = self.node.tangent(q);
+        let b = match &tangent {
             Some(tg) => {
                 // The products with P = I - t t^T and t t^T as products with t (module
                 // documentation): D_n P + D_a t t^T = D_n + (D_a t - D_n t) t^T, and with
@@ -297,7 +299,7 @@ impl LineHydro {
         dv[0][0] = add_mat(dv[0][0], scale_mat(-wet, b));
         if let Some(f) = &flow {
             let m = self.density * self.volume();
-            let inertia = match self.node.tangent(q) {
+            let inertia = match &tangent {
                 Some(tg) => add_mat(
                     diag(m * (1.0 + self.ca)),
                     outer(m * (self.caax - self.ca), tg.t, tg.t),

@@ -135,7 +135,12 @@ impl WaveComponent {
 
     /// Elevation eta, its horizontal gradient and its rate at (x, y, t).
     pub fn surface(&self, x: f64, y: f64, t: f64) -> (f64, [f64; 2], f64) {
-        let (s, c) = self.angle(x, y, t).sin_cos();
+        self.surface_at(self.angle(x, y, t).sin_cos())
+    }
+
+    /// [`WaveComponent::surface`] with the phase angle's (sin, cos) already known.
+    #[inline]
+    pub fn surface_at(&self, (s, c): (f64, f64)) -> (f64, [f64; 2], f64) {
         let a = self.amplitude;
         let dx = -a * s * self.k;
         (

@@ -164,6 +164,13 @@ impl Water {
         self.waves.is_empty() && self.current.is_zero()
     }
 
+    /// Whether the elements in this water must evaluate its flow: it moves, or it has a free
+    /// surface (whose elevation decides what is wet).
+    #[inline]
+    pub fn needs_flow(&self) -> bool {
+        self.free_surface || !self.is_still()
+    }
+
     /// The ramp factor s(t) of the waves and its rate ([`Water::ramp`]).
     pub fn ramp_factor(&self, t: f64) -> (f64, f64) {
         if self.ramp <= 0.0 || t >= self.ramp {
@@ -214,17 +221,17 @@ impl Water {
         let mut flow = Flow::default();
         if !self.waves.is_empty() {
             // The components' phase angles, once: for the elevation, then the flow.
-            let (s, _) = self.ramp_factor(t);
+            let (s, ds) = self.ramp_factor(t);
             let mut angles =
                 smallvec::SmallVec::<[(f64, f64); 64]>::with_capacity(self.waves.len());
             let (mut eta, mut slope) = (0.0, [0.0; 2]);
             for c in &self.waves {
-                let (sin, cos) = c.angle(point[0], point[1], t).sin_cos();
-                angles.push((sin, cos));
-                eta += c.amplitude * cos;
-                let d = -c.amplitude * c.k * sin;
-                slope[0] += d * c.direction[0];
-                slope[1] += d * c.direction[1];
+                let angle = c.angle(point[0], point[1], t).sin_cos();
+                angles.push(angle);
+                let (e, g, _) = c.surface_at(angle);
+                eta += e;
+                slope[0] += g[0];
+                slope[1] += g[1];
             }
             let (eta, slope) = (s * eta, [s * slope[0], s * slope[1]]);
             flow.elevation = eta;
@@ -235,7 +242,6 @@ impl Water {
                 c.add_flow_at(angle, zs, self.g, gradients, &mut lin);
             }
             // The ramp: s u, s a + s' u, s p, and the gradients likewise.
-            let (s, ds) = self.ramp_factor(t);
             flow.velocity = lin.velocity.map(|u| s * u);
             flow.acceleration =
                 std::array::from_fn(|i| s * lin.acceleration[i] + ds * lin.velocity[i]);
