@@ -292,6 +292,9 @@ def test_newton_iterations():
     # Full Newton factorises at every iteration and converges in a few; modified Newton reuses
     # factorisations (docs/theory/newton.md): far fewer, more iterations, and the same solution to
     # within its tolerance (1e-12 of the 1 m length scale per step, accumulated over 1000 steps).
+    # The default keeps a matrix while it contracts fast and stops a kept matrix's iteration at
+    # a thousandth of the tolerance: fewer factorisations than full Newton, and its answer within
+    # that share of the tolerance per step (1e-15 m, over 1000 steps).
     out = run_example("newton_iterations.py")
 
     def counts(name: str) -> tuple[int, int]:
@@ -305,7 +308,10 @@ def test_newton_iterations():
     assert full_factorisations == full_iterations <= 5 * 1000  # a few per step, one each
     assert modified_factorisations < full_factorisations / 3
     assert modified_iterations > full_iterations  # linear convergence
-    assert number_after("largest position gap between the two:", out) < 1e-8
+    assert number_after("largest position gap, modified Newton to full Newton:", out) < 1e-8
+    _, default_factorisations = counts("default")
+    assert default_factorisations < full_factorisations / 2
+    assert number_after("largest position gap, default to full Newton:", out) < 1e-11
 
 
 def test_stepping():

@@ -932,7 +932,7 @@ class RunSettings:
     def __init__(self, t_end: float, dt: float, alpha: float | None = None, t_start: float = 0.0,
                  tolerance: float = 1e-10, max_iterations: int = 25, max_halvings: int = 4,
                  initial_tolerance: float = 1e-8, save_every: int = 1,
-                 jacobian_reuse: bool = False, scheme: str = "trapezoidal",
+                 jacobian_reuse: bool | None = None, scheme: str = "trapezoidal",
                  rho_inf: float | None = None, formulation: str = "index-3",
                  adaptive: bool = False, rtol: float = 1e-6, atol: float = 1e-6,
                  h_min: float = 1e-10, h_max: float | None = None,

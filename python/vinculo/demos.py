@@ -18,6 +18,7 @@ Gravity is ``(0, 0, -g)`` throughout; pendulums swing in the x-z plane.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import scipy.linalg
@@ -547,6 +548,7 @@ def run_hanging_chain(
     alpha: float = 0.5,
     model: HangingChain | None = None,
     progress: bool = False,
+    **options: Any,
 ) -> HangingChainResult:
     """Simulate a chain released from a tilted straight shape.
 
@@ -556,12 +558,13 @@ def run_hanging_chain(
         alpha: the integrator's parameter (1/2 conserves energy; more damps it).
         model: the chain (default: ``build_hanging_chain()``, 5 links tilted 60 degrees).
         progress: draw a progress bar.
+        **options: run options of :func:`vinculo.simulate` (``jacobian_reuse``, ...).
 
     Returns:
         The run with its total energy at every stored time.
     """
     model = model if model is not None else build_hanging_chain()
-    solution = simulate(model.system, t_end, dt, alpha, progress=progress)
+    solution = simulate(model.system, t_end, dt, alpha, progress=progress, **options)
     return HangingChainResult(model, solution, solution.energy())
 
 

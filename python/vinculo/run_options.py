@@ -57,14 +57,21 @@ class RunOptions:
             the largest initial speed or ``sqrt(|g| length_scale)``.
         save_every: store every k-th step (the last step is always stored); long runs of large
             models need it to keep the output in memory.
-        jacobian_reuse: modified Newton: keep the factorised iteration matrix across iterations
-            and steps, refreshing it when the Newton increments shrink by less than half per
-            iteration, after 8 iterations with one matrix, and whenever the step size changes (a
-            step that fails with an old matrix is retried once with a fresh one). The converged
-            states are the same to the Newton tolerance; ``Solution.factorisations`` counts the
-            factorisations. Each step stops with an error near ``tolerance`` (full Newton stops
-            far below it), which enters the velocities divided by ``dt``: with small steps lower
-            the tolerance. False: full Newton (a new matrix every iteration).
+        jacobian_reuse: when Newton reuses a factorised iteration matrix instead of a new one.
+            ``"auto"`` (default): the matrix is kept across iterations and steps while it shrinks
+            the Newton increments by a tenth or better per iteration, and an iteration made with
+            a kept matrix stops when the distance to the solution it bounds (the contraction
+            mapping bound ``theta / (1 - theta) |dx|``) is below a thousandth of ``tolerance``;
+            with a new matrix it stops as full Newton. A static chain factorises once per run, a
+            swinging one about once a step, and the answer stays within about a thousandth of the
+            tolerance per step of full Newton's (docs/theory/newton.md). ``True``: modified
+            Newton, Exudyn's default mode: the matrix is kept while the increments shrink by
+            half or better per iteration, after 8 iterations with one matrix a new one, and each
+            step stops with an error near ``tolerance`` (full Newton stops far below it), which
+            enters the velocities divided by ``dt`` (with small steps lower the tolerance).
+            ``False``: full Newton (a new matrix every iteration). Every mode makes a new matrix
+            when the step size changes, and a step that fails with an old matrix is retried once
+            with a new one; ``Solution.factorisations`` counts the factorisations.
         adaptive: choose the step sizes by a local error estimate (on positions and velocities,
             not multipliers) and a PI controller so that each step meets ``rtol`` and ``atol``;
             ``dt`` is then the first step. False: fixed steps of ``dt`` (halved where Newton fails).
@@ -119,7 +126,7 @@ class RunOptions:
     max_halvings: int = 4
     initial_tolerance: float = 1e-8
     save_every: int = 1
-    jacobian_reuse: bool = False
+    jacobian_reuse: bool | str = "auto"
     adaptive: bool = False
     rtol: float = 1e-6
     atol: float = 1e-6
@@ -153,6 +160,20 @@ class RunOptions:
             )
         return cls(**options)
 
+    def _jacobian_reuse(self) -> bool | None:
+        """``jacobian_reuse`` as the core takes it: None for ``"auto"``."""
+        value = self.jacobian_reuse
+        if isinstance(value, str) and value == "auto":
+            return None
+        if isinstance(value, (bool, np.bool_)):
+            return bool(value)
+        raise errors.InvalidInputError(
+            f"jacobian_reuse must be 'auto' (the default), True (modified Newton) or False (full "
+            f"Newton), got {value!r}",
+            name="jacobian_reuse",
+            value=value,
+        )
+
     def settings(self, t_end: float, dt: float, alpha: float | None) -> _core.RunSettings:
         """The settings of a run to ``t_end`` with steps ``dt`` and these options, as one object
         of the compiled core (its ``SimulationOptions``, checked once).
@@ -170,8 +191,8 @@ class RunOptions:
 
         Raises:
             InvalidInputError: ``scheme``, ``formulation`` or ``linear_solver`` is not a string,
-                ``t_eval`` is not a 1-D sequence of times, or a value is out of its range (checked
-                by the core).
+                ``jacobian_reuse`` is not ``"auto"``, True or False, ``t_eval`` is not a 1-D
+                sequence of times, or a value is out of its range (checked by the core).
         """
         if not isinstance(self.scheme, str):
             raise errors.InvalidInputError(
@@ -204,6 +225,6 @@ class RunOptions:
             times = [float(x) for x in array]
         options = {field.name: getattr(self, field.name) for field in fields(self)}
         options.update(
-            jacobian_reuse=bool(self.jacobian_reuse), adaptive=bool(self.adaptive), t_eval=times
+            jacobian_reuse=self._jacobian_reuse(), adaptive=bool(self.adaptive), t_eval=times
         )
         return _core.RunSettings(t_end, dt, alpha, **options)

@@ -7,7 +7,7 @@ use crate::system::PySystem;
 use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
 use std::time::{Duration, Instant};
-use vinculo::integrators::{Formulation, NewtonOptions, Scheme};
+use vinculo::integrators::{Formulation, JacobianReuse, NewtonOptions, Scheme};
 use vinculo::{
     simulate_with_observer, AdaptiveOptions, Observer, SimulationOptions, SparseSolver, StepControl,
 };
@@ -225,7 +225,7 @@ impl PyRunSettings {
     #[new]
     #[pyo3(signature = (t_end, dt, alpha=None, t_start=0.0, tolerance=1e-10, max_iterations=25,
                         max_halvings=4, initial_tolerance=1e-8, save_every=1,
-                        jacobian_reuse=false, scheme="trapezoidal", rho_inf=None,
+                        jacobian_reuse=None, scheme="trapezoidal", rho_inf=None,
                         formulation="index-3", adaptive=false, rtol=1e-6, atol=1e-6, h_min=1e-10,
                         h_max=None, t_eval=None, max_output_bytes=None,
                         linear_solver="auto"))]
@@ -240,7 +240,7 @@ impl PyRunSettings {
         max_halvings: i64,
         initial_tolerance: f64,
         save_every: i64,
-        jacobian_reuse: bool,
+        jacobian_reuse: Option<bool>,
         scheme: &str,
         rho_inf: Option<f64>,
         formulation: &str,
@@ -269,7 +269,11 @@ impl PyRunSettings {
             newton: NewtonOptions {
                 tolerance,
                 max_iterations: count("max_iterations", max_iterations, 1)?,
-                jacobian_reuse,
+                jacobian_reuse: match jacobian_reuse {
+                    None => JacobianReuse::WhileFast,
+                    Some(true) => JacobianReuse::Always,
+                    Some(false) => JacobianReuse::Never,
+                },
             },
             max_halvings: count("max_halvings", max_halvings, 0)?,
             initial_tolerance,

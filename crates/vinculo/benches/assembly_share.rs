@@ -15,7 +15,9 @@
 use std::process::Command;
 use std::time::Instant;
 
-use vinculo::integrators::{GeneralizedTrapezoidal, NewtonOptions, StepStart, StepWorkspace};
+use vinculo::integrators::{
+    GeneralizedTrapezoidal, JacobianReuse, NewtonOptions, StepStart, StepWorkspace,
+};
 use vinculo::linear::{LinearSolver, Singular};
 use vinculo::model::System;
 use vinculo::{simulate_with_observer, Observer, SimulationOptions};
@@ -106,7 +108,11 @@ fn one(n: usize, hanging: bool, modified: bool, parallel: bool) {
         t_end: steps as f64 * DT,
         dt: DT,
         newton: NewtonOptions {
-            jacobian_reuse: modified,
+            jacobian_reuse: if modified {
+                JacobianReuse::Always
+            } else {
+                JacobianReuse::Never
+            },
             ..NewtonOptions::default()
         },
         parallel_from,

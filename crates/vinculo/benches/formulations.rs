@@ -6,7 +6,7 @@
 //! timed after one warm-up run, with full and with modified Newton.
 
 use std::time::Instant;
-use vinculo::integrators::{Formulation, NewtonOptions};
+use vinculo::integrators::{Formulation, JacobianReuse, NewtonOptions};
 use vinculo::model::System;
 use vinculo::{simulate, SimulationOptions, SparseSolver};
 
@@ -39,7 +39,11 @@ fn main() {
         ("ggl", Formulation::Ggl, SparseSolver::Auto),
     ];
     for (name, formulation, sparse_solver) in cases {
-        for (jacobian_reuse, mode) in [(false, "full"), (true, "modified")] {
+        for (jacobian_reuse, mode) in [
+            (JacobianReuse::Never, "full"),
+            (JacobianReuse::Always, "modified"),
+            (JacobianReuse::WhileFast, "default"),
+        ] {
             let options = SimulationOptions {
                 t_end: 0.5,
                 dt: 1e-3,

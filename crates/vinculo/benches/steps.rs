@@ -1,11 +1,11 @@
 //! Steps per second of the simulation loop on the reference models.
 //!
 //! Run with `cargo bench -p vinculo --bench steps`. Times only `simulate` (model building and
-//! analysis included, output included), after one warm-up run, with full Newton and with
-//! modified Newton (`jacobian_reuse`).
+//! analysis included, output included), after one warm-up run, with full Newton, modified
+//! Newton and the default reuse of the iteration matrix (`NewtonOptions::jacobian_reuse`).
 
 use std::time::Instant;
-use vinculo::integrators::NewtonOptions;
+use vinculo::integrators::{JacobianReuse, NewtonOptions};
 use vinculo::model::System;
 use vinculo::{simulate, SimulationOptions};
 
@@ -47,7 +47,11 @@ fn measure(name: &str, system: &System, t_end: f64, dt: f64) {
 }
 
 fn measure_with(name: &str, system: &System, t_end: f64, dt: f64, dense_limit: usize) {
-    for (jacobian_reuse, mode) in [(false, "full"), (true, "modified")] {
+    for (jacobian_reuse, mode) in [
+        (JacobianReuse::Never, "full"),
+        (JacobianReuse::Always, "modified"),
+        (JacobianReuse::WhileFast, "default"),
+    ] {
         let options = SimulationOptions {
             t_end,
             dt,

@@ -62,8 +62,8 @@ use crate::initial::{
 };
 use crate::integrators::energy_guard::EnergyGuard;
 use crate::integrators::{
-    Formulation, NewtonFailure, NewtonOptions, RuleState, Scheme, StabilizedWorkspace, StepStart,
-    StepWorkspace,
+    Formulation, JacobianReuse, NewtonFailure, NewtonOptions, RuleState, Scheme,
+    StabilizedWorkspace, StepStart, StepWorkspace,
 };
 use crate::math::Vec3;
 use crate::model::System;
@@ -187,6 +187,12 @@ impl FixedSteps {
                 return (h_nominal, StepEnd::Natural);
             }
         }
+        // A remainder that differs from the step by less than the times resolve (a stop computed
+        // as the sum of the steps, rounded) is the step itself: the same step size, so that the
+        // iteration matrix made for it serves, and the same numbers as a run through that stop.
+        if (remaining - h_nominal).abs() <= time_spacing(stop) {
+            return (h_nominal, StepEnd::At(stop));
+        }
         (remaining, StepEnd::At(stop))
     }
 
@@ -270,6 +276,24 @@ pub struct Snapshot {
     pub(crate) fingerprint: u64,
     /// The run it was taken from (0: none, a snapshot loaded from a file).
     pub(crate) run: u64,
+    /// The iteration matrix whose factorisation the run held, if any.
+    pub(crate) matrix: Option<HeldMatrix>,
+}
+
+/// The iteration matrix whose factorisation a run held when a snapshot was taken. Restoring
+/// the snapshot factorises these values again, so that the steps after the restore reuse the
+/// same matrix as the steps after the snapshot did (Newton's default and modified Newton keep a
+/// matrix across steps), bit for bit.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct HeldMatrix {
+    /// The step size and scheme coefficients it was made for.
+    pub(crate) key: [f64; 2],
+    /// The last contraction ratio observed with it.
+    pub(crate) rate: f64,
+    /// Whether it is the GGL formulation's matrix (else the index-3 one's).
+    pub(crate) ggl: bool,
+    /// Its values, in the order of the formulation's pattern.
+    pub(crate) values: Vec<f64>,
 }
 
 impl Snapshot {
@@ -460,8 +484,21 @@ impl<'a> Simulation<'a> {
             }
             StepControl::Fixed => options.newton.tolerance,
         };
+        // The default reuse serves index-3 fixed steps; error-controlled steps project their
+        // error estimate with the step's last matrix, which must be the end's, and GGL's
+        // multipliers and velocities take the iterate's error divided by h^2 (newton.rs).
+        let jacobian_reuse = match options.newton.jacobian_reuse {
+            JacobianReuse::WhileFast
+                if options.formulation == Formulation::Ggl
+                    || matches!(options.step_control, StepControl::Adaptive(_)) =>
+            {
+                JacobianReuse::Never
+            }
+            policy => policy,
+        };
         let newton = NewtonOptions {
             tolerance: relative * length,
+            jacobian_reuse,
             ..options.newton
         };
         // The GGL steps have their own unknowns and solver; the index-3 workspace still serves
@@ -665,6 +702,15 @@ impl<'a> Simulation<'a> {
             status: self.sol.status.clone(),
             fingerprint: self.fingerprint,
             run: self.run,
+            matrix: self.ws.matrix.held().map(|(key, rate)| HeldMatrix {
+                key,
+                rate,
+                ggl: self.stabilized.is_some(),
+                values: match &self.stabilized {
+                    Some(g) => g.values().to_vec(),
+                    None => self.ws.values.clone(),
+                },
+            }),
         }
     }
 
@@ -722,6 +768,25 @@ impl<'a> Simulation<'a> {
         Ok(())
     }
 
+    /// Factorises the snapshot's iteration matrix `held` again and marks it held, when it is a
+    /// matrix of this run's formulation and pattern (a snapshot of a run with other solver
+    /// settings leaves no matrix held: the next step makes its own).
+    fn adopt_matrix(&mut self, held: &HeldMatrix) {
+        let factored = match &mut self.stabilized {
+            Some(g) if held.ggl && g.values().len() == held.values.len() => {
+                g.refactor(&held.values).is_ok()
+            }
+            None if !held.ggl && self.ws.values.len() == held.values.len() => {
+                self.ws.values.copy_from_slice(&held.values);
+                self.ws.solver.factor(&self.ws.values).is_ok()
+            }
+            _ => false,
+        };
+        if factored {
+            self.ws.matrix.adopt(held.key, held.rate);
+        }
+    }
+
     /// What makes `snapshot` (of this model) a snapshot of another kind of run than this one:
     /// the other step control, or a time rule with another state.
     fn other_run_kind(&self, snapshot: &Snapshot) -> Option<String> {
@@ -769,7 +834,7 @@ impl<'a> Simulation<'a> {
 
     /// Returns to the state of `snapshot` (taken from this simulation): later stored states
     /// are dropped, and stepping on repeats the steps that followed the snapshot bit for bit
-    /// (with modified Newton, the first step after a restore factorises a fresh matrix).
+    /// (the iteration matrix the run held is factorised again from the snapshot's values).
     ///
     /// # Panics
     /// If the snapshot's model size differs from this simulation's.
@@ -792,6 +857,10 @@ impl<'a> Simulation<'a> {
         self.sol.factorisations = snapshot.factorisations;
         self.sol.status = snapshot.status.clone();
         self.ws.matrix.invalidate();
+        self.ws.matrix.factorisations = snapshot.factorisations;
+        if let Some(held) = &snapshot.matrix {
+            self.adopt_matrix(held);
+        }
         self.system.reset_user_groups();
     }
 }
@@ -897,7 +966,8 @@ impl Simulation<'_> {
             }
             // Modified Newton starting from a matrix of an earlier step gets one more attempt
             // with a fresh matrix before the step counts as failed.
-            let stale = self.newton.jacobian_reuse && ws.matrix.holds(scheme.matrix_key(h_try));
+            let stale = self.newton.jacobian_reuse.across_steps()
+                && ws.matrix.holds(scheme.matrix_key(h_try));
             // A step to an event found before is not searched for events again.
             let to_event = event_stop.is_some_and(|te| end == StepEnd::At(te));
             let events = matches!(c.controller, Controller::Fixed(_))

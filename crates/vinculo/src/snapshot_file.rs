@@ -1,6 +1,6 @@
 //! Snapshot files: a [`Snapshot`] saved to and loaded from a small binary file.
 //!
-//! # Format (version 4)
+//! # Format (version 5)
 //!
 //! Little-endian throughout; every float is stored as its IEEE-754 bits, so a loaded snapshot
 //! is bit for bit the saved one.
@@ -8,7 +8,7 @@
 //! | field | type |
 //! |---|---|
 //! | magic `VNCLSNAP` | 8 bytes |
-//! | version (4) | u32 |
+//! | version (5) | u32 |
 //! | model fingerprint ([`crate::run::fingerprint`]), particles n, constraint equations m | 3 x u64 |
 //! | time | f64 |
 //! | positions, velocities, accelerations | 3 x (n x 3 f64) |
@@ -16,6 +16,7 @@
 //! | the time rule's state: 4 arrays of 3-vectors, each a u64 length then length x 3 f64 | |
 //! | step controller tag: 0 (fixed steps) or 1 (error control), then its state (below) | u8 |
 //! | accepted steps, next output, stored rows, steps taken, steps rejected, accepted step sizes, factorisations | 7 x u64 |
+//! | held iteration matrix: 0 (none) or 1, then its formulation (0: index-3, 1: GGL), its key (step size and scheme coefficient), its last contraction ratio, a u64 count and that many values | u8, then u8, 3 x f64, u64, f64s |
 //! | checksum: FNV-1a 64 of every byte before it | u64 |
 //!
 //! Fixed steps (tag 0): top u32, unit f64, units u64, level u32, t_grid f64, and the contact
@@ -32,7 +33,9 @@
 //! | PI controller: order k, last error norm, last attempt rejected (0 or 1), hold | f64, f64, u8, f64 |
 //! | next step size h, error norm of the last judged step | 2 x f64 |
 //!
-//! Version 3 is version 4 without the contact events' state (read as none pending). Version 1
+//! Version 4 is version 5 without the held iteration matrix (read as none: the first step after
+//! restoring it factorises a new one). Version 3 is version 4 without the contact events' state
+//! (read as none pending). Version 1
 //! is version 3 with fixed steps only (tag 0). Version 2 also kept an acceleration
 //! history for the error estimate, which step doubling no longer
 //! needs; its files with fixed steps are still read, those of error-controlled runs refused.
@@ -44,11 +47,11 @@ use crate::adaptive::ErrorControl;
 use crate::error::{Error, Result};
 use crate::integrators::{RuleState, Scheme};
 use crate::math::Vec3;
-use crate::run::{Carried, Controller, FixedSteps, Fnv, Snapshot};
+use crate::run::{Carried, Controller, FixedSteps, Fnv, HeldMatrix, Snapshot};
 use crate::step_control::{AdaptiveOptions, ErrorWeights, PiController};
 
 const MAGIC: &[u8; 8] = b"VNCLSNAP";
-const VERSION: u32 = 4;
+const VERSION: u32 = 5;
 /// The oldest format version still read.
 const OLDEST: u32 = 1;
 
@@ -289,6 +292,16 @@ impl Snapshot {
         ] {
             w.u64(x as u64);
         }
+        match &self.matrix {
+            None => w.0.push(0),
+            Some(held) => {
+                w.0.push(1);
+                w.0.push(held.ggl as u8);
+                w.f64s(&[held.key[0], held.key[1], held.rate]);
+                w.u64(held.values.len() as u64);
+                w.f64s(&held.values);
+            }
+        }
         let mut h = Fnv::new();
         h.write(&w.0);
         w.u64(h.finish());
@@ -300,7 +313,7 @@ impl Snapshot {
     ///
     /// # Errors
     /// [`Error::Snapshot`] when the file cannot be read, is not a snapshot file, is of a format
-    /// version this vinculo does not read (1 to 4 are; of 2 only fixed steps), or is truncated or corrupt (its
+    /// version this vinculo does not read (1 to 5 are; of 2 only fixed steps), or is truncated or corrupt (its
     /// checksum does not match).
     pub fn load(path: impl AsRef<Path>) -> Result<Snapshot> {
         let path = path.as_ref();
@@ -393,6 +406,23 @@ impl Snapshot {
         for x in &mut counts {
             *x = r.usize()?;
         }
+        let matrix = if version >= 5 && r.take(1)?[0] == 1 {
+            let ggl = r.take(1)?[0] == 1;
+            let (key, rate) = ([r.f64()?, r.f64()?], r.f64()?);
+            let count = r.usize()?;
+            if count.saturating_mul(8) > body.len() - r.at {
+                return Err(file_error(path, "the file is truncated or corrupt"));
+            }
+            let values = (0..count).map(|_| r.f64()).collect::<Result<Vec<f64>>>()?;
+            Some(HeldMatrix {
+                key,
+                rate,
+                ggl,
+                values,
+            })
+        } else {
+            None
+        };
         if r.at != body.len() {
             return Err(file_error(path, "the file is corrupt (trailing bytes)"));
         }
@@ -418,6 +448,7 @@ impl Snapshot {
             status: Ok(()),
             fingerprint,
             run: 0,
+            matrix,
         })
     }
 }

@@ -30,7 +30,9 @@
 //! `(J^-1)_pp = S^-1`, so three solves with the factorised J give it.
 
 use crate::error::{Error, Result};
-use crate::integrators::newton::{self, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem};
+use crate::integrators::newton::{
+    self, JacobianReuse, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem,
+};
 use crate::integrators::{Index3Rule, StepPoint, StepProblem, StepStart, StepWorkspace};
 use crate::math::{Mat3, Vec3};
 use crate::model::System;
@@ -234,7 +236,7 @@ pub fn solve_statics(system: &System, options: &StaticsOptions) -> Result<Static
     let newton = NewtonOptions {
         tolerance: options.tolerance * system.length_scale(),
         max_iterations: 25.min(options.max_iterations),
-        jacobian_reuse: false,
+        jacobian_reuse: JacobianReuse::Never,
     };
     ws.state.q.clone_from(&q0);
     ws.state.lambda.clone_from(&lambda0);

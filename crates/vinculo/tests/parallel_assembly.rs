@@ -5,7 +5,7 @@
 //! (elements of three particles, whose Jacobian blocks couple second neighbours). The residuals are the same bit for bit and the Jacobians agree to round-off,
 //! so the Newton iterates agree far below the Newton tolerance.
 
-use vinculo::integrators::{NewtonOptions, Scheme};
+use vinculo::integrators::{JacobianReuse, NewtonOptions, Scheme};
 use vinculo::model::System;
 use vinculo::{simulate, SimulationOptions, Solution};
 
@@ -107,7 +107,7 @@ fn parallel_assembly_gives_the_serial_trajectory() {
     let modified = SimulationOptions {
         scheme: Scheme::GeneralizedAlpha { rho_inf: 0.9 },
         newton: NewtonOptions {
-            jacobian_reuse: true,
+            jacobian_reuse: JacobianReuse::Always,
             ..NewtonOptions::default()
         },
         ..options.clone()

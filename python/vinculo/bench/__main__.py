@@ -3,8 +3,9 @@
 The same models (see ``vinculo.bench.models``) at the same fixed step dt = 1e-3 with the same
 scheme in both codes: generalised-alpha, index 3, spectral radius 0.9 (Exudyn's default), and
 spectral radius 0 on the 1 m chains released horizontally (the robustness rows). vinculo runs
-twice: with full Newton (its default, the headline) and with modified Newton (Exudyn's default
-mode). Each row checks that the codes put the chain's tip (the buoy's centre) at the same place
+three times: with its default Newton (the headline: the iteration matrix kept while it contracts
+fast, docs/theory/newton.md), with full Newton and with modified Newton (Exudyn's default mode).
+Each row checks that the codes put the chain's tip (the buoy's centre) at the same place
 at t_end, within a tolerance derived from the scheme's own error on that model
 (:func:`agreement_tolerance`), and gives steps per second (best of a few runs, wall time of the
 integration, model building excluded). The last row is the buoy of the case study
@@ -40,6 +41,9 @@ AGREEMENT_SHARE = 0.01
 #: (vinculo 1e-10 of the length scale, Exudyn relative 1e-8), for models at rest, whose scheme
 #: error is nil.
 AGREEMENT_FLOOR = 1e-7
+
+#: vinculo's Newton in the table's three columns: its default, full and modified Newton.
+NEWTON_MODES = ("auto", False, True)
 
 
 def agreement_tolerance(scheme_error: float, length: float) -> float:
@@ -101,40 +105,40 @@ def _gap(mine: Run, theirs: Run | None, component: int | None) -> float:
 
 def _row(
     name: str,
-    full: Run,
-    modified: Run,
+    runs: tuple[Run, Run, Run],
     peer: Run | None,
     tolerance: float,
     out,
     component: int | None = None,
 ) -> bool:
-    """Prints one table row; returns False if full Newton and the peer both ran and disagree by
-    more than ``tolerance`` (modified Newton's gap is reported, not judged)."""
+    """Prints one table row of vinculo's default, full and modified Newton ``runs``; returns
+    False if the peer ran and the default or full Newton disagrees with it by more than
+    ``tolerance`` (modified Newton's gap is reported, not judged)."""
 
     def rate(run: Run | None) -> str:
         if run is None:
             return "(no Exudyn)"
         return f"{run.steps_per_second:,.0f}" if run.tip is not None else "failed"
 
+    default, full, modified = runs
     agree = True
     if peer is None or peer.tip is None:
         ratio, gaps = "", "diverged" if peer is not None else ""
     else:
-        ratio = f"{full.steps_per_second / peer.steps_per_second:.1f}x"
-        gap_full, gap_modified = _gap(full, peer, component), _gap(modified, peer, component)
-        agree = gap_full <= tolerance
-        marks = ["ok" if g <= tolerance else "DIFFER" for g in (gap_full, gap_modified)]
-        gaps = f"{gap_full:.1e} {marks[0]:<6} {gap_modified:.1e} {marks[1]:<6}"
+        ratio = f"{default.steps_per_second / peer.steps_per_second:.1f}x"
+        found = [_gap(run, peer, component) for run in runs]
+        agree = found[0] <= tolerance and found[1] <= tolerance
+        gaps = " ".join(f"{g:.1e} {'ok' if g <= tolerance else 'DIFFER':<6}" for g in found)
     out(
-        f"{name:<30} {rate(full):>12} {rate(modified):>12} {rate(peer):>12} {ratio:>7}  "
-        f"{tolerance:>8.1e}  {gaps:<32} {full.detail}"
+        f"{name:<30} {rate(default):>12} {rate(full):>12} {rate(modified):>12} {rate(peer):>12} "
+        f"{ratio:>7}  {tolerance:>8.1e}  {gaps:<48} {default.detail}"
     )
     return agree
 
 
 def compare(quick: bool = False, repeat: int = 3, out=print) -> bool:
-    """The side-by-side table; returns True if vinculo with full Newton agrees with every peer
-    run that finished."""
+    """The side-by-side table; returns True if vinculo with its default and with full Newton
+    agrees with every peer run that finished."""
     exu = _import_exudyn()
     if exu is None:
         out("Exudyn is not installed (pip install exudyn): its columns are skipped.")
@@ -148,38 +152,44 @@ def compare(quick: bool = False, repeat: int = 3, out=print) -> bool:
         f"{ROBUSTNESS.rho_inf:g}), dt = 1e-3; vinculo's Newton tolerance 1e-10 of the length "
         f"scale; tolerance: max({AGREEMENT_SHARE:g} |tip(dt) - tip(dt/2)|, "
         f"{AGREEMENT_FLOOR:g} x length), vinculo full Newton at dt and dt/2; gaps |tip_vinculo - "
-        "tip_exudyn| at t_end, full and modified Newton"
+        "tip_exudyn| at t_end, vinculo's default, full and modified Newton; ratio: default / "
+        "Exudyn"
     )
     out(
-        f"{'model':<30} {'full st/s':>12} {'modif. st/s':>12} {'Exudyn st/s':>12} {'ratio':>7}  "
-        f"{'tol (m)':>8}  {'gap full (m)':<16}{'gap modified (m)':<16} vinculo solver"
+        f"{'model':<30} {'default st/s':>12} {'full st/s':>12} {'modif. st/s':>12} "
+        f"{'Exudyn st/s':>12} {'ratio':>7}  {'tol (m)':>8}  {'gap default (m)':<16}"
+        f"{'gap full (m)':<16}{'gap modified (m)':<16} vinculo solver"
     )
     agree = True
     rows = [(m, COMPARISON) for m in comparison_models(quick)]
     rows += [(m, ROBUSTNESS) for m in robustness_models(quick)]
     for model, integration in rows:
         times = 1 if model.n >= 1_000 else repeat
-        full = run_vinculo(model, dataclasses.replace(integration, jacobian_reuse=False), times)
-        modified = run_vinculo(model, dataclasses.replace(integration, jacobian_reuse=True), times)
+        runs = tuple(
+            run_vinculo(model, dataclasses.replace(integration, jacobian_reuse=mode), times)
+            for mode in NEWTON_MODES
+        )
         half = run_vinculo(
             dataclasses.replace(model, dt=model.dt / 2),
             dataclasses.replace(integration, jacobian_reuse=False),
         )
-        error = _gap(full, half, None)
+        error = _gap(runs[1], half, None)
         tolerance = agreement_tolerance(error, model.n * model.link)
         peer = None if exu is None else run_exudyn(model, exu, integration, repeat=times)
-        agree &= _row(model.name, full, modified, peer, tolerance, out)
+        agree &= _row(model.name, runs, peer, tolerance, out)
     buoy = buoy_bench(quick)
     times = 1 if quick else repeat
-    full = run_vinculo_buoy(buoy, dataclasses.replace(COMPARISON, jacobian_reuse=False), times)
-    modified = run_vinculo_buoy(buoy, dataclasses.replace(COMPARISON, jacobian_reuse=True), times)
+    runs = tuple(
+        run_vinculo_buoy(buoy, dataclasses.replace(COMPARISON, jacobian_reuse=mode), times)
+        for mode in NEWTON_MODES
+    )
     half = run_vinculo_buoy(
         dataclasses.replace(buoy, dt=buoy.dt / 2),
         dataclasses.replace(COMPARISON, jacobian_reuse=False),
     )
-    tolerance = max(agreement_tolerance(_gap(full, half, 0), 1.0), CENTRE_TOLERANCE)
+    tolerance = max(agreement_tolerance(_gap(runs[1], half, 0), 1.0), CENTRE_TOLERANCE)
     peer = None if exu is None else run_exudyn_buoy(buoy, exu, COMPARISON, repeat=1)
-    agree &= _row(buoy.name, full, modified, peer, tolerance, out, component=0)
+    agree &= _row(buoy.name, runs, peer, tolerance, out, component=0)
     out(
         "buoy: the default case (X0 = 5 mm, 10-period ramp) at dt = 1e-3; gap: |x_vinculo - "
         f"x_exudyn| of the sphere's centre at t_end, tolerance at least {CENTRE_TOLERANCE:g} m; "

@@ -107,22 +107,23 @@ class Integration:
     Attributes:
         rho_inf: spectral radius at infinite frequency (0.9: Exudyn's default, damping only the
             highest frequencies; 0: the most damping, still second order).
-        jacobian_reuse: vinculo with modified Newton (Exudyn's default mode) or full Newton.
+        jacobian_reuse: vinculo's Newton: ``"auto"`` (its default), True (modified Newton,
+            Exudyn's default mode) or False (full Newton).
     """
 
     rho_inf: float = 0.9
-    jacobian_reuse: bool = False
+    jacobian_reuse: bool | str = "auto"
 
     def describe(self) -> str:
         """One line for the table headers."""
-        newton = "modified" if self.jacobian_reuse else "full"
+        newton = {"auto": "its default", True: "modified", False: "full"}[self.jacobian_reuse]
         return f"generalised-alpha rho_inf = {self.rho_inf:g}, vinculo with {newton} Newton"
 
 
-#: The comparison rows: Exudyn's spectral radius, vinculo's default full Newton.
-COMPARISON = Integration(rho_inf=0.9, jacobian_reuse=False)
+#: The comparison rows: Exudyn's spectral radius, vinculo's default Newton.
+COMPARISON = Integration(rho_inf=0.9)
 #: The robustness rows (1 m chains released horizontally): the most high-frequency damping.
-ROBUSTNESS = Integration(rho_inf=0.0, jacobian_reuse=False)
+ROBUSTNESS = Integration(rho_inf=0.0)
 
 
 def exudyn_settings(model: Chain, exu, dense: bool = False, rho_inf: float = 0.9):

@@ -25,7 +25,8 @@ pub use error_estimate::richardson_factor;
 pub use generalized_alpha::{AlphaCoefficients, AlphaStep, GeneralizedAlpha};
 
 pub use newton::{
-    IterationMatrix, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport,
+    IterationMatrix, JacobianReuse, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem,
+    NewtonReport,
 };
 pub use rule::{GglBase, GglCoefficients, Index3Rule, RuleState, StepPoint, StepStart, TimeRule};
 pub use stabilized::{phi_qt, Formulation, StabilizedWorkspace};

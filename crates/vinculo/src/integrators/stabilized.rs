@@ -165,6 +165,17 @@ pub struct StabilizedWorkspace {
 }
 
 impl StabilizedWorkspace {
+    /// The values of the last iteration matrix assembled (the one factorised last).
+    pub(crate) fn values(&self) -> &[f64] {
+        &self.values
+    }
+
+    /// Factorises the iteration matrix `values` (of this workspace's pattern) again.
+    pub(crate) fn refactor(&mut self, values: &[f64]) -> Result<(), crate::linear::Singular> {
+        self.values.copy_from_slice(values);
+        self.solver.factor(&self.values)
+    }
+
     /// Analyses the system once: dense LU up to `dense_limit` unknowns, general sparse LU above.
     pub fn new(system: &System, dense_limit: usize) -> StabilizedWorkspace {
         let layout = StabilizedLayout::new(system, dense_limit);
