@@ -290,6 +290,8 @@ pub(crate) struct HeldMatrix {
     pub(crate) key: [f64; 2],
     /// The last contraction ratio observed with it.
     pub(crate) rate: f64,
+    /// The iterate it was assembled at (empty: not recorded).
+    pub(crate) point: Vec<f64>,
     /// Whether it is the GGL formulation's matrix (else the index-3 one's).
     pub(crate) ggl: bool,
     /// Its values, in the order of the formulation's pattern.
@@ -702,9 +704,10 @@ impl<'a> Simulation<'a> {
             status: self.sol.status.clone(),
             fingerprint: self.fingerprint,
             run: self.run,
-            matrix: self.ws.matrix.held().map(|(key, rate)| HeldMatrix {
+            matrix: self.ws.matrix.held().map(|(key, rate, point)| HeldMatrix {
                 key,
                 rate,
+                point: point.to_vec(),
                 ggl: self.stabilized.is_some(),
                 values: match &self.stabilized {
                     Some(g) => g.values().to_vec(),
@@ -783,7 +786,7 @@ impl<'a> Simulation<'a> {
             _ => false,
         };
         if factored {
-            self.ws.matrix.adopt(held.key, held.rate);
+            self.ws.matrix.adopt(held.key, held.rate, &held.point);
         }
     }
 

@@ -16,7 +16,7 @@
 //! | the time rule's state: 4 arrays of 3-vectors, each a u64 length then length x 3 f64 | |
 //! | step controller tag: 0 (fixed steps) or 1 (error control), then its state (below) | u8 |
 //! | accepted steps, next output, stored rows, steps taken, steps rejected, accepted step sizes, factorisations | 7 x u64 |
-//! | held iteration matrix: 0 (none) or 1, then its formulation (0: index-3, 1: GGL), its key (step size and scheme coefficient), its last contraction ratio, a u64 count and that many values | u8, then u8, 3 x f64, u64, f64s |
+//! | held iteration matrix: 0 (none) or 1, then its formulation (0: index-3, 1: GGL), its key (step size and scheme coefficient), its last contraction ratio, a u64 count and that many values, a u64 count and that many values of the iterate it was assembled at | u8, then u8, 3 x f64, u64, f64s, u64, f64s |
 //! | checksum: FNV-1a 64 of every byte before it | u64 |
 //!
 //! Fixed steps (tag 0): top u32, unit f64, units u64, level u32, t_grid f64, and the contact
@@ -136,6 +136,14 @@ impl Reader<'_> {
         Ok(u64::from_le_bytes(
             self.take(8)?.try_into().expect("8 bytes"),
         ))
+    }
+    /// A u64 count, then that many f64.
+    fn sized_f64s(&mut self) -> Result<Vec<f64>> {
+        let count = self.usize()?;
+        if count.saturating_mul(8) > self.bytes.len() - self.at {
+            return Err(file_error(self.path, "the file is truncated or corrupt"));
+        }
+        (0..count).map(|_| self.f64()).collect()
     }
     fn usize(&mut self) -> Result<usize> {
         let x = self.u64()?;
@@ -300,6 +308,8 @@ impl Snapshot {
                 w.f64s(&[held.key[0], held.key[1], held.rate]);
                 w.u64(held.values.len() as u64);
                 w.f64s(&held.values);
+                w.u64(held.point.len() as u64);
+                w.f64s(&held.point);
             }
         }
         let mut h = Fnv::new();
@@ -409,14 +419,12 @@ impl Snapshot {
         let matrix = if version >= 5 && r.take(1)?[0] == 1 {
             let ggl = r.take(1)?[0] == 1;
             let (key, rate) = ([r.f64()?, r.f64()?], r.f64()?);
-            let count = r.usize()?;
-            if count.saturating_mul(8) > body.len() - r.at {
-                return Err(file_error(path, "the file is truncated or corrupt"));
-            }
-            let values = (0..count).map(|_| r.f64()).collect::<Result<Vec<f64>>>()?;
+            let values = r.sized_f64s()?;
+            let point = r.sized_f64s()?;
             Some(HeldMatrix {
                 key,
                 rate,
+                point,
                 ggl,
                 values,
             })

@@ -48,7 +48,11 @@
 //!
 //! - an increment made with a matrix factorised at that iterate is Newton's, and the stop is full
 //!   Newton's (increment and residual below the tolerance; the distance left is about the
-//!   increment squared times the curvature);
+//!   increment squared times the curvature); so is the first increment of a solve with a kept
+//!   matrix assembled within the tolerance of the solve's start in every unknown
+//!   ([`NewtonProblem::is_within`]: a model at rest, whose predictor differs from the last state
+//!   by round-off and whose matrix is the same; a static hanging chain takes one iteration a
+//!   step instead of two, as in full Newton);
 //! - an increment made with a kept matrix that contracts by theta leaves x within
 //!   theta / (1 - theta) |dx| of the solution, at most |dx| while theta <= 1/2: the stop asks
 //!   |dx| <= [`REUSED_ERROR_SHARE`] tolerance (and the residual below the tolerance). The bound
@@ -134,7 +138,7 @@ pub const REUSED_ERROR_SHARE: f64 = 1e-3;
 pub const FLOOR_CONTRACTION: f64 = 0.9;
 
 /// What the linear solver's current factorisation is, for reuse by modified Newton.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct IterationMatrix {
     /// Step size and scheme coefficients the factorisation was assembled for; `None` when the
     /// solver holds no reusable factorisation (nothing factorised yet, or another matrix).
@@ -143,6 +147,9 @@ pub struct IterationMatrix {
     pub factorisations: usize,
     /// The last contraction ratio observed with the held factorisation (0 when none was).
     rate: f64,
+    /// The iterate the held matrix was assembled at ([`NewtonProblem::iterate`]; empty when
+    /// the problem does not say).
+    point: Vec<f64>,
 }
 
 impl IterationMatrix {
@@ -157,16 +164,19 @@ impl IterationMatrix {
         self.key = None;
     }
 
-    /// The key and last contraction ratio of the held factorisation, if any.
-    pub(crate) fn held(&self) -> Option<([f64; 2], f64)> {
-        self.key.map(|key| (key, self.rate))
+    /// The key, last contraction ratio and assembly point of the held factorisation, if any.
+    pub(crate) fn held(&self) -> Option<([f64; 2], f64, &[f64])> {
+        self.key.map(|key| (key, self.rate, &self.point[..]))
     }
 
     /// Records that the solver holds a factorisation made for `key` (restored from a
-    /// snapshot: not counted as a new factorisation), with the contraction ratio it had.
-    pub(crate) fn adopt(&mut self, key: [f64; 2], rate: f64) {
+    /// snapshot: not counted as a new factorisation), with the contraction ratio and assembly
+    /// point it had.
+    pub(crate) fn adopt(&mut self, key: [f64; 2], rate: f64, point: &[f64]) {
         self.key = Some(key);
         self.rate = rate;
+        self.point.clear();
+        self.point.extend_from_slice(point);
     }
 }
 
@@ -193,6 +203,17 @@ pub trait NewtonProblem {
     /// documentation). 0 (the default): no estimate, the tolerance alone decides.
     fn round_off(&self, _values: &[f64]) -> f64 {
         0.0
+    }
+    /// Writes the current iterate into `x` (resized) in the unknowns of the increments, so that
+    /// [`NewtonProblem::is_within`] can tell later whether an iterate is close to it; false
+    /// (the default) when the problem does not say.
+    fn iterate(&self, _x: &mut Vec<f64>) -> bool {
+        false
+    }
+    /// Whether every unknown of the current iterate is within `distance` of `x`, written by
+    /// [`NewtonProblem::iterate`] (false, the default, when the problem does not say).
+    fn is_within(&self, _x: &[f64], _distance: f64) -> bool {
+        false
     }
     /// The largest ratio of [`NewtonProblem::round_off`] to the tolerance at which the round-off
     /// counts as meeting it ([`ROUND_OFF_REACH`] unless the problem says otherwise).
@@ -394,6 +415,17 @@ pub fn solve(
             stale_iterations = 0;
             previous = f64::INFINITY;
             solves_with_matrix = 0;
+            if while_fast && !problem.iterate(&mut matrix.point) {
+                matrix.point.clear();
+            }
+        } else if while_fast
+            && solves_with_matrix == 0
+            && !matrix.point.is_empty()
+            && problem.is_within(&matrix.point, options.tolerance)
+        {
+            // A kept matrix assembled within the tolerance of this iterate (a model at rest):
+            // its increment is Newton's (module documentation).
+            fresh = true;
         }
         solver.solve_in_place(r);
         increment_before = increment;

@@ -31,6 +31,7 @@ use super::rule::{Index3Rule, RuleState, StepPoint, StepStart, TimeRule};
 use super::workspace::{StepBuffers, StepWorkspace};
 use crate::assembly::{
     AxialAddedMass, InertiaRows, JacobianTerms, Layout, ParallelAssembly, ResidualTerms, MIN_TASK,
+    NONE,
 };
 use crate::math::Vec3;
 use crate::model::Particle;
@@ -235,6 +236,34 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
 
     fn round_off_reach(&self) -> f64 {
         R::ROUND_OFF_REACH
+    }
+
+    /// The free particles' positions, then the scaled multipliers `lambda sigma / s`.
+    fn iterate(&self, x: &mut Vec<f64>) -> bool {
+        let b = &*self.buffers;
+        x.clear();
+        for (qi, &d) in b.q.iter().zip(&self.layout.dof) {
+            if d != NONE {
+                x.extend_from_slice(qi);
+            }
+        }
+        let sigma = self.point.sigma;
+        x.extend(b.lambda.iter().zip(self.scales).map(|(l, s)| l * sigma / s));
+        true
+    }
+
+    fn is_within(&self, x: &[f64], distance: f64) -> bool {
+        let b = &*self.buffers;
+        if x.len() != 3 * self.layout.free + b.lambda.len() {
+            return false;
+        }
+        let free = b.q.iter().zip(&self.layout.dof).filter(|(_, &d)| d != NONE);
+        let positions = free.flat_map(|(qi, _)| qi.iter().copied());
+        let sigma = self.point.sigma;
+        let multipliers = b.lambda.iter().zip(self.scales).map(|(l, s)| l * sigma / s);
+        let now = positions.chain(multipliers);
+        // Stops at the first unknown that moved farther (a model in motion: the first one).
+        now.zip(x).all(|(a, b)| (a - b).abs() <= distance)
     }
 }
 
