@@ -257,13 +257,17 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
         if x.len() != 3 * self.layout.free + b.lambda.len() {
             return false;
         }
-        let free = b.q.iter().zip(&self.layout.dof).filter(|(_, &d)| d != NONE);
-        let positions = free.flat_map(|(qi, _)| qi.iter().copied());
-        let sigma = self.point.sigma;
-        let multipliers = b.lambda.iter().zip(self.scales).map(|(l, s)| l * sigma / s);
-        let now = positions.chain(multipliers);
         // Stops at the first unknown that moved farther (a model in motion: the first one).
-        now.zip(x).all(|(a, b)| (a - b).abs() <= distance)
+        let dof = &self.layout.dof;
+        let positions =
+            b.q.iter()
+                .zip(dof)
+                .all(|(qi, &d)| d == NONE || (0..3).all(|k| (qi[k] - x[d + k]).abs() <= distance));
+        let sigma = self.point.sigma;
+        let m3 = 3 * self.layout.free;
+        positions
+            && (b.lambda.iter().zip(self.scales).zip(&x[m3..]))
+                .all(|((l, s), xk)| (l * sigma / s - xk).abs() <= distance)
     }
 }
 
