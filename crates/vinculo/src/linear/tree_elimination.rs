@@ -82,11 +82,14 @@
 //!
 //! the same block LU (z_b = D_b^-1 r_b, r_P -= A_Pb z_b), whose chain of dependencies is one
 //! 3 x N product a block forward and one 3-term dot product backward: the solve with the factors
-//! D_b^-1 r_b does not wait for the parent. Measured on chains of 1,000 particles at dt = 1 ms
-//! (generalised-alpha, blocks of 4, `crates/vinculo/benches/steps.rs`' models): the solve was
-//! 40 % of a step of the hanging chain; a step of it went from 81 to 72 us, of the swinging one
-//! from 303 to 288 us with Newton's default (one factorisation and three solves a step), and from
-//! 426 to 440 us with full Newton (the G_b cost each factorisation what a solve saves).
+//! D_b^-1 r_b does not wait for the parent. The forward sweep carries a chain's update of the
+//! next block in registers (stored and read back as a block, it waits for the stores to reach
+//! memory), and G_b r_b is summed one entry of r_b at a time. Measured on chains of 1,000
+//! particles at dt = 1 ms (generalised-alpha, blocks of 4, `crates/vinculo/benches/steps.rs`'
+//! models): the solve was 40 % of a step of the hanging chain; a step of it went from 81 to
+//! 63 us, of the swinging one from 303 to 272 us with Newton's default (one factorisation and
+//! three solves a step), and from 426 to 421 us with full Newton (G_b costs each factorisation
+//! about what a solve saves).
 //!
 //! # Singular blocks
 //!
@@ -979,22 +982,6 @@ fn row_times_inverse<const N: usize>(d: &[f64], perm: &[u32], a: &mut [f64; N]) 
     }
 }
 
-/// The dot product of the first N entries of `a` with `b`, summed in pairs (a shorter chain of
-/// dependent additions than a running sum).
-#[inline(always)]
-fn dot<const N: usize>(a: &[f64], b: &[f64; N]) -> f64 {
-    let a = &a[..N];
-    let mut even = 0.0;
-    let mut odd = 0.0;
-    for j in (0..N).step_by(2) {
-        even += a[j] * b[j];
-        if j + 1 < N {
-            odd += a[j + 1] * b[j + 1];
-        }
-    }
-    even + odd
-}
-
 impl LinearSolver for TreeElimination {
     fn factor(&mut self, values: &[f64]) -> Result<(), Singular> {
         self.factored = false;
@@ -1140,14 +1127,36 @@ impl TreeElimination {
     fn sweeps_explicit<const N: usize>(&mut self) {
         let z = &mut self.z;
         // Forward, leaves first: r_P -= G_b r_b (block b's r is final: its children came first).
+        // The update of a parent that comes next (a chain's) is carried in registers to it:
+        // written to memory and read back at once as a block, it would wait for the stores.
+        let mut carry = [0.0f64; 3];
+        let mut carried_to = usize::MAX;
         for (b, (g, &pb)) in self.low.chunks_exact(3 * N).zip(&self.parent).enumerate() {
+            if carried_to != b {
+                carry = [0.0; 3];
+            }
+            // r_b (with the carried update) and G_b r_b, one entry of r_b at a time in
+            // registers (an array of them would go through memory).
+            let zb = &mut z[N * b..N * b + N];
+            let g = &g[..3 * N];
+            let mut update = [0.0f64; 3];
+            for i in 0..N {
+                let ri = zb[i] - if i < 3 { carry[i] } else { 0.0 };
+                zb[i] = ri;
+                update[0] += g[i] * ri;
+                update[1] += g[N + i] * ri;
+                update[2] += g[2 * N + i] * ri;
+            }
             if pb == ROOT {
                 continue;
             }
-            let rb: [f64; N] = z[N * b..N * b + N].try_into().expect("N unknowns");
-            let p = N * pb as usize;
-            for r in 0..3 {
-                z[p + r] -= dot::<N>(&g[r * N..r * N + N], &rb);
+            let p = pb as usize;
+            if p == b + 1 {
+                (carry, carried_to) = (update, p);
+            } else {
+                for r in 0..3 {
+                    z[N * p + r] -= update[r];
+                }
             }
         }
         // Backward, roots first: x_b = D_b^-1 r_b - W_b x_P (the solve with the factors does not
