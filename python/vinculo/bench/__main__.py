@@ -164,7 +164,7 @@ def compare(quick: bool = False, repeat: int = 3, out=print) -> bool:
     rows = [(m, COMPARISON) for m in comparison_models(quick)]
     rows += [(m, ROBUSTNESS) for m in robustness_models(quick)]
     for model, integration in rows:
-        times = 1 if model.n >= 1_000 else repeat
+        times = 1 if model.n >= 10_000 else repeat
         runs = tuple(
             run_vinculo(model, dataclasses.replace(integration, jacobian_reuse=mode), times)
             for mode in NEWTON_MODES
