@@ -86,7 +86,8 @@ class Solution:
             lines with bending stiffness) or 'sparse LU' (graphs with loops across branches;
             every GGL run above the dense size; ``linear_solver='sparse-lu'``).
         factorisations: number of Newton iteration matrices factorised over the run (one per
-            Newton iteration in full Newton, fewer with ``jacobian_reuse=True``).
+            Newton iteration in full Newton, ``jacobian_reuse=False``; fewer with the default,
+            which keeps a matrix while it contracts fast, and with modified Newton).
         scheme: the time discretisation: 'trapezoidal', 'backward-euler' or 'generalized-alpha'.
         steps_taken: steps attempted, including those rejected and retried.
         steps_rejected: attempts rejected (Newton failed, or the error estimate of an
