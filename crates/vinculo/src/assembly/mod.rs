@@ -396,9 +396,9 @@ impl Layout {
         }
     }
 
-    /// The magnitudes of the scaled unknowns of [`Layout::apply_increment`]: |q| of each free
-    /// particle's coordinates and |lambda_k sigma / s_k| of each multiplier, into `out`.
-    pub fn unknown_magnitudes(
+    /// The scaled unknowns of [`Layout::apply_increment`]: q of each free particle's
+    /// coordinates and lambda_k sigma / s_k of each multiplier, into `out`.
+    pub fn scaled_unknowns(
         &self,
         q: &[crate::math::Vec3],
         lambda: &[f64],
@@ -409,15 +409,31 @@ impl Layout {
         for (i, qi) in q.iter().enumerate() {
             let d = self.dof[i];
             if d != NONE {
-                for k in 0..3 {
-                    out[d + k] = qi[k].abs();
-                }
+                out[d..d + 3].copy_from_slice(qi);
             }
         }
         let m3 = 3 * self.free;
         for (c, l) in lambda.iter().enumerate() {
-            out[m3 + c] = (l * sigma / scales[c]).abs();
+            out[m3 + c] = l * sigma / scales[c];
         }
+    }
+
+    /// Whether every scaled unknown ([`Layout::scaled_unknowns`]) of `q` and `lambda` is within
+    /// `distance` of `x`; stops at the first one that is not (in a model in motion, the first).
+    pub fn unknowns_within(
+        &self,
+        (q, lambda): (&[crate::math::Vec3], &[f64]),
+        (scales, sigma): (&[f64], f64),
+        x: &[f64],
+        distance: f64,
+    ) -> bool {
+        let m3 = 3 * self.free;
+        x.len() == m3 + lambda.len()
+            && q.iter()
+                .zip(&self.dof)
+                .all(|(qi, &d)| d == NONE || (0..3).all(|k| (qi[k] - x[d + k]).abs() <= distance))
+            && (lambda.iter().zip(scales).zip(&x[m3..]))
+                .all(|((l, s), xk)| (l * sigma / s - xk).abs() <= distance)
     }
 
     /// Applies a Newton increment `dx` (in scaled unknowns) to the positions of the free

@@ -352,7 +352,6 @@ pub fn solve(
         || (while_fast && matrix.rate > FAST_CONTRACTION);
     // Solves made with the current matrix in this call (0: the matrix is an earlier call's).
     let mut solves_with_matrix = 0usize;
-    let mut rate = 0.0;
     let mut stale_iterations = 0;
     let mut previous = f64::INFINITY;
     let mut factorisations = 0;
@@ -435,19 +434,18 @@ pub fn solve(
         refresh = match policy {
             JacobianReuse::Never => true,
             JacobianReuse::Always => increment > MAX_CONTRACTION * previous,
+            // Kept while fast, and while the next increment, theta |dx|, is predicted to stop
+            // the loop; a matrix used once in this solve has no contraction to judge yet.
+            JacobianReuse::WhileFast if solves_with_matrix >= 2 => {
+                let rate = increment / previous;
+                matrix.rate = rate;
+                rate > FAST_CONTRACTION || rate * increment > REUSED_ERROR_SHARE * options.tolerance
+            }
             JacobianReuse::WhileFast => {
-                if solves_with_matrix >= 2 {
-                    rate = increment / previous;
-                    matrix.rate = rate;
-                } else if fresh {
-                    rate = 0.0;
+                if fresh {
                     matrix.rate = 0.0;
                 }
-                // Kept while fast, and while the next increment, theta |dx|, is predicted to
-                // stop the loop.
-                rate > FAST_CONTRACTION
-                    || (solves_with_matrix >= 2
-                        && rate * increment > REUSED_ERROR_SHARE * options.tolerance)
+                false
             }
         };
         previous = increment;

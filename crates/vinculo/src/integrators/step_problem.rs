@@ -31,7 +31,6 @@ use super::rule::{Index3Rule, RuleState, StepPoint, StepStart, TimeRule};
 use super::workspace::{StepBuffers, StepWorkspace};
 use crate::assembly::{
     AxialAddedMass, InertiaRows, JacobianTerms, Layout, ParallelAssembly, ResidualTerms, MIN_TASK,
-    NONE,
 };
 use crate::math::Vec3;
 use crate::model::Particle;
@@ -225,10 +224,10 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
         let mut x = vec![0.0; pattern.n];
         let (scales, sigma) = (self.scales, self.point.sigma);
         self.layout
-            .unknown_magnitudes(&b.q, &b.lambda, scales, sigma, &mut x);
+            .scaled_unknowns(&b.q, &b.lambda, scales, sigma, &mut x);
         let mut rows = vec![0.0f64; pattern.n];
         for (row, col, k) in pattern.entries() {
-            rows[row] += values[k].abs() * x[col];
+            rows[row] += values[k].abs() * x[col].abs();
         }
         let largest = rows.iter().fold(0.0f64, |m, r| m.max(*r));
         super::newton::ROUND_OFF_ULPS * f64::EPSILON * largest
@@ -238,36 +237,21 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
         R::ROUND_OFF_REACH
     }
 
-    /// The free particles' positions, then the scaled multipliers `lambda sigma / s`.
+    /// The scaled unknowns ([`Layout::scaled_unknowns`]).
     fn iterate(&self, x: &mut Vec<f64>) -> bool {
         let b = &*self.buffers;
-        x.clear();
-        for (qi, &d) in b.q.iter().zip(&self.layout.dof) {
-            if d != NONE {
-                x.extend_from_slice(qi);
-            }
-        }
-        let sigma = self.point.sigma;
-        x.extend(b.lambda.iter().zip(self.scales).map(|(l, s)| l * sigma / s));
+        x.resize(self.layout.unknowns(), 0.0);
+        let (scales, sigma) = (self.scales, self.point.sigma);
+        self.layout
+            .scaled_unknowns(&b.q, &b.lambda, scales, sigma, x);
         true
     }
 
     fn is_within(&self, x: &[f64], distance: f64) -> bool {
         let b = &*self.buffers;
-        if x.len() != 3 * self.layout.free + b.lambda.len() {
-            return false;
-        }
-        // Stops at the first unknown that moved farther (a model in motion: the first one).
-        let dof = &self.layout.dof;
-        let positions =
-            b.q.iter()
-                .zip(dof)
-                .all(|(qi, &d)| d == NONE || (0..3).all(|k| (qi[k] - x[d + k]).abs() <= distance));
-        let sigma = self.point.sigma;
-        let m3 = 3 * self.layout.free;
-        positions
-            && (b.lambda.iter().zip(self.scales).zip(&x[m3..]))
-                .all(|((l, s), xk)| (l * sigma / s - xk).abs() <= distance)
+        let scaling = (self.scales, self.point.sigma);
+        self.layout
+            .unknowns_within((&b.q, &b.lambda), scaling, x, distance)
     }
 }
 
