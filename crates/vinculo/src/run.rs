@@ -710,9 +710,10 @@ impl<'a> Simulation<'a> {
                 point: point.to_vec(),
                 ggl: self.stabilized.is_some(),
                 values: match &self.stabilized {
-                    Some(g) => g.values().to_vec(),
-                    None => self.ws.values.clone(),
-                },
+                    Some(g) => g.values(),
+                    None => self.ws.values(),
+                }
+                .to_vec(),
             }),
         }
     }
@@ -776,13 +777,8 @@ impl<'a> Simulation<'a> {
     /// settings leaves no matrix held: the next step makes its own).
     fn adopt_matrix(&mut self, held: &HeldMatrix) {
         let factored = match &mut self.stabilized {
-            Some(g) if held.ggl && g.values().len() == held.values.len() => {
-                g.refactor(&held.values).is_ok()
-            }
-            None if !held.ggl && self.ws.values.len() == held.values.len() => {
-                self.ws.values.copy_from_slice(&held.values);
-                self.ws.solver.factor(&self.ws.values).is_ok()
-            }
+            Some(g) if held.ggl => g.refactor(&held.values),
+            None if !held.ggl => self.ws.refactor(&held.values),
             _ => false,
         };
         if factored {

@@ -89,6 +89,11 @@ impl Writer {
             self.f64(x);
         }
     }
+    /// A u64 count, then that many f64.
+    fn sized_f64s(&mut self, xs: &[f64]) {
+        self.u64(xs.len() as u64);
+        self.f64s(xs);
+    }
 
     /// The state of the error control (module documentation).
     fn error_control(&mut self, e: &ErrorControl) {
@@ -306,10 +311,8 @@ impl Snapshot {
                 w.0.push(1);
                 w.0.push(held.ggl as u8);
                 w.f64s(&[held.key[0], held.key[1], held.rate]);
-                w.u64(held.values.len() as u64);
-                w.f64s(&held.values);
-                w.u64(held.point.len() as u64);
-                w.f64s(&held.point);
+                w.sized_f64s(&held.values);
+                w.sized_f64s(&held.point);
             }
         }
         let mut h = Fnv::new();

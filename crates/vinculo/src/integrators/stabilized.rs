@@ -104,7 +104,7 @@
 use super::newton::{self, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem, NewtonReport};
 use super::rule::{GglBase, RuleState, StepPoint, StepStart, TimeRule};
 use super::stabilized_layout::StabilizedLayout;
-use super::workspace::{StepBuffers, StepWorkspace};
+use super::workspace::{refactor, StepBuffers, StepWorkspace};
 
 use crate::assembly::{add, add_block, add_force_blocks, NONE};
 use crate::constraints::{Constraint, Gradient, Hessian};
@@ -170,10 +170,10 @@ impl StabilizedWorkspace {
         &self.values
     }
 
-    /// Factorises the iteration matrix `values` (of this workspace's pattern) again.
-    pub(crate) fn refactor(&mut self, values: &[f64]) -> Result<(), crate::linear::Singular> {
-        self.values.copy_from_slice(values);
-        self.solver.factor(&self.values)
+    /// Factorises the iteration matrix `values` again; false when they are not of this
+    /// workspace's pattern (another length) or do not factorise.
+    pub(crate) fn refactor(&mut self, values: &[f64]) -> bool {
+        refactor(&mut self.values, self.solver.as_mut(), values)
     }
 
     /// Analyses the system once: dense LU up to `dense_limit` unknowns, general sparse LU above.

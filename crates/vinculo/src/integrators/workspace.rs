@@ -59,7 +59,27 @@ pub struct StepBuffers {
     pub v_eval: Vec<Vec3>,
 }
 
+/// Copies `values` into a workspace's `own` and factorises them with `solver`: false when they
+/// are not of its pattern (another length) or do not factorise.
+pub(crate) fn refactor(own: &mut [f64], solver: &mut dyn LinearSolver, values: &[f64]) -> bool {
+    own.len() == values.len() && {
+        own.copy_from_slice(values);
+        solver.factor(own).is_ok()
+    }
+}
+
 impl StepWorkspace {
+    /// The values of the last iteration matrix assembled (the one factorised last).
+    pub(crate) fn values(&self) -> &[f64] {
+        &self.values
+    }
+
+    /// Factorises the iteration matrix `values` again; false when they are not of this
+    /// workspace's pattern (another length) or do not factorise.
+    pub(crate) fn refactor(&mut self, values: &[f64]) -> bool {
+        refactor(&mut self.values, self.solver.as_mut(), values)
+    }
+
     /// Analyses the system once (solver chosen automatically).
     pub fn new(system: &System, dense_limit: usize) -> StepWorkspace {
         StepWorkspace::with_solver(system, dense_limit, SparseSolver::Auto)
