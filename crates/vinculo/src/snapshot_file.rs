@@ -1,6 +1,6 @@
 //! Snapshot files: a [`Snapshot`] saved to and loaded from a small binary file.
 //!
-//! # Format (version 5)
+//! # Format (version 6)
 //!
 //! Little-endian throughout; every float is stored as its IEEE-754 bits, so a loaded snapshot
 //! is bit for bit the saved one.
@@ -8,11 +8,11 @@
 //! | field | type |
 //! |---|---|
 //! | magic `VNCLSNAP` | 8 bytes |
-//! | version (5) | u32 |
+//! | version (6) | u32 |
 //! | model fingerprint ([`crate::run::fingerprint`]), particles n, constraint equations m | 3 x u64 |
 //! | time | f64 |
 //! | positions, velocities, accelerations | 3 x (n x 3 f64) |
-//! | multipliers | m f64 |
+//! | multipliers, their rates over the last step (the predictor's, `run.rs`) | 2 x (m f64) |
 //! | the time rule's state: 4 arrays of 3-vectors, each a u64 length then length x 3 f64 | |
 //! | step controller tag: 0 (fixed steps) or 1 (error control), then its state (below) | u8 |
 //! | accepted steps, next output, stored rows, steps taken, steps rejected, accepted step sizes, factorisations | 7 x u64 |
@@ -33,7 +33,8 @@
 //! | PI controller: order k, last error norm, last attempt rejected (0 or 1), hold | f64, f64, u8, f64 |
 //! | next step size h, error norm of the last judged step | 2 x f64 |
 //!
-//! Version 4 is version 5 without the held iteration matrix (read as none: the first step after
+//! Version 5 is version 6 without the multipliers' rates (read as zero: the first step after
+//! restoring it predicts the last multipliers). Version 4 is version 5 without the held iteration matrix (read as none: the first step after
 //! restoring it factorises a new one). Version 3 is version 4 without the contact events' state
 //! (read as none pending). Version 1
 //! is version 3 with fixed steps only (tag 0). Version 2 also kept an acceleration
@@ -51,7 +52,7 @@ use crate::run::{Carried, Controller, FixedSteps, Fnv, HeldMatrix, Snapshot};
 use crate::step_control::{AdaptiveOptions, ErrorWeights, PiController};
 
 const MAGIC: &[u8; 8] = b"VNCLSNAP";
-const VERSION: u32 = 5;
+const VERSION: u32 = 6;
 /// The oldest format version still read.
 const OLDEST: u32 = 1;
 
@@ -271,7 +272,7 @@ impl Snapshot {
         w.vecs(&c.q);
         w.vecs(&c.v);
         w.vecs(&c.acc);
-        for &x in &c.lambda {
+        for &x in c.lambda.iter().chain(&c.lambda_rate) {
             w.f64(x);
         }
         w.sized_vecs(&c.rule.acceleration);
@@ -326,7 +327,7 @@ impl Snapshot {
     ///
     /// # Errors
     /// [`Error::Snapshot`] when the file cannot be read, is not a snapshot file, is of a format
-    /// version this vinculo does not read (1 to 5 are; of 2 only fixed steps), or is truncated or corrupt (its
+    /// version this vinculo does not read (1 to 6 are; of 2 only fixed steps), or is truncated or corrupt (its
     /// checksum does not match).
     pub fn load(path: impl AsRef<Path>) -> Result<Snapshot> {
         let path = path.as_ref();
@@ -370,10 +371,13 @@ impl Snapshot {
         let q = r.vecs(n)?;
         let v = r.vecs(n)?;
         let acc = r.vecs(n)?;
-        if m.saturating_mul(8) > body.len() - r.at {
+        let rates = if version >= 6 { m } else { 0 };
+        if (m + rates).saturating_mul(8) > body.len() - r.at {
             return Err(file_error(path, "the file is truncated or corrupt"));
         }
         let lambda = (0..m).map(|_| r.f64()).collect::<Result<Vec<f64>>>()?;
+        let mut lambda_rate = (0..rates).map(|_| r.f64()).collect::<Result<Vec<f64>>>()?;
+        lambda_rate.resize(m, 0.0);
         let rule = RuleState {
             acceleration: r.sized_vecs()?,
             algorithmic: r.sized_vecs()?,
@@ -446,6 +450,7 @@ impl Snapshot {
                 v,
                 acc,
                 lambda,
+                lambda_rate,
                 rule,
                 controller,
                 step,

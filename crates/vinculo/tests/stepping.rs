@@ -288,14 +288,15 @@ fn with_checksum(mut body: Vec<u8>) -> Vec<u8> {
     body
 }
 
-/// A version 5 file of an error-controlled run that is truncated, or whose error-control part
+/// A version 6 file of an error-controlled run that is truncated, or whose error-control part
 /// is cut short or carries an unknown time rule under a valid checksum, or that claims to be of
 /// version 1 (which has fixed steps only) or 2 (whose error control kept an acceleration
 /// history), is refused with the snapshot error, and so is the
 /// snapshot restored into a fixed-step run or a run of another time rule; a fixed-step
-/// file written as version 1 (version 5 without the contact events' state, none pending, and
-/// without the held iteration matrix, none held) is still read, to the same snapshot (saved
-/// again, the version 5 file with no matrix held).
+/// file written as version 1 (version 6 without the multipliers' rates, read as zero, without the
+/// contact events' state, none pending, and without the held iteration matrix, none held) is
+/// still read, to the same snapshot (saved again, the version 6 file with zero rates and no
+/// matrix held), and so is one written as version 5 (without the rates alone).
 #[test]
 fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     let system = chain();
@@ -311,7 +312,7 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     run.step_to(0.05).clone().unwrap();
     run.snapshot().save(&path).unwrap();
     let good = std::fs::read(&path).unwrap();
-    assert_eq!(&good[8..12], &5u32.to_le_bytes());
+    assert_eq!(&good[8..12], &6u32.to_le_bytes());
     let refused = |bytes: &[u8], expected: &str| {
         let damaged = dir.join("damaged.snap");
         std::fs::write(&damaged, bytes).unwrap();
@@ -333,19 +334,21 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     // The time rule's tag (right after the step controller's tag 1) made unknown.
     let n = system.particles().len();
     let m = run.snapshot().constraints();
-    // Header, counts, time, q, v, acc, lambda, then the rule's four sized arrays (empty for the
-    // default trapezoidal rule: their lengths alone).
-    let tag_at = 8 + 4 + 24 + 8 + 3 * 24 * n + 8 * m + 4 * 8;
+    // Header, counts, time, q, v, acc, lambda, its rates, then the rule's four sized arrays
+    // (empty for the default trapezoidal rule: their lengths alone).
+    let rates_at = 8 + 4 + 24 + 8 + 3 * 24 * n + 8 * m;
+    let tag_at = rates_at + 8 * m + 4 * 8;
     assert_eq!(body[tag_at], 1, "the step controller's tag");
     let mut unknown = body.to_vec();
     unknown[tag_at + 1] = 7;
     refused(&with_checksum(unknown), "unknown time rule 7");
-    // Version 1 has no error control.
-    let mut as_v1 = body.to_vec();
+    // Version 1 has no error control (the versions before 6 have no multipliers' rates).
+    let without_rates = [&body[..rates_at], &body[rates_at + 8 * m..]].concat();
+    let mut as_v1 = without_rates.clone();
     as_v1[8..12].copy_from_slice(&1u32.to_le_bytes());
     refused(&with_checksum(as_v1), "unknown step controller 1");
     // Version 2's error control is not read.
-    let mut as_v2 = body.to_vec();
+    let mut as_v2 = without_rates;
     as_v2[8..12].copy_from_slice(&2u32.to_le_bytes());
     refused(&with_checksum(as_v2), "format version 2");
 
@@ -380,19 +383,46 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     // tag) without the contact events' two numbers after it.
     assert_eq!(body[tag_at], 0, "the step controller's tag");
     let events_at = tag_at + 1 + 32;
-    // The seven counts after the events' state end the version 1 file; version 5 goes on with
+    // The seven counts after the events' state end the version 1 file; version 6 goes on with
     // the held iteration matrix (the run holds one: its flag is 1).
     let counts_end = events_at + 16 + 7 * 8;
     assert_eq!(body[counts_end], 1, "the held matrix's flag");
-    let mut v1_body = [&body[..events_at], &body[events_at + 16..counts_end]].concat();
+    let rates_end = rates_at + 8 * m;
+    assert!(
+        body[rates_at..rates_end].iter().any(|&b| b != 0),
+        "the chain's tensions change: non-zero rates"
+    );
+    let zero_rates = vec![0u8; 8 * m];
+    let mut v1_body = [
+        &body[..rates_at],
+        &body[rates_end..events_at],
+        &body[events_at + 16..counts_end],
+    ]
+    .concat();
     v1_body[8..12].copy_from_slice(&1u32.to_le_bytes());
     let v1 = dir.join("fixed-v1.snap");
     std::fs::write(&v1, with_checksum(v1_body)).unwrap();
     let loaded = vinculo::Snapshot::load(&v1).unwrap();
     let again = dir.join("fixed-again.snap");
     loaded.save(&again).unwrap();
-    let without_matrix = with_checksum([&body[..counts_end], &[0u8][..]].concat());
+    let without_matrix = with_checksum(
+        [
+            &body[..rates_at],
+            &zero_rates,
+            &body[rates_end..counts_end],
+            &[0u8][..],
+        ]
+        .concat(),
+    );
     assert_eq!(std::fs::read(&again).unwrap(), without_matrix);
+    // A version 5 file: without the rates.
+    let mut v5_body = [&body[..rates_at], &body[rates_end..]].concat();
+    v5_body[8..12].copy_from_slice(&5u32.to_le_bytes());
+    let v5 = dir.join("fixed-v5.snap");
+    std::fs::write(&v5, with_checksum(v5_body)).unwrap();
+    vinculo::Snapshot::load(&v5).unwrap().save(&again).unwrap();
+    let zeroed = with_checksum([&body[..rates_at], &zero_rates, &body[rates_end..]].concat());
+    assert_eq!(std::fs::read(&again).unwrap(), zeroed);
     std::fs::remove_dir_all(&dir).ok();
 }
 
