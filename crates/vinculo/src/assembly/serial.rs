@@ -84,10 +84,11 @@ impl Layout {
         for (x, &p) in parts.iter().enumerate() {
             let d = self.dof[p];
             if d != NONE {
-                let row = &mut r[d..d + 3];
-                for k in 0..3 {
-                    row[k] -= weight * rows[x][k];
-                }
+                let row: &mut [f64; 3] = (&mut r[d..d + 3]).try_into().expect("3 rows");
+                let g = rows[x];
+                row[0] -= weight * g[0];
+                row[1] -= weight * g[1];
+                row[2] -= weight * g[2];
             }
         }
     }
