@@ -31,8 +31,11 @@ impl Layout {
             }
         }
         for f in system.forces() {
+            // The rows of the particles it acts on (a line node's loads act on the node alone,
+            // its neighbours only giving the tangent).
+            let acting = f.acting_particles();
             f.with_force(at.q_eval, at.v_eval, at.t_eval, |fl| {
-                self.subtract_rows(r, f.particles(), sigma, fl)
+                self.subtract_rows(r, acting, sigma, fl)
             });
         }
         let same_point = at.same_point();

@@ -114,6 +114,16 @@ impl Force {
         dispatch!(self, f => f.particles())
     }
 
+    /// The first [`Force::acting`] of [`Force::particles`] (one dispatch for both).
+    #[inline]
+    pub fn acting_particles(&self) -> &[usize] {
+        match self {
+            Force::SeabedContact(f) => &f.particles()[..1],
+            Force::LineHydro(f) => &f.particles()[..1],
+            other => other.particles(),
+        }
+    }
+
     /// The particles the force acts on: the first `acting()` of [`Force::particles`]. Every kind
     /// acts on all its particles except the line-node elements ([`LineHydro`],
     /// [`SeabedContact`]), which act on their node alone and read their neighbours only for the

@@ -396,15 +396,18 @@ mod tests {
     }
 
     /// Parallel assembly (forced by a zero threshold) gives the serial residual and Jacobian,
-    /// on a chain and a cloth large enough to be split among threads and on the system with
-    /// every constraint and force kind, for the trapezoidal rule (alpha = 0.6) and
-    /// generalised-alpha (rho_inf = 0.6).
+    /// on a chain and a cloth large enough to be split among threads, on the system with
+    /// every constraint and force kind and on a line in water (whose node elements the serial
+    /// residual places on their node alone, the parallel one on all three particles, zero on
+    /// the neighbours), for the trapezoidal rule (alpha = 0.6) and generalised-alpha
+    /// (rho_inf = 0.6).
     #[test]
     fn parallel_assembly_matches_serial() {
         for (name, s) in [
             ("every kind", every_kind()),
             ("chain", chain(5_000)),
             ("cloth", cloth(50)),
+            ("line in water", line_in_water()),
         ] {
             let q_n = s.initial_positions();
             let run = |parallel: bool, trapezoidal: bool| {
