@@ -154,8 +154,20 @@ impl Law {
         self.eval(t).0
     }
 
-    /// Value, first and second derivative at `t`.
+    /// Value, first and second derivative at `t`. A constant is answered where it is asked (the
+    /// unstretched length of every segment of a line, at every evaluation of a residual), the
+    /// other kinds by [`Law::eval_varying`].
+    #[inline(always)]
     pub fn eval(&self, t: f64) -> Derivatives {
+        match self {
+            Law::Constant(c) => (*c, 0.0, 0.0),
+            _ => self.eval_varying(t),
+        }
+    }
+
+    /// [`Law::eval`] of the kinds other than a constant.
+    #[inline(never)]
+    fn eval_varying(&self, t: f64) -> Derivatives {
         match self {
             Law::Constant(c) => (*c, 0.0, 0.0),
             Law::Polynomial(c) => {
