@@ -91,6 +91,14 @@
 //! three solves a step), and from 426 to 421 us with full Newton (G_b costs each factorisation
 //! about what a solve saves).
 //!
+//! A line held at both ends is such a chain but at its ends: its blocks are a node and the link
+//! to its parent, but the node next to an anchor holds the link to the anchor too (a block of
+//! 5 among blocks of 4), and an end point moved by constraints on its coordinates is a block of
+//! its own (3 coordinates and 3 multipliers), the root. The blocks before `head` and from
+//! `tail` on in the elimination order (at most [`MAX_EDGE_BLOCKS`] at either end; none for a
+//! chain from one anchor) take the general sweeps, the uniform run between them the products
+//! above.
+//!
 //! # Singular blocks
 //!
 //! The elimination pivots only inside a block, so a block may be singular or nearly so while the
@@ -136,6 +144,10 @@ pub const NEAR_SINGULAR: f64 = 1e3 * f64::EPSILON;
 /// with its fill-reducing ordering. A line with bending needs 2.
 pub const MAX_COUPLED_ANCESTORS: usize = 8;
 
+/// Most blocks the general sweeps may take at either end of the uniform run of a chain (module
+/// documentation): the ends of a line held at both ends.
+const MAX_EDGE_BLOCKS: usize = 4;
+
 const ABSENT: u32 = u32::MAX;
 const ROOT: u32 = u32::MAX;
 
@@ -176,9 +188,15 @@ pub struct TreeElimination {
     perm: Vec<u32>,
     /// Work vector in local (block) order.
     z: Vec<f64>,
-    /// The common size of every block when each block is coupled with its parent alone (a
-    /// chain, a branched string), or 0.
+    /// The common size of the blocks `head..tail` (in the elimination order), each coupled
+    /// with its parent alone (a chain), or 0.
     uniform: usize,
+    /// The blocks before `head` and from `tail` on take the general sweeps (module
+    /// documentation): none for a chain from one anchor; for a line between a fixed anchor
+    /// and a point moved by constraints, the node at the anchor (the first block) and the
+    /// moved point (the last, the root).
+    head: usize,
+    tail: usize,
     /// Per block: its storage (D_b, A_ub, A_bu) was gathered in the current factorisation.
     gathered: Vec<bool>,
     factored: bool,
@@ -605,13 +623,29 @@ impl TreeElimination {
         if covered != pattern.nnz() {
             return Err(Decline::Other);
         }
-        let parents_only = (0..blocks).all(|b| coupled(b).len() <= 1);
-        let uniform = match start.windows(2).map(|w| w[1] - w[0]).min() {
-            Some(nb) if start[blocks] == nb * blocks && parents_only => nb,
-            _ => 0,
+        // The uniform run: the blocks around the middle of the elimination order that have the
+        // middle block's size and at most a parent, when they are most of the blocks and at
+        // most MAX_EDGE_BLOCKS others are left at either end.
+        let size = |b: usize| start[b + 1] - start[b];
+        let mid = blocks / 2;
+        let (uniform, head, tail) = match (blocks > 0).then(|| size(mid)) {
+            Some(nb) if (3..=5).contains(&nb) && coupled(mid).len() <= 1 => {
+                let regular = |b: &usize| size(*b) == nb && coupled(*b).len() <= 1;
+                let head = (0..mid).rev().find(|b| !regular(b)).map_or(0, |b| b + 1);
+                let tail = (mid + 1..blocks).find(|b| !regular(b)).unwrap_or(blocks);
+                let most = 2 * (tail - head) > blocks;
+                if most && head <= MAX_EDGE_BLOCKS && blocks - tail <= MAX_EDGE_BLOCKS {
+                    (nb, head, tail)
+                } else {
+                    (0, 0, 0)
+                }
+            }
+            _ => (0, 0, 0),
         };
         Ok(TreeElimination {
             uniform,
+            head,
+            tail,
             gathered: vec![false; blocks],
             diag: vec![0.0; diag_at[blocks]],
             low: vec![0.0; coupling_at[blocks]],
@@ -1065,43 +1099,55 @@ impl TreeElimination {
     /// any number of coupled ancestors).
     fn sweeps(&mut self) {
         for b in 0..self.blocks() {
-            let (s, e) = (self.start[b], self.start[b + 1]);
-            let d = &self.diag[self.diag_at[b]..self.diag_at[b + 1]];
-            let (head, tail) = self.z.split_at_mut(e);
-            let zb = &mut head[s..];
-            let perm = &self.perm[s..e];
-            // Blocks of 3 (a free particle), 4 (a particle and its link) and 5 get unrolled copies.
-            match e - s {
-                3 => block_solve_fixed::<3>(d, perm, zb),
-                4 => block_solve_fixed::<4>(d, perm, zb),
-                5 => block_solve_fixed::<5>(d, perm, zb),
-                nb => lu_solve(d, nb, perm, zb, 1),
-            }
-            let nb = e - s;
-            let low = &self.low[self.coupling_at[b]..self.coupling_at[b + 1]];
-            let set = &self.ancestors[self.coupled_at[b]..self.coupled_at[b + 1]];
-            for (i, &u) in set.iter().enumerate() {
-                let zu = &mut tail[self.start[u as usize] - e..];
-                subtract_coupling(&low[3 * nb * i..], zb, zu);
-            }
+            self.forward_general(b);
         }
         for b in (0..self.blocks()).rev() {
-            let set = &self.ancestors[self.coupled_at[b]..self.coupled_at[b + 1]];
-            let k = set.len();
-            if k == 0 {
-                continue;
-            }
-            let (s, e) = (self.start[b], self.start[b + 1]);
-            let (head, tail) = self.z.split_at_mut(e);
-            let zb = &mut head[s..];
-            let w = &self.w[self.coupling_at[b]..self.coupling_at[b] + 3 * k * (e - s)];
-            for (i, &u) in set.iter().enumerate() {
-                let at = self.start[u as usize] - e;
-                let xu = [tail[at], tail[at + 1], tail[at + 2]];
-                for (x, wj) in zb.iter_mut().zip(w.chunks_exact(3 * k)) {
-                    let wj = &wj[3 * i..3 * i + 3];
-                    *x -= wj[0] * xu[0] + wj[1] * xu[1] + wj[2] * xu[2];
-                }
+            self.backward_general(b);
+        }
+    }
+
+    /// Block b's part of the forward sweep: z_b = D_b^-1 r_b, then r_u -= A_ub z_b for u in U_b.
+    #[inline]
+    fn forward_general(&mut self, b: usize) {
+        let (s, e) = (self.start[b], self.start[b + 1]);
+        let d = &self.diag[self.diag_at[b]..self.diag_at[b + 1]];
+        let (head, tail) = self.z.split_at_mut(e);
+        let zb = &mut head[s..];
+        let perm = &self.perm[s..e];
+        // Blocks of 3 (a free particle), 4 (a particle and its link) and 5 get unrolled copies.
+        match e - s {
+            3 => block_solve_fixed::<3>(d, perm, zb),
+            4 => block_solve_fixed::<4>(d, perm, zb),
+            5 => block_solve_fixed::<5>(d, perm, zb),
+            nb => lu_solve(d, nb, perm, zb, 1),
+        }
+        let nb = e - s;
+        let low = &self.low[self.coupling_at[b]..self.coupling_at[b + 1]];
+        let set = &self.ancestors[self.coupled_at[b]..self.coupled_at[b + 1]];
+        for (i, &u) in set.iter().enumerate() {
+            let zu = &mut tail[self.start[u as usize] - e..];
+            subtract_coupling(&low[3 * nb * i..], zb, zu);
+        }
+    }
+
+    /// Block b's part of the backward sweep: x_b = z_b - sum over u in U_b of W_b[:, u] x_u.
+    #[inline]
+    fn backward_general(&mut self, b: usize) {
+        let set = &self.ancestors[self.coupled_at[b]..self.coupled_at[b + 1]];
+        let k = set.len();
+        if k == 0 {
+            return;
+        }
+        let (s, e) = (self.start[b], self.start[b + 1]);
+        let (head, tail) = self.z.split_at_mut(e);
+        let zb = &mut head[s..];
+        let w = &self.w[self.coupling_at[b]..self.coupling_at[b] + 3 * k * (e - s)];
+        for (i, &u) in set.iter().enumerate() {
+            let at = self.start[u as usize] - e;
+            let xu = [tail[at], tail[at + 1], tail[at + 2]];
+            for (x, wj) in zb.iter_mut().zip(w.chunks_exact(3 * k)) {
+                let wj = &wj[3 * i..3 * i + 3];
+                *x -= wj[0] * xu[0] + wj[1] * xu[1] + wj[2] * xu[2];
             }
         }
     }
@@ -1109,11 +1155,11 @@ impl TreeElimination {
     /// After the elimination of a uniform chain (module documentation): each block's A_Pb
     /// becomes G_b = A_Pb D_b^-1, each of its rows solved from the factors transposed.
     fn make_explicit<const N: usize>(&mut self) {
-        let blocks = self
-            .diag
+        let (h, t) = (self.head, self.tail);
+        let blocks = self.diag[self.diag_at[h]..self.diag_at[t]]
             .chunks_exact(N * N)
-            .zip(self.perm.chunks_exact(N))
-            .zip(self.low.chunks_exact_mut(3 * N));
+            .zip(self.perm[self.start[h]..self.start[t]].chunks_exact(N))
+            .zip(self.low[self.coupling_at[h]..self.coupling_at[t]].chunks_exact_mut(3 * N));
         for ((d, perm), low) in blocks {
             for row in low.chunks_exact_mut(N) {
                 let row: &mut [f64; N] = row.try_into().expect("N entries");
@@ -1123,21 +1169,31 @@ impl TreeElimination {
     }
 
     /// The sweeps of a uniform chain after [`TreeElimination::make_explicit`] (module
-    /// documentation): block b starts at N b, its LU factors at N^2 b, its G_b and W_b at 3 N b.
+    /// documentation): the general sweeps for the blocks before `head` and from `tail` on,
+    /// products for the others, block head + k starting at N k past the head's unknowns, its LU
+    /// factors at N^2 k past the head's, its G_b and W_b at 3 N k past the head's.
     fn sweeps_explicit<const N: usize>(&mut self) {
+        let (h, t) = (self.head, self.tail);
+        for b in 0..h {
+            self.forward_general(b);
+        }
+        let (z0, d0, c0) = (self.start[h], self.diag_at[h], self.coupling_at[h]);
+        let start = &self.start;
         let z = &mut self.z;
         // Forward, leaves first: r_P -= G_b r_b (block b's r is final: its children came first).
         // The update of a parent that comes next (a chain's) is carried in registers to it:
         // written to memory and read back at once as a block, it would wait for the stores.
         let mut carry = [0.0f64; 3];
         let mut carried_to = usize::MAX;
-        for (b, (g, &pb)) in self.low.chunks_exact(3 * N).zip(&self.parent).enumerate() {
+        let low = self.low[c0..].chunks_exact(3 * N);
+        for (k, (g, &pb)) in low.zip(&self.parent[h..t]).enumerate() {
+            let b = h + k;
             if carried_to != b {
                 carry = [0.0; 3];
             }
             // r_b (with the carried update) and G_b r_b, one entry of r_b at a time in
             // registers (an array of them would go through memory).
-            let zb = &mut z[N * b..N * b + N];
+            let zb = &mut z[z0 + N * k..z0 + N * k + N];
             let g = &g[..3 * N];
             let mut update = [0.0f64; 3];
             for i in 0..N {
@@ -1151,33 +1207,43 @@ impl TreeElimination {
                 continue;
             }
             let p = pb as usize;
-            if p == b + 1 {
+            if p == b + 1 && p < t {
                 (carry, carried_to) = (update, p);
             } else {
                 for r in 0..3 {
-                    z[N * p + r] -= update[r];
+                    z[start[p] + r] -= update[r];
                 }
             }
         }
+        for b in t..self.blocks() {
+            self.forward_general(b);
+        }
         // Backward, roots first: x_b = D_b^-1 r_b - W_b x_P (the solve with the factors does not
         // wait for x_P).
-        let blocks = self
-            .diag
+        for b in (t..self.blocks()).rev() {
+            self.backward_general(b);
+        }
+        let start = &self.start;
+        let z = &mut self.z;
+        let blocks = self.diag[d0..]
             .chunks_exact(N * N)
-            .zip(self.perm.chunks_exact(N))
-            .zip(self.w.chunks_exact(3 * N))
-            .zip(&self.parent);
-        for (b, (((d, perm), w), &pb)) in blocks.enumerate().rev() {
-            let (head, tail) = z.split_at_mut(N * b + N);
-            let zb = &mut head[N * b..];
+            .zip(self.perm[z0..].chunks_exact(N))
+            .zip(self.w[c0..].chunks_exact(3 * N))
+            .zip(&self.parent[h..t]);
+        for (k, (((d, perm), w), &pb)) in blocks.enumerate().rev() {
+            let (before, after) = z.split_at_mut(z0 + N * k + N);
+            let zb = &mut before[z0 + N * k..];
             block_solve_fixed::<N>(d, perm, zb);
             if pb != ROOT {
-                let p = N * pb as usize - N * b - N;
-                let xp = [tail[p], tail[p + 1], tail[p + 2]];
+                let p = start[pb as usize] - (z0 + N * k + N);
+                let xp = [after[p], after[p + 1], after[p + 2]];
                 for i in 0..N {
                     zb[i] -= w[3 * i] * xp[0] + w[3 * i + 1] * xp[1] + w[3 * i + 2] * xp[2];
                 }
             }
+        }
+        for b in (0..h).rev() {
+            self.backward_general(b);
         }
     }
 }
@@ -1263,23 +1329,45 @@ mod tests {
     }
 
     /// Tree elimination and faer's general sparse LU give the same solution (to 1e-12 relative)
-    /// on random matrices with the patterns of a chain and of a branched string (row
-    /// interchanges inside the blocks included); the reference is the sparse LU, and the
-    /// residual against the matrix is checked too. The chain's blocks (a particle and its
-    /// link, each coupled with its parent alone) are solved by matrix-vector products (module
-    /// documentation), the branched string's by the general sweeps.
+    /// on random matrices with the patterns of a chain, of a chain held at both ends, of a
+    /// chain whose far end is moved by constraints and of a branched string (row interchanges
+    /// inside the blocks included); the reference is the sparse LU, and the residual against
+    /// the matrix is checked too. The chain's blocks (a particle and its link, each coupled with
+    /// its parent alone) are solved by matrix-vector products (module documentation), and so
+    /// are those of the other two chains but their ends' (the block of 5 of the node next to a
+    /// second anchor, the block of 6 of an end with its three coordinates prescribed, the
+    /// root), the branched string's by the general sweeps.
     #[test]
     fn tree_elimination_matches_sparse_lu() {
+        use crate::integrators::fixtures::chain;
+        let mut held = chain(30);
+        let last = held.particle_id(30).unwrap();
+        let anchor = held
+            .add_particle(1.0, [3.05, 0.0, 0.0], [0.0; 3], true)
+            .unwrap();
+        held.add_distance(last, anchor, None).unwrap();
+        let mut moved = chain(30);
+        let end = moved
+            .add_particle(1.0, [3.05, 0.0, 0.0], [0.0; 3], false)
+            .unwrap();
+        moved
+            .add_distance(moved.particle_id(30).unwrap(), end, None)
+            .unwrap();
+        for axis in 0..3 {
+            moved.add_fixed_coordinate(end, axis, None).unwrap();
+        }
         let cases = [
-            (crate::integrators::fixtures::chain(30), 5, 4),
-            (branched_string(1), 1, 0),
-            (branched_string(40), 7, 0),
+            (chain(30), 5, (4, 0, 30)),
+            (held, 3, (4, 1, 30)),
+            (moved, 9, (4, 1, 30)),
+            (branched_string(1), 1, (0, 0, 0)),
+            (branched_string(40), 7, (0, 0, 0)),
         ];
-        for (system, seed, uniform) in cases {
+        for (system, seed, (uniform, head, tail)) in cases {
             let layout = Layout::new(&system, 0);
             let mut tree = TreeElimination::analyse(&layout.pattern, 3 * layout.free)
                 .expect("a chain and a branched string are trees");
-            assert_eq!(tree.uniform, uniform);
+            assert_eq!((tree.uniform, tree.head, tree.tail), (uniform, head, tail));
             let mut lu = SparseLu::new(&layout.pattern);
             let n = layout.unknowns();
             let mut rng = Lcg(seed + 100);
