@@ -141,16 +141,17 @@ impl ResidualTerms<'_> {
     /// is positive (shorter than its length).
     #[inline(always)]
     pub fn row(&self, con: &crate::constraints::Constraint, c: usize, phi: f64) -> f64 {
-        if con.is_compliant() {
-            let psi = stretch_row(self.end_weight, self.start_phi, c, phi);
-            let held = if self.slack && con.can_slack() && psi > 0.0 {
-                0.0
-            } else {
-                psi
-            };
-            held + con.compliance(self.t_eval) * self.lambda[c]
-        } else {
-            phi
+        match con.compliant_segment() {
+            Some(segment) => {
+                let psi = stretch_row(self.end_weight, self.start_phi, c, phi);
+                let held = if self.slack && segment.slack && psi > 0.0 {
+                    0.0
+                } else {
+                    psi
+                };
+                held + segment.compliance(self.t_eval) * self.lambda[c]
+            }
+            None => phi,
         }
     }
 

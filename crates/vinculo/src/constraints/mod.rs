@@ -258,6 +258,18 @@ impl Constraint {
         }
     }
 
+    /// The elastic segment of finite EA that the constraint is (directly or between points of
+    /// bodies), if it is one: what [`Constraint::is_compliant`], [`Constraint::can_slack`] and
+    /// [`Constraint::compliance`] ask, in one match (the residual's row of every segment).
+    #[inline(always)]
+    pub fn compliant_segment(&self) -> Option<&ElasticDistance> {
+        match self {
+            Constraint::ElasticDistance(c) if c.ea.is_finite() => Some(c.as_ref()),
+            Constraint::OnPoints(c) => c.inner.compliant_segment(),
+            _ => None,
+        }
+    }
+
     /// True when the constraint's equation has a compliance (its row gets a diagonal entry).
     #[inline]
     pub fn is_compliant(&self) -> bool {
