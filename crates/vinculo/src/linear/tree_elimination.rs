@@ -1235,7 +1235,11 @@ impl TreeElimination {
             let zb = &mut before[z0 + N * k..];
             block_solve_fixed::<N>(d, perm, zb);
             if pb != ROOT {
-                let p = start[pb as usize] - (z0 + N * k + N);
+                // The parent's unknowns, past this block's end: by the run's layout when it is
+                // in the run (a chain's next block), from the table at the run's end.
+                let pb = pb as usize;
+                let at = if pb < t { z0 + N * (pb - h) } else { start[pb] };
+                let p = at - (z0 + N * k + N);
                 let xp = [after[p], after[p + 1], after[p + 2]];
                 for i in 0..N {
                     zb[i] -= w[3 * i] * xp[0] + w[3 * i + 1] * xp[1] + w[3 * i + 2] * xp[2];
