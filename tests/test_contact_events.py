@@ -43,11 +43,11 @@ def _exact_height(t: float) -> float:
     return -DEPTH - (p_s + c1 * math.exp(r1 * s) + c2 * math.exp(r2 * s))
 
 
-def _largest_error(dt: float, t_end: float = 0.8) -> tuple[float, vinculo.Solution]:
+def _largest_error(dt: float, t_end: float = 0.8, **scheme) -> tuple[float, vinculo.Solution]:
     system = vinculo.System(gravity=(0.0, 0.0, -G))
     ball = system.add_particle(mass=MASS, position=(0.0, 0.0, -DEPTH + HEIGHT))
     system.add_seabed_contact(ball, depth=DEPTH, diameter=1.0, length=1.0, kbot=KBOT, cbot=CBOT)
-    solution = vinculo.simulate(system, t_end, dt)
+    solution = vinculo.simulate(system, t_end, dt, **scheme)
     z = np.asarray(solution.particle(ball))[:, 2]
     exact = np.array([_exact_height(t) for t in solution.times])
     return float(np.max(np.abs(z - exact))), solution
@@ -61,6 +61,51 @@ def test_a_particle_dropped_on_the_seabed_converges_at_second_order():
     assert errors[0] < 3e-4
     assert errors[0] / errors[1] > 3.5
     assert errors[1] / errors[2] > 3.5
+
+
+@pytest.mark.parametrize("rho_inf", [0.9, 0.5])
+def test_generalised_alpha_is_second_order_through_the_touchdown(rho_inf):
+    # Generalised-alpha evaluates the forces at the step's end, where the damping's jump has no
+    # value to end on: its steps land a thousandth short of the touchdown (the gap closes in two
+    # or three steps) and the rule starts again on the far side with the consistent
+    # accelerations (crates/vinculo/src/run.rs, contact events). Measured: 1.3e-4, 3.2e-5,
+    # 7.9e-6 m (rho_inf = 0.9) and 3.5e-4, 9.5e-5, 2.5e-5 m (0.5). Before, its algorithmic
+    # accelerations carried the jump on: 3.7e-3, 1.8e-3, 9.1e-4 m, first order, and a Newton
+    # failure at dt = 0.04 with rho_inf = 0.9 (the iterates went back and forth over the jump).
+    errors = [_largest_error(dt, scheme="generalized-alpha", rho_inf=rho_inf)[0]
+              for dt in (0.04, 0.02, 0.01)]
+    assert errors[0] < 5e-4
+    assert errors[0] / errors[1] > 3.5
+    assert errors[1] / errors[2] > 3.5
+
+
+def test_backward_euler_steps_through_the_touchdown():
+    # Backward Euler is first order (the error halves with dt: measured 5.7e-2, 3.0e-2,
+    # 1.5e-2 m); at dt = 0.04 its Newton iterations failed across the jump, and the run
+    # stopped with a ConvergenceError: a failed step across a jump now goes short of it.
+    errors = [_largest_error(dt, scheme="backward-euler")[0] for dt in (0.04, 0.02, 0.01)]
+    assert errors[0] < 0.1
+    assert 1.8 < errors[0] / errors[1] < 2.2
+    assert 1.8 < errors[1] / errors[2] < 2.2
+
+
+def test_a_chain_landing_on_the_seabed_keeps_its_velocities_on_the_constraints():
+    # The benchmark's chain on the seabed (20 segments, fairlead surging 2 m) with
+    # generalised-alpha at 10 ms: each node that lands restarts the rule on the far side of
+    # the jump, so the velocities stay on the segments' constraints (measured: at most
+    # 7.3e-6 (scaled velocity violation); before, the stale algorithmic accelerations put them
+    # 2.2e-2 off, and the output rows interpolated between steps 4.4e-6 off the segments'
+    # lengths, which the tensions computed from the positions carry times EA / l).
+    from vinculo.mooring import bench
+    from vinculo.mooring.analysis import run
+
+    model = bench.chain_on_seabed(20)
+    result = run(model, bench.motion_for(model), 20.0, dt=0.01, plots=False,
+                 scheme="generalized-alpha", rho_inf=0.5)
+    solution = result.solution
+    assert solution.steps_rejected > 0  # nodes landed
+    assert np.max(solution.velocity_violation) < 1e-4
+    assert np.max(solution.position_violation) < 1e-7
 
 
 def test_the_run_lands_on_the_touchdown():

@@ -91,6 +91,17 @@ impl Scheme {
         }
     }
 
+    /// True when the forces of a step are evaluated at its end alone (generalised-alpha and
+    /// backward Euler), where a force that jumps with the positions (a seabed contact's damping)
+    /// has no value a step could end on: the run's contact events land such a step short of
+    /// the jump (`run.rs`).
+    pub fn evaluates_at_end(&self) -> bool {
+        match *self {
+            Scheme::GeneralizedTrapezoidal { alpha } => alpha >= 1.0,
+            Scheme::GeneralizedAlpha { .. } => true,
+        }
+    }
+
     /// Order of accuracy of the positions.
     pub fn order(&self) -> usize {
         with_rule!(*self, rule => rule.order())
