@@ -108,6 +108,26 @@ def test_a_chain_landing_on_the_seabed_keeps_its_velocities_on_the_constraints()
     assert np.max(solution.position_violation) < 1e-7
 
 
+def test_the_steps_come_back_to_the_grid_after_the_touchdown():
+    # The step to the touchdown leaves the grid of multiples of dt; after the transient the run
+    # goes back to it, so that the steps end on the multiples of dt again (the same floats as
+    # a run without the event), and output asked there is the steps' own state rather than an
+    # interpolation between steps.
+    dt = 0.04
+    _, solution = _largest_error(dt, save_every=1)
+    times = np.asarray(solution.times)
+    later = times[times > 0.6]
+    assert later.size >= 5
+    np.testing.assert_array_equal(later, np.round(later / dt) * dt)
+    grid = np.arange(0.0, 0.8 + 1e-9, dt)
+    _, on_grid = _largest_error(dt, t_eval=grid)
+    rows = np.asarray(on_grid.times) > 0.6
+    # The rows asked for after 0.6 s are the steps' own states, bit for bit those of the run
+    # that stores every step.
+    np.testing.assert_array_equal(np.asarray(on_grid.positions)[rows],
+                                  np.asarray(solution.positions)[times > 0.6])
+
+
 def test_the_run_lands_on_the_touchdown():
     # The step that found the touchdown is replaced by one that ends there: a stored time at
     # t_c = sqrt(2 h0 / g), with the particle on the seabed (free fall is a quadratic, which the

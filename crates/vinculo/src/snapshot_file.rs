@@ -21,7 +21,9 @@
 //!
 //! Fixed steps (tag 0): top u32, unit f64, units u64, level u32, t_grid f64, and the contact
 //! events' state (`run.rs`): the pending event's time (NaN: none) and the end of the short
-//! steps after the last event (-inf: none), 2 x f64.
+//! steps after the last event (-inf: none), 2 x f64; then the run's own grid: its origin f64,
+//! whether the grid is it (u8), and the point of it the run is going back to, time (NaN:
+//! none) and units, f64 and u64.
 //!
 //! Error control (tag 1, `adaptive.rs`; its scratch arrays are not saved):
 //!
@@ -34,7 +36,8 @@
 //! | next step size h, error norm of the last judged step | 2 x f64 |
 //!
 //! Version 5 is version 6 without the multipliers' rates (read as zero: the first step after
-//! restoring it predicts the last multipliers). Version 4 is version 5 without the held iteration matrix (read as none: the first step after
+//! restoring it predicts the last multipliers) and without the run's own grid (read as the
+//! current grid: a run restored during a contact event's transient stays on the event's grid). Version 4 is version 5 without the held iteration matrix (read as none: the first step after
 //! restoring it factorises a new one). Version 3 is version 4 without the contact events' state
 //! (read as none pending). Version 1
 //! is version 3 with fixed steps only (tag 0). Version 2 also kept an acceleration
@@ -289,6 +292,11 @@ impl Snapshot {
                 w.f64(fixed.t_grid);
                 w.f64(fixed.event_stop.unwrap_or(f64::NAN));
                 w.f64(fixed.settle_until);
+                w.f64(fixed.origin);
+                w.0.push(fixed.home as u8);
+                let (at, units) = fixed.rejoin.unwrap_or((f64::NAN, 0));
+                w.f64(at);
+                w.u64(units);
             }
             Controller::Adaptive(control) => {
                 w.0.push(1);
@@ -394,6 +402,13 @@ impl Snapshot {
                 } else {
                     (None, f64::NEG_INFINITY)
                 };
+                let (origin, home, rejoin) = if version >= 6 {
+                    let (origin, home) = (r.f64()?, r.take(1)?[0] == 1);
+                    let (at, units) = (r.f64()?, r.u64()?);
+                    (origin, home, Some((at, units)).filter(|(t, _)| !t.is_nan()))
+                } else {
+                    (t_grid, true, None)
+                };
                 Controller::Fixed(FixedSteps {
                     top,
                     unit,
@@ -402,6 +417,9 @@ impl Snapshot {
                     t_grid,
                     event_stop,
                     settle_until,
+                    origin,
+                    home,
+                    rejoin,
                 })
             }
             1 if version >= 3 => Controller::Adaptive(Box::new(r.error_control()?)),

@@ -294,9 +294,10 @@ fn with_checksum(mut body: Vec<u8>) -> Vec<u8> {
 /// history), is refused with the snapshot error, and so is the
 /// snapshot restored into a fixed-step run or a run of another time rule; a fixed-step
 /// file written as version 1 (version 6 without the multipliers' rates, read as zero, without the
-/// contact events' state, none pending, and without the held iteration matrix, none held) is
-/// still read, to the same snapshot (saved again, the version 6 file with zero rates and no
-/// matrix held), and so is one written as version 5 (without the rates alone).
+/// contact events' state, none pending, without the run's own grid, read as the current grid,
+/// and without the held iteration matrix, none held) is still read, to the same snapshot
+/// (saved again, the version 6 file with zero rates and no matrix held), and so is one written
+/// as version 5 (without the rates and the run's own grid).
 #[test]
 fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     let system = chain();
@@ -383,9 +384,11 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     // tag) without the contact events' two numbers after it.
     assert_eq!(body[tag_at], 0, "the step controller's tag");
     let events_at = tag_at + 1 + 32;
-    // The seven counts after the events' state end the version 1 file; version 6 goes on with
-    // the held iteration matrix (the run holds one: its flag is 1).
-    let counts_end = events_at + 16 + 7 * 8;
+    // Version 6 keeps the run's own grid after the events' state (origin, flag, the point to
+    // go back to, 25 bytes); the seven counts after them end the version 1 file; version 6 goes
+    // on with the held iteration matrix (the run holds one: its flag is 1).
+    let grid_at = events_at + 16;
+    let counts_end = grid_at + 25 + 7 * 8;
     assert_eq!(body[counts_end], 1, "the held matrix's flag");
     let rates_end = rates_at + 8 * m;
     assert!(
@@ -396,7 +399,7 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     let mut v1_body = [
         &body[..rates_at],
         &body[rates_end..events_at],
-        &body[events_at + 16..counts_end],
+        &body[grid_at + 25..counts_end],
     ]
     .concat();
     v1_body[8..12].copy_from_slice(&1u32.to_le_bytes());
@@ -415,8 +418,13 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
         .concat(),
     );
     assert_eq!(std::fs::read(&again).unwrap(), without_matrix);
-    // A version 5 file: without the rates.
-    let mut v5_body = [&body[..rates_at], &body[rates_end..]].concat();
+    // A version 5 file: without the rates and the run's own grid (read as the current one).
+    let mut v5_body = [
+        &body[..rates_at],
+        &body[rates_end..grid_at],
+        &body[grid_at + 25..],
+    ]
+    .concat();
     v5_body[8..12].copy_from_slice(&5u32.to_le_bytes());
     let v5 = dir.join("fixed-v5.snap");
     std::fs::write(&v5, with_checksum(v5_body)).unwrap();
