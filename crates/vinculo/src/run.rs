@@ -18,9 +18,10 @@
 //! A snapshot ([`Simulation::snapshot`]) is a copy of the carried state and of the number of
 //! stored rows; restoring it and stepping on repeats the steps bit for bit (the workspaces
 //! hold nothing a step reads before writing it, except the factorisation that Newton's default
-//! and modified Newton keep, which the snapshot holds and a restore factorises again). A snapshot of either kind of run saves to a file
-//! (`snapshot_file.rs`) with the step controller's state; the error control's scratch arrays are
-//! not part of it and are sized for the system again on restore.
+//! and modified Newton keep, which the snapshot holds and a restore factorises again). A
+//! snapshot of either kind of run saves to a file (`snapshot_file.rs`) with the step
+//! controller's state; the error control's scratch arrays are not part of it and are sized for
+//! the system again on restore.
 //!
 //! Error-controlled steps are never bent to an intermediate stop: [`Simulation::step_to`] ends
 //! with the step that reaches or passes it (its state is the current state), so a run stepped to
@@ -1211,7 +1212,12 @@ impl Simulation<'_> {
                         self.law_trouble = system.law_failure(c.t + h_try);
                     }
                     let retry = match &mut c.controller {
-                        Controller::Fixed(fixed) => fixed.halve(),
+                        Controller::Fixed(fixed) => {
+                            // A failed step back to the run's grid is halved like any other;
+                            // the way back is found again once the steps are dt.
+                            fixed.rejoin = None;
+                            fixed.halve()
+                        }
                         Controller::Adaptive(control) => control.newton_failed(h_try),
                     };
                     if may_reject {

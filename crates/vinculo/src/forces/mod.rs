@@ -114,7 +114,11 @@ impl Force {
         dispatch!(self, f => f.particles())
     }
 
-    /// The first [`Force::acting`] of [`Force::particles`] (one dispatch for both).
+    /// The particles the force acts on, the first of [`Force::particles`]. Every kind acts on
+    /// all its particles except the line-node elements ([`LineHydro`], [`SeabedContact`]),
+    /// which act on their node alone and read their neighbours only for the node's tangent.
+    /// Their Jacobian then has the node's rows alone, so the matrix pattern holds no block
+    /// between the two neighbours and a line stays a chain for the tree elimination.
     #[inline]
     pub fn acting_particles(&self) -> &[usize] {
         match self {
@@ -124,17 +128,10 @@ impl Force {
         }
     }
 
-    /// The particles the force acts on: the first `acting()` of [`Force::particles`]. Every kind
-    /// acts on all its particles except the line-node elements ([`LineHydro`],
-    /// [`SeabedContact`]), which act on their node alone and read their neighbours only for the
-    /// node's tangent. Their Jacobian then has the node's rows alone, so the matrix pattern holds
-    /// no block between the two neighbours and a line stays a chain for the tree elimination.
+    /// How many particles the force acts on ([`Force::acting_particles`]).
     #[inline]
     pub fn acting(&self) -> usize {
-        match self {
-            Force::SeabedContact(_) | Force::LineHydro(_) => 1,
-            _ => self.particles().len(),
-        }
+        self.acting_particles().len()
     }
 
     /// Applied force on each touched particle.
