@@ -77,9 +77,9 @@
 //! ([`Scheme::evaluates_at_end`]: generalised-alpha, backward Euler), measured on that dropped
 //! particle:
 //! - A step that ends on the jump has no solution (the residual jumps there by the damping
-//!   force, and Newton's iterates go back and forth over it): such a scheme lands [`LAND_SHORT`]
-//!   of the way short of the event, on the side it came from, and the next steps find what is
-//!   left of it, two or three of them closing the gap to within [`EVENT_MARGIN`]. A step whose
+//!   force, and Newton's iterates go back and forth over it): such a scheme lands `LAND_SHORT`
+//!   (a thousandth) of the way short of the event, on the side it came from, and the next steps find what is
+//!   left of it, two or three of them closing the gap to within `EVENT_MARGIN`. A step whose
 //!   Newton iterations fail with a jump between its start and its predictor goes short of the
 //!   jump too, instead of being halved (generalised-alpha at dt = 0.04 and backward Euler at
 //!   0.04 stopped with a ConvergenceError before).

@@ -156,7 +156,7 @@ impl Law {
 
     /// Value, first and second derivative at `t`. A constant is answered where it is asked (the
     /// unstretched length of every segment of a line, at every evaluation of a residual), the
-    /// other kinds by [`Law::eval_varying`].
+    /// other kinds out of line (`Law::eval_varying`).
     #[inline(always)]
     pub fn eval(&self, t: f64) -> Derivatives {
         match self {
