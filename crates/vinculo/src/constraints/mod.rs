@@ -240,27 +240,20 @@ impl Constraint {
     /// for an elastic segment of finite EA, 0 (an exact constraint) for every other kind.
     #[inline(always)]
     pub fn compliance(&self, t: f64) -> f64 {
-        match self {
-            Constraint::ElasticDistance(c) => c.compliance(t),
-            Constraint::OnPoints(c) => c.inner.compliance(t),
-            _ => 0.0,
-        }
+        self.compliant_segment().map_or(0.0, |s| s.compliance(t))
     }
 
     /// True for an elastic segment that goes slack instead of pushing
     /// ([`crate::model::System::set_slack`]).
     #[inline]
     pub fn can_slack(&self) -> bool {
-        match self {
-            Constraint::ElasticDistance(c) => c.slack && c.ea.is_finite(),
-            Constraint::OnPoints(c) => c.inner.can_slack(),
-            _ => false,
-        }
+        self.compliant_segment().is_some_and(|s| s.slack)
     }
 
     /// The elastic segment of finite EA that the constraint is (directly or between points of
     /// bodies), if it is one: what [`Constraint::is_compliant`], [`Constraint::can_slack`] and
-    /// [`Constraint::compliance`] ask, in one match (the residual's row of every segment).
+    /// [`Constraint::compliance`] answer from, and what the residual's row of every segment
+    /// asks once.
     #[inline(always)]
     pub fn compliant_segment(&self) -> Option<&ElasticDistance> {
         match self {
@@ -273,11 +266,7 @@ impl Constraint {
     /// True when the constraint's equation has a compliance (its row gets a diagonal entry).
     #[inline]
     pub fn is_compliant(&self) -> bool {
-        match self {
-            Constraint::ElasticDistance(c) => c.ea.is_finite(),
-            Constraint::OnPoints(c) => c.inner.is_compliant(),
-            _ => false,
-        }
+        self.compliant_segment().is_some()
     }
 
     /// The prescribed laws of time the constraint follows.
