@@ -189,11 +189,7 @@ impl ErrorControl {
             } else {
                 (&self.q_mid, &self.v_mid)
             };
-            for i in 0..q_k.len() {
-                for c in 0..3 {
-                    ws.state.q[i][c] = q_k[i][c] + half * v_k[i][c] + 0.5 * half * half * acc[i][c];
-                }
-            }
+            crate::run::extrapolate((q_k, v_k, acc), half, &mut ws.state.q);
             let start = StepStart::new(t_k, q_k, v_k, half);
             let stab = stabilized.as_deref_mut();
             if self

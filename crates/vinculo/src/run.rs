@@ -1083,12 +1083,7 @@ impl Simulation<'_> {
             // Predictor: constant-acceleration extrapolation of the positions, linear
             // extrapolation of the multipliers (module documentation).
             let ws = &mut self.ws;
-            for i in 0..c.q.len() {
-                for k in 0..3 {
-                    ws.state.q[i][k] =
-                        c.q[i][k] + h_try * c.v[i][k] + 0.5 * h_try * h_try * c.acc[i][k];
-                }
-            }
+            extrapolate((&c.q, &c.v, &c.acc), h_try, &mut ws.state.q);
             let ahead = match c.controller {
                 Controller::Fixed(_) => h_try,
                 Controller::Adaptive(_) => 0.0,
@@ -1133,11 +1128,7 @@ impl Simulation<'_> {
                     let switch = events
                         .then(|| first_event(system, &self.event_forces, start, &ws.state.q, h_try))
                         .flatten();
-                    let event = switch
-                        .filter(|&(s, _)| {
-                            s > EVENT_MARGIN * h_try && s < (1.0 - EVENT_MARGIN) * h_try
-                        })
-                        .filter(|&(s, _)| unresolved_step(c.t, s).is_none());
+                    let event = inside_step(switch, c.t, h_try);
                     // A step accepted across a jump (within EVENT_MARGIN of an end) or onto one
                     // starts the rule again on the jump's far side.
                     let restart = to_event || (switch.is_some() && event.is_none());
@@ -1185,20 +1176,12 @@ impl Simulation<'_> {
                     // goes short of the jump instead, where its predictor, the step's Taylor
                     // polynomial, switches the force.
                     if events {
-                        let predicted: Vec<Vec3> = (c.q.iter().zip(&c.v).zip(&c.acc))
-                            .map(|((q, v), a)| {
-                                std::array::from_fn(|k| {
-                                    q[k] + h_try * v[k] + 0.5 * h_try * h_try * a[k]
-                                })
-                            })
-                            .collect();
+                        let mut predicted = vec![[0.0; 3]; c.q.len()];
                         let start = (&c.q[..], &c.v[..], &c.acc[..]);
-                        let switch =
-                            first_event(system, &self.event_forces, start, &predicted, h_try)
-                                .filter(|&(s, _)| {
-                                    s > EVENT_MARGIN * h_try && s < (1.0 - EVENT_MARGIN) * h_try
-                                })
-                                .filter(|&(s, _)| unresolved_step(c.t, s).is_none());
+                        extrapolate(start, h_try, &mut predicted);
+                        let found =
+                            first_event(system, &self.event_forces, start, &predicted, h_try);
+                        let switch = inside_step(found, c.t, h_try);
                         if let (Some((s, f)), Controller::Fixed(fixed)) =
                             (switch, &mut c.controller)
                         {
@@ -1462,7 +1445,25 @@ impl Simulation<'_> {
     }
 }
 
-/// Stores a state with its violations and the statistics of the step that produced it.
+/// q + h v + h^2/2 a of every particle from `(q, v, a)` into `out`: the predictor of a step of
+/// size `h` (constant-acceleration extrapolation), the Taylor polynomial along which contact
+/// events are found.
+pub(crate) fn extrapolate((q, v, a): (&[Vec3], &[Vec3], &[Vec3]), h: f64, out: &mut [Vec3]) {
+    for (o, ((q, v), a)) in out.iter_mut().zip(q.iter().zip(v).zip(a)) {
+        for k in 0..3 {
+            o[k] = q[k] + h * v[k] + 0.5 * h * h * a[k];
+        }
+    }
+}
+
+/// A force's switch at `s` into a step of size `h` from `t` (`found`), when a step can go to
+/// it: more than [`EVENT_MARGIN`] of the step from either end, and a step the times resolve.
+fn inside_step(found: Option<(f64, usize)>, t: f64, h: f64) -> Option<(f64, usize)> {
+    found
+        .filter(|&(s, _)| s > EVENT_MARGIN * h && s < (1.0 - EVENT_MARGIN) * h)
+        .filter(|&(s, _)| unresolved_step(t, s).is_none())
+}
+
 /// The earliest time after the start of a step of size `h` from `start` (positions,
 /// velocities, accelerations) to the positions `q1` at which one of the forces `event_forces` of
 /// `system` (those that can switch, [`crate::forces::Force::has_events`]) jumps, if any.
@@ -1480,6 +1481,7 @@ fn first_event(
         .reduce(|a, b| if b.0 < a.0 { b } else { a })
 }
 
+/// Stores a state with its violations and the statistics of the step that produced it.
 fn store(
     sol: &mut Solution,
     system: &System,
