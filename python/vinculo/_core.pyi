@@ -995,6 +995,9 @@ class RunResult:
     def factorisations(self) -> int:
         """Newton iteration matrices factorised over the run."""
     @property
+    def residual_evaluations(self) -> int:
+        """Residual evaluations of the step equations by Newton's iterations over the run."""
+    @property
     def linear_solver(self) -> str:
         """The linear solver of the steps: 'dense LU', 'tree elimination' or 'sparse LU'."""
     @property

@@ -88,6 +88,10 @@ class Solution:
         factorisations: number of Newton iteration matrices factorised over the run (one per
             Newton iteration in full Newton, ``jacobian_reuse=False``; fewer with the default,
             which keeps a matrix while it contracts fast, and with modified Newton).
+        residual_evaluations: number of evaluations of the step equations' residual by Newton's
+            iterations over the run, rejected steps included (a step makes one more than its
+            iterations, or as many when Newton stops on its last increment because the residual
+            it was solved from already met the tolerance; docs/theory/newton.md).
         scheme: the time discretisation: 'trapezoidal', 'backward-euler' or 'generalized-alpha'.
         steps_taken: steps attempted, including those rejected and retried.
         steps_rejected: attempts rejected (Newton failed, or the error estimate of an
@@ -111,6 +115,7 @@ class Solution:
     system: System
     linear_solver: str = ""
     factorisations: int = 0
+    residual_evaluations: int = 0
     scheme: str = ""
     steps_taken: int = 0
     steps_rejected: int = 0
@@ -143,6 +148,7 @@ class Solution:
             system=system,
             linear_solver=result.linear_solver,
             factorisations=result.factorisations,
+            residual_evaluations=result.residual_evaluations,
             scheme=result.scheme,
             steps_taken=result.steps_taken,
             steps_rejected=result.steps_rejected,

@@ -173,6 +173,12 @@ impl PyRunResult {
         self.solution.factorisations
     }
 
+    /// Residual evaluations of the step equations by Newton's iterations.
+    #[getter]
+    fn residual_evaluations(&self) -> usize {
+        self.solution.residual_evaluations
+    }
+
     /// The linear solver of the steps.
     #[getter]
     fn linear_solver(&self) -> &'static str {

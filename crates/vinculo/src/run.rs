@@ -387,6 +387,7 @@ pub struct Snapshot {
     pub(crate) steps_rejected: usize,
     pub(crate) accepted: usize,
     pub(crate) factorisations: usize,
+    pub(crate) residual_evaluations: usize,
     pub(crate) status: std::result::Result<(), Error>,
     pub(crate) fingerprint: u64,
     /// The run it was taken from (0: none, a snapshot loaded from a file).
@@ -817,6 +818,7 @@ impl<'a> Simulation<'a> {
             steps_rejected: self.sol.steps_rejected,
             accepted: self.sol.accepted_step_sizes.len(),
             factorisations: self.sol.factorisations,
+            residual_evaluations: self.sol.residual_evaluations,
             status: self.sol.status.clone(),
             fingerprint: self.fingerprint,
             run: self.run,
@@ -973,6 +975,8 @@ impl<'a> Simulation<'a> {
         self.sol.status = snapshot.status.clone();
         self.ws.matrix.invalidate();
         self.ws.matrix.factorisations = snapshot.factorisations;
+        self.sol.residual_evaluations = snapshot.residual_evaluations;
+        self.ws.matrix.residuals = snapshot.residual_evaluations;
         if let Some(held) = &snapshot.matrix {
             self.adopt_matrix(held);
         }
@@ -1116,6 +1120,7 @@ impl Simulation<'_> {
             let stabilized = self.stabilized.as_mut();
             let attempt = scheme.step(system, ws, stabilized, start, &mut c.rule, &self.newton);
             self.sol.factorisations = ws.matrix.factorisations;
+            self.sol.residual_evaluations = ws.matrix.residuals;
             // A failed user function stops the run at once (NaN terms would only fail again).
             if let Some(e) = system.user_failure() {
                 self.sol.status = Err(e);

@@ -1,6 +1,6 @@
 //! Snapshot files: a [`Snapshot`] saved to and loaded from a small binary file.
 //!
-//! # Format (version 6)
+//! # Format (version 7)
 //!
 //! Little-endian throughout; every float is stored as its IEEE-754 bits, so a loaded snapshot
 //! is bit for bit the saved one.
@@ -8,14 +8,14 @@
 //! | field | type |
 //! |---|---|
 //! | magic `VNCLSNAP` | 8 bytes |
-//! | version (6) | u32 |
+//! | version (7) | u32 |
 //! | model fingerprint ([`crate::run::fingerprint`]), particles n, constraint equations m | 3 x u64 |
 //! | time | f64 |
 //! | positions, velocities, accelerations | 3 x (n x 3 f64) |
 //! | multipliers, their rates over the last step (the predictor's, `run.rs`) | 2 x (m f64) |
 //! | the time rule's state: 4 arrays of 3-vectors, each a u64 length then length x 3 f64 | |
 //! | step controller tag: 0 (fixed steps) or 1 (error control), then its state (below) | u8 |
-//! | accepted steps, next output, stored rows, steps taken, steps rejected, accepted step sizes, factorisations | 7 x u64 |
+//! | accepted steps, next output, stored rows, steps taken, steps rejected, accepted step sizes, factorisations, residual evaluations | 8 x u64 |
 //! | held iteration matrix: 0 (none) or 1, then its formulation (0: index-3, 1: GGL), its key (step size and scheme coefficient), its last contraction ratio, a u64 count and that many values, a u64 count and that many values of the iterate it was assembled at | u8, then u8, 3 x f64, u64, f64s, u64, f64s |
 //! | checksum: FNV-1a 64 of every byte before it | u64 |
 //!
@@ -35,7 +35,8 @@
 //! | PI controller: order k, last error norm, last attempt rejected (0 or 1), hold | f64, f64, u8, f64 |
 //! | next step size h, error norm of the last judged step | 2 x f64 |
 //!
-//! Version 5 is version 6 without the multipliers' rates (read as zero: the first step after
+//! Version 6 is version 7 without the residual evaluations (read as zero). Version 5 is version
+//! 6 without the multipliers' rates (read as zero: the first step after
 //! restoring it predicts the last multipliers) and without the run's own grid (read as the
 //! current grid: a run restored during a contact event's transient stays on the event's grid). Version 4 is version 5 without the held iteration matrix (read as none: the first step after
 //! restoring it factorises a new one). Version 3 is version 4 without the contact events' state
@@ -55,7 +56,7 @@ use crate::run::{Carried, Controller, FixedSteps, Fnv, HeldMatrix, Snapshot};
 use crate::step_control::{AdaptiveOptions, ErrorWeights, PiController};
 
 const MAGIC: &[u8; 8] = b"VNCLSNAP";
-const VERSION: u32 = 6;
+const VERSION: u32 = 7;
 /// The oldest format version still read.
 const OLDEST: u32 = 1;
 
@@ -311,6 +312,7 @@ impl Snapshot {
             self.steps_rejected,
             self.accepted,
             self.factorisations,
+            self.residual_evaluations,
         ] {
             w.u64(x as u64);
         }
@@ -335,7 +337,7 @@ impl Snapshot {
     ///
     /// # Errors
     /// [`Error::Snapshot`] when the file cannot be read, is not a snapshot file, is of a format
-    /// version this vinculo does not read (1 to 6 are; of 2 only fixed steps), or is truncated or corrupt (its
+    /// version this vinculo does not read (1 to 7 are; of 2 only fixed steps), or is truncated or corrupt (its
     /// checksum does not match).
     pub fn load(path: impl AsRef<Path>) -> Result<Snapshot> {
         let path = path.as_ref();
@@ -437,8 +439,9 @@ impl Snapshot {
                 ))
             }
         };
-        let mut counts = [0usize; 7];
-        for x in &mut counts {
+        let mut counts = [0usize; 8];
+        let stored = if version >= 7 { 8 } else { 7 };
+        for x in &mut counts[..stored] {
             *x = r.usize()?;
         }
         let matrix = if version >= 5 && r.take(1)?[0] == 1 {
@@ -459,7 +462,7 @@ impl Snapshot {
         if r.at != body.len() {
             return Err(file_error(path, "the file is corrupt (trailing bytes)"));
         }
-        let [step, next_output, rows, steps_taken, steps_rejected, accepted, factorisations] =
+        let [step, next_output, rows, steps_taken, steps_rejected, accepted, factorisations, residual_evaluations] =
             counts;
         Ok(Snapshot {
             carried: Carried {
@@ -479,6 +482,7 @@ impl Snapshot {
             steps_rejected,
             accepted,
             factorisations,
+            residual_evaluations,
             status: Ok(()),
             fingerprint,
             run: 0,

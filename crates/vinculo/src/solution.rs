@@ -52,6 +52,10 @@ pub struct Solution {
     /// Factorisations of Newton iteration matrices (one per iteration in full Newton; fewer with
     /// [`NewtonOptions::jacobian_reuse`](crate::integrators::NewtonOptions::jacobian_reuse)).
     pub factorisations: usize,
+    /// Evaluations of the step equations' residual by Newton's iterations (at most one more
+    /// than the iterations of a step: the loop may stop on an increment without the residual
+    /// at the iterate it gives, `integrators/newton.rs`).
+    pub residual_evaluations: usize,
     /// The time discretisation used ([`Scheme::name`] names it).
     pub scheme: Scheme,
     /// The equations discretised ([`Formulation::name`] names them).
@@ -80,6 +84,7 @@ impl Solution {
             steps_rejected: 0,
             accepted_step_sizes: Vec::new(),
             factorisations: 0,
+            residual_evaluations: 0,
             scheme: Scheme::default(),
             formulation: Formulation::default(),
             linear_solver,

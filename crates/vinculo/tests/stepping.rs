@@ -313,7 +313,7 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     run.step_to(0.05).clone().unwrap();
     run.snapshot().save(&path).unwrap();
     let good = std::fs::read(&path).unwrap();
-    assert_eq!(&good[8..12], &6u32.to_le_bytes());
+    assert_eq!(&good[8..12], &7u32.to_le_bytes());
     let refused = |bytes: &[u8], expected: &str| {
         let damaged = dir.join("damaged.snap");
         std::fs::write(&damaged, bytes).unwrap();
@@ -385,10 +385,11 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     assert_eq!(body[tag_at], 0, "the step controller's tag");
     let events_at = tag_at + 1 + 32;
     // Version 6 keeps the run's own grid after the events' state (origin, flag, the point to
-    // go back to, 25 bytes); the seven counts after them end the version 1 file; version 6 goes
-    // on with the held iteration matrix (the run holds one: its flag is 1).
+    // go back to, 25 bytes); the seven counts after them end the version 1 file; version 7
+    // has an eighth (the residual evaluations) and goes on with the held iteration matrix (the
+    // run holds one: its flag is 1).
     let grid_at = events_at + 16;
-    let counts_end = grid_at + 25 + 7 * 8;
+    let counts_end = grid_at + 25 + 8 * 8;
     assert_eq!(body[counts_end], 1, "the held matrix's flag");
     let rates_end = rates_at + 8 * m;
     assert!(
@@ -399,7 +400,7 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     let mut v1_body = [
         &body[..rates_at],
         &body[rates_end..events_at],
-        &body[grid_at + 25..counts_end],
+        &body[grid_at + 25..counts_end - 8],
     ]
     .concat();
     v1_body[8..12].copy_from_slice(&1u32.to_le_bytes());
@@ -412,25 +413,47 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
         [
             &body[..rates_at],
             &zero_rates,
-            &body[rates_end..counts_end],
+            &body[rates_end..counts_end - 8],
+            &[0u8; 8][..],
             &[0u8][..],
         ]
         .concat(),
     );
     assert_eq!(std::fs::read(&again).unwrap(), without_matrix);
-    // A version 5 file: without the rates and the run's own grid (read as the current one).
+    // A version 5 file: without the rates, the run's own grid (read as the current one) and
+    // the residual evaluations (read as zero).
     let mut v5_body = [
         &body[..rates_at],
         &body[rates_end..grid_at],
-        &body[grid_at + 25..],
+        &body[grid_at + 25..counts_end - 8],
+        &body[counts_end..],
     ]
     .concat();
     v5_body[8..12].copy_from_slice(&5u32.to_le_bytes());
     let v5 = dir.join("fixed-v5.snap");
     std::fs::write(&v5, with_checksum(v5_body)).unwrap();
     vinculo::Snapshot::load(&v5).unwrap().save(&again).unwrap();
-    let zeroed = with_checksum([&body[..rates_at], &zero_rates, &body[rates_end..]].concat());
+    let zeroed = with_checksum(
+        [
+            &body[..rates_at],
+            &zero_rates,
+            &body[rates_end..counts_end - 8],
+            &[0u8; 8][..],
+            &body[counts_end..],
+        ]
+        .concat(),
+    );
     assert_eq!(std::fs::read(&again).unwrap(), zeroed);
+    // A version 6 file: without the residual evaluations.
+    let mut v6_body = [&body[..counts_end - 8], &body[counts_end..]].concat();
+    v6_body[8..12].copy_from_slice(&6u32.to_le_bytes());
+    let v6 = dir.join("fixed-v6.snap");
+    std::fs::write(&v6, with_checksum(v6_body)).unwrap();
+    let restored = vinculo::Snapshot::load(&v6).unwrap();
+    restored.save(&again).unwrap();
+    let counted_zero =
+        with_checksum([&body[..counts_end - 8], &[0u8; 8][..], &body[counts_end..]].concat());
+    assert_eq!(std::fs::read(&again).unwrap(), counted_zero);
     std::fs::remove_dir_all(&dir).ok();
 }
 

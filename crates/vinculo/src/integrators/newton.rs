@@ -68,6 +68,23 @@
 //! 0.002 and 1.0 factorisations a step on 1,000 particles at dt = 1 ms, against 1.0 and 2.3 in
 //! full Newton), and the pendulum of 10^4 steps of 1 ms ends 4e-10 m from full Newton's bob
 //! (modified Newton: 1e-4 m).
+//!
+//! # Stopping on the increment
+//!
+//! Both tests of a stop, on the residual and on the increment, can be made one residual sooner:
+//! when the residual R(x_k) that the increment dx_{k+1} is solved from is within the tolerance and
+//! dx_{k+1} passes the test above, the loop applies it and stops, without evaluating
+//! R(x_{k+1}). The iterate returned is the one the next iteration would have returned: its stop
+//! asks R(x_{k+1}) within the tolerance, and with J~ dx_{k+1} = R(x_k) (the update is
+//! x <- x - dx), R(x_{k+1}) = R(x_k) - J dx_{k+1} + O(|dx|^2) = (J~ - J) dx_{k+1} + O(|dx|^2),
+//! far below R(x_k) for an increment this small (zero to first order with a matrix factorised at
+//! x_k; a kept one contracts). Where
+//! R(x_k) is above the tolerance the loop goes on as before. It saves one residual of a step's
+//! two to four: a 100-segment mooring line at 5 ms steps (modified Newton, two iterations a
+//! step) evaluates two residuals a step instead of three, with the same iterates bit for bit.
+//! The residual evaluation also updates what the problem derives from the iterate (a step's
+//! velocities), so only a problem whose caller does that after the solve may stop so
+//! ([`NewtonProblem::stops_on_increment`]: the index-3 steps).
 
 use crate::linear::{LinearSolver, Singular};
 
@@ -145,6 +162,8 @@ pub struct IterationMatrix {
     key: Option<[f64; 2]>,
     /// Factorisations of iteration matrices made so far.
     pub factorisations: usize,
+    /// Residual evaluations made so far by the solves that used it.
+    pub residuals: usize,
     /// The last contraction ratio observed with the held factorisation (0 when none was).
     rate: f64,
     /// The iterate the held matrix was assembled at ([`NewtonProblem::iterate`]; empty when
@@ -220,6 +239,14 @@ pub trait NewtonProblem {
     fn round_off_reach(&self) -> f64 {
         ROUND_OFF_REACH
     }
+    /// Whether the loop may stop on an increment without evaluating the residual at the
+    /// iterate it gives (module documentation, "Stopping on the increment"): true for a problem
+    /// whose caller brings what the residual derives from the iterate (a step's velocities) up
+    /// to date after the solve. False (the default): every stop is checked on a residual at
+    /// the returned iterate.
+    fn stops_on_increment(&self) -> bool {
+        false
+    }
 }
 
 /// The largest ratio of a residual's round-off to the tolerance at which the round-off counts as
@@ -237,7 +264,8 @@ pub struct NewtonReport {
     pub iterations: usize,
     /// Factorisations made (equal to `iterations` in full Newton).
     pub factorisations: usize,
-    /// Final scaled residual norm.
+    /// The last scaled residual norm evaluated: at the returned iterate, or, when the loop
+    /// stopped on the increment, at the iterate that increment was solved from.
     pub residual: f64,
     /// Last scaled increment norm.
     pub increment: f64,
@@ -362,8 +390,19 @@ pub fn solve(
     // factorised at that iteration.
     let mut increment_before = f64::INFINITY;
     let mut fresh = false;
+    // Whether an increment leaves the iterate close enough to the solution (module
+    // documentation): one made with a matrix factorised at its iterate as full Newton's, one
+    // made with a kept matrix far below the tolerance.
+    let close_enough = |increment: f64, fresh: bool| {
+        if !while_fast || fresh {
+            increment <= options.tolerance
+        } else {
+            increment <= REUSED_ERROR_SHARE * options.tolerance
+        }
+    };
     for iteration in 0..=options.max_iterations {
         problem.residual(r);
+        matrix.residuals += 1;
         residual = inf_norm(r);
         if !residual.is_finite() {
             return Err(NewtonFailure::NotConverged {
@@ -384,12 +423,7 @@ pub fn solve(
         } else {
             options.tolerance
         };
-        // Whether the distance to the solution is small enough (module documentation).
-        let close = if !while_fast || fresh {
-            increment <= options.tolerance
-        } else {
-            increment <= REUSED_ERROR_SHARE * options.tolerance
-        };
+        let close = close_enough(increment, fresh);
         if iteration > 0 && residual <= reachable && (close || at_floor) {
             return Ok(NewtonReport {
                 iterations: iteration,
@@ -455,7 +489,21 @@ pub fn solve(
                 detail: "the Newton increment is not finite (numerically singular matrix)".into(),
             }));
         }
+        // Stopping on the increment (module documentation): the residual it was solved from
+        // is within the tolerance and the increment leaves the iterate close enough, by the
+        // same test the next iteration would make; its residual need not be evaluated.
+        let stop = close_enough(increment, fresh)
+            && residual <= options.tolerance
+            && problem.stops_on_increment();
         problem.update(r);
+        if stop {
+            return Ok(NewtonReport {
+                iterations: iteration + 1,
+                factorisations,
+                residual,
+                increment,
+            });
+        }
     }
     Err(NewtonFailure::NotConverged {
         iterations: options.max_iterations,
@@ -616,6 +664,87 @@ mod tests {
         fn update(&mut self, dx: &[f64]) {
             self.x -= dx[0];
         }
+    }
+
+    /// [`Cubic`] counting its residual evaluations, which may stop on an increment.
+    struct CountedCubic {
+        cubic: Cubic,
+        stops_on_increment: bool,
+        residuals: usize,
+    }
+
+    impl NewtonProblem for CountedCubic {
+        fn residual(&mut self, r: &mut [f64]) {
+            self.residuals += 1;
+            self.cubic.residual(r);
+        }
+        fn jacobian(&mut self, values: &mut [f64]) {
+            self.cubic.jacobian(values);
+        }
+        fn update(&mut self, dx: &[f64]) {
+            self.cubic.update(dx);
+        }
+        fn stops_on_increment(&self) -> bool {
+            self.stops_on_increment
+        }
+    }
+
+    /// Solves x^3 + x = c for c = 1.001, ..., 1.2 as [`cubic_sequence`] does: the roots found,
+    /// the residuals evaluated and the linear solves made.
+    fn counted_sequence(policy: JacobianReuse, on_increment: bool) -> (Vec<f64>, usize, usize) {
+        let options = NewtonOptions {
+            jacobian_reuse: policy,
+            ..Default::default()
+        };
+        let mut solver: Box<dyn LinearSolver> = Box::new(DenseLu::new(1));
+        let (mut values, mut r) = (vec![0.0], vec![0.0]);
+        let mut matrix = IterationMatrix::default();
+        let mut problem = CountedCubic {
+            cubic: Cubic {
+                x: cubic_root(1.0),
+                c: 1.0,
+            },
+            stops_on_increment: on_increment,
+            residuals: 0,
+        };
+        let (mut roots, mut solves) = (Vec::new(), 0);
+        for k in 1..=200 {
+            problem.cubic.c = 1.0 + 1e-3 * k as f64;
+            let work = LinearWork::new(&mut solver, &mut values, &mut r, &mut matrix);
+            let report = solve(&mut problem, work, [1e-3, 1.0], &options).expect("converged");
+            solves += report.iterations;
+            roots.push(problem.cubic.x);
+        }
+        (roots, problem.residuals, solves)
+    }
+
+    /// Stopping on the increment finds the same iterate as the stop on the residual at it
+    /// (bit for bit, under each policy: the residual there is far below the tolerance) with
+    /// fewer residual evaluations: without it every solve evaluates one residual more than it
+    /// makes linear solves; with it, a solve whose residual before its last increment is within
+    /// the tolerance does not (measured: full Newton 600 instead of 800 residuals, all 200
+    /// solves; the default 800 instead of 825; modified Newton 1,324 instead of 1,460).
+    #[test]
+    fn stopping_on_the_increment_saves_the_last_residual_and_finds_the_same_root() {
+        for policy in [
+            JacobianReuse::Never,
+            JacobianReuse::WhileFast,
+            JacobianReuse::Always,
+        ] {
+            let (roots, residuals, solves) = counted_sequence(policy, false);
+            let (early_roots, early_residuals, early_solves) = counted_sequence(policy, true);
+            assert_eq!(roots, early_roots, "{policy:?}");
+            assert_eq!(solves, early_solves, "{policy:?}");
+            assert_eq!(residuals, solves + 200, "{policy:?}");
+            assert!(
+                early_residuals >= solves && early_residuals < residuals,
+                "{policy:?}: {early_residuals} residuals against {residuals}, {solves} solves"
+            );
+        }
+        // Full Newton's residual before its last increment is already within the tolerance
+        // (quadratic convergence): every solve stops on that increment.
+        let (_, early_residuals, solves) = counted_sequence(JacobianReuse::Never, true);
+        assert_eq!(early_residuals, solves);
     }
 
     /// The root of x^3 + x = c >= 0 by bisection on [0, max(c, 1)], to round-off: the

@@ -124,6 +124,11 @@ impl<'a, R: Index3Rule> StepProblem<'a, R> {
 }
 
 impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
+    /// [`index3_step`] updates the velocities from the returned positions.
+    fn stops_on_increment(&self) -> bool {
+        true
+    }
+
     fn residual(&mut self, r: &mut [f64]) {
         if self.parallel.is_some() {
             self.kinematics_parallel();
