@@ -70,7 +70,7 @@ def run(sizes: tuple[int, ...] = SIZES, hanging: bool = True, out=print) -> floa
     shape = "hanging" if hanging else "swinging"
     out(
         f"vinculo scaling: {shape} chains, 0.1 m links, 0.1 kg, dt = 1e-3 "
-        "(trapezoidal rule, full Newton; set-up of a run apart)"
+        "(trapezoidal rule, the default Newton; set-up of a run apart)"
     )
     out(
         f"{'N':>9} {'steps':>6} {'s/step':>11} {'us/particle':>12} {'set-up s':>9} "

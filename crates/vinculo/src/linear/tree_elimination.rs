@@ -118,6 +118,7 @@
 //! conditions on a particle's block) it declines and the caller falls back to the general sparse
 //! LU.
 
+use super::block_slots::{BlockSlots, ABSENT};
 use super::{LinearSolver, Singular, SparseLu};
 use crate::assembly::{Pattern, Storage};
 
@@ -148,7 +149,6 @@ pub const MAX_COUPLED_ANCESTORS: usize = 8;
 /// documentation): the ends of a line held at both ends.
 const MAX_EDGE_BLOCKS: usize = 4;
 
-const ABSENT: u32 = u32::MAX;
 const ROOT: u32 = u32::MAX;
 
 /// Tree-structured block LU (see the module documentation).
@@ -175,10 +175,11 @@ pub struct TreeElimination {
     /// Global unknown of each local unknown.
     unknowns: Vec<u32>,
     /// Slots of D_b (row-major), of A_ub for the ancestors u of U_b in turn (3 x n_b each,
-    /// row-major) and of [A_bu for u in U_b] (n_b x 3|U_b|, row-major).
-    diag_slots: Vec<u32>,
-    low_slots: Vec<u32>,
-    up_slots: Vec<u32>,
+    /// row-major) and of [A_bu for u in U_b] (n_b x 3|U_b|, row-major); a uniform chain's
+    /// are periodic (`block_slots.rs`).
+    diag_slots: BlockSlots,
+    low_slots: BlockSlots,
+    up_slots: BlockSlots,
     /// LU factors of D_b, the A_ub (G_b = A_Pb D_b^-1 once a uniform chain is factorised, see
     /// the module documentation), and W_b = D_b^-1 [A_bu for u in U_b], in the slots' layout.
     diag: Vec<f64>,
@@ -642,6 +643,15 @@ impl TreeElimination {
             }
             _ => (0, 0, 0),
         };
+        // The uniform run's slots are periodic: kept as its first block's and their steps.
+        let candidates = if uniform > 0 { head..tail } else { 0..0 };
+        let diag_slots = BlockSlots::new(diag_slots, candidates.clone(), uniform * uniform, |b| {
+            diag_at[b]
+        });
+        let low_slots = BlockSlots::new(low_slots, candidates.clone(), 3 * uniform, |b| {
+            coupling_at[b]
+        });
+        let up_slots = BlockSlots::new(up_slots, candidates, 3 * uniform, |b| coupling_at[b]);
         Ok(TreeElimination {
             uniform,
             head,
@@ -690,13 +700,13 @@ impl TreeElimination {
     /// entry for entry, so the slots are the same), for the fallback's analysis.
     fn pattern(&self) -> Pattern {
         let n = self.unknowns.len();
-        let mut entries = Vec::with_capacity(self.diag_slots.len() + 2 * self.low_slots.len());
+        let mut entries = Vec::with_capacity(self.diag.len() + 2 * self.low.len());
         for b in 0..self.blocks() {
             let local = &self.unknowns[self.start[b]..self.start[b + 1]];
             let nb = local.len();
             for (i, &ui) in local.iter().enumerate() {
                 for (j, &uj) in local.iter().enumerate() {
-                    if self.diag_slots[self.diag_at[b] + i * nb + j] != ABSENT {
+                    if self.diag_slots.get(self.diag_at[b] + i * nb + j) != ABSENT {
                         entries.push((ui as usize, uj as usize));
                     }
                 }
@@ -707,10 +717,10 @@ impl TreeElimination {
                 for r in 0..3 {
                     let up = self.unknowns[self.start[u as usize] + r] as usize;
                     for (j, &uj) in local.iter().enumerate() {
-                        if self.low_slots[at + 3 * nb * i + r * nb + j] != ABSENT {
+                        if self.low_slots.get(at + 3 * nb * i + r * nb + j) != ABSENT {
                             entries.push((up, uj as usize));
                         }
-                        if self.up_slots[at + j * 3 * k + 3 * i + r] != ABSENT {
+                        if self.up_slots.get(at + j * 3 * k + 3 * i + r) != ABSENT {
                             entries.push((uj as usize, up));
                         }
                     }
@@ -761,9 +771,10 @@ impl TreeElimination {
     fn gather_block(&mut self, b: usize, values: &[f64]) {
         let (da, db) = (self.diag_at[b], self.diag_at[b + 1]);
         let (ca, cb) = (self.coupling_at[b], self.coupling_at[b + 1]);
-        gather(&mut self.diag[da..db], &self.diag_slots[da..db], values);
-        gather(&mut self.low[ca..cb], &self.low_slots[ca..cb], values);
-        gather(&mut self.w[ca..cb], &self.up_slots[ca..cb], values);
+        self.diag_slots
+            .gather(da..db, &mut self.diag[da..db], values);
+        self.low_slots.gather(ca..cb, &mut self.low[ca..cb], values);
+        self.up_slots.gather(ca..cb, &mut self.w[ca..cb], values);
         self.gathered[b] = true;
     }
 
@@ -826,13 +837,6 @@ impl TreeElimination {
             }
         }
         Ok(())
-    }
-}
-
-/// Gathers `values` at `slots` into `out` (absent entries are zero).
-fn gather(out: &mut [f64], slots: &[u32], values: &[f64]) {
-    for (o, &s) in out.iter_mut().zip(slots) {
-        *o = if s == ABSENT { 0.0 } else { values[s as usize] };
     }
 }
 
@@ -1325,6 +1329,16 @@ mod tests {
         v
     }
 
+    impl TreeElimination {
+        /// Slots kept one by one, and the storage entries.
+        fn slots_kept(&self) -> (usize, usize) {
+            let kept = self.diag_slots.explicit_len()
+                + self.low_slots.explicit_len()
+                + self.up_slots.explicit_len();
+            (kept, self.diag.len() + self.low.len() + self.w.len())
+        }
+    }
+
     fn solve(solver: &mut dyn LinearSolver, values: &[f64], b: &[f64]) -> Vec<f64> {
         solver.factor(values).unwrap();
         let mut x = b.to_vec();
@@ -1340,7 +1354,8 @@ mod tests {
     /// its parent alone) are solved by matrix-vector products (module documentation), and so
     /// are those of the other two chains but their ends' (the block of 5 of the node next to a
     /// second anchor, the block of 6 of an end with its three coordinates prescribed, the
-    /// root), the branched string's by the general sweeps.
+    /// root), the branched string's by the general sweeps. The chains' slots are periodic
+    /// over their uniform run (`block_slots.rs`): at most six blocks keep theirs one by one.
     #[test]
     fn tree_elimination_matches_sparse_lu() {
         use crate::integrators::fixtures::chain;
@@ -1372,6 +1387,12 @@ mod tests {
             let mut tree = TreeElimination::analyse(&layout.pattern, 3 * layout.free)
                 .expect("a chain and a branched string are trees");
             assert_eq!((tree.uniform, tree.head, tree.tail), (uniform, head, tail));
+            let (kept, entries) = tree.slots_kept();
+            if uniform > 0 {
+                assert!(kept <= 6 * entries / tree.blocks(), "{kept} of {entries}");
+            } else {
+                assert_eq!(kept, entries);
+            }
             let mut lu = SparseLu::new(&layout.pattern);
             let n = layout.unknowns();
             let mut rng = Lcg(seed + 100);
