@@ -84,7 +84,8 @@
 //! step) evaluates two residuals a step instead of three, with the same iterates bit for bit.
 //! The residual evaluation also updates what the problem derives from the iterate (a step's
 //! velocities), so only a problem whose caller does that after the solve may stop so
-//! ([`NewtonProblem::stops_on_increment`]: the index-3 steps).
+//! ([`NewtonProblem::stops_on_increment`]: the index-3 steps, and the GGL steps, whose velocities
+//! are unknowns of their own).
 
 use crate::linear::{LinearSolver, Singular};
 

@@ -346,6 +346,13 @@ impl StabilizedProblem<'_> {
 }
 
 impl NewtonProblem for StabilizedProblem<'_> {
+    /// The iterate holds the velocities (unknowns of their own), and the evaluation point the
+    /// residual derives serves only the Jacobian at the same iterate, which Newton assembles
+    /// after a residual there: nothing needs the residual at the returned iterate.
+    fn stops_on_increment(&self) -> bool {
+        true
+    }
+
     fn residual(&mut self, r: &mut [f64]) {
         let (system, layout, rule) = (self.system, self.layout, self.rule);
         let point = rule.point;
