@@ -690,9 +690,18 @@ mod tests {
         }
     }
 
-    /// Solves x^3 + x = c for c = 1.001, ..., 1.2 as [`cubic_sequence`] does: the roots found,
-    /// the residuals evaluated and the linear solves made.
-    fn counted_sequence(policy: JacobianReuse, on_increment: bool) -> (Vec<f64>, usize, usize) {
+    /// A run of 200 solves of x^3 + x = c for c = 1.001, 1.002, ..., 1.2, each from the
+    /// previous root.
+    struct CubicRun {
+        /// The root found by each solve.
+        roots: Vec<f64>,
+        residuals: usize,
+        solves: usize,
+        factorisations: usize,
+    }
+
+    /// The run of [`CubicRun`] with `policy`, stopping on increments or not.
+    fn counted_sequence(policy: JacobianReuse, on_increment: bool) -> CubicRun {
         let options = NewtonOptions {
             jacobian_reuse: policy,
             ..Default::default()
@@ -716,7 +725,12 @@ mod tests {
             solves += report.iterations;
             roots.push(problem.cubic.x);
         }
-        (roots, problem.residuals, solves)
+        CubicRun {
+            roots,
+            residuals: problem.residuals,
+            solves,
+            factorisations: matrix.factorisations,
+        }
     }
 
     /// Stopping on the increment finds the same iterate as the stop on the residual at it
@@ -732,20 +746,22 @@ mod tests {
             JacobianReuse::WhileFast,
             JacobianReuse::Always,
         ] {
-            let (roots, residuals, solves) = counted_sequence(policy, false);
-            let (early_roots, early_residuals, early_solves) = counted_sequence(policy, true);
-            assert_eq!(roots, early_roots, "{policy:?}");
-            assert_eq!(solves, early_solves, "{policy:?}");
+            let checked = counted_sequence(policy, false);
+            let early = counted_sequence(policy, true);
+            let (residuals, solves) = (checked.residuals, checked.solves);
+            assert_eq!(checked.roots, early.roots, "{policy:?}");
+            assert_eq!(solves, early.solves, "{policy:?}");
             assert_eq!(residuals, solves + 200, "{policy:?}");
             assert!(
-                early_residuals >= solves && early_residuals < residuals,
-                "{policy:?}: {early_residuals} residuals against {residuals}, {solves} solves"
+                early.residuals >= solves && early.residuals < residuals,
+                "{policy:?}: {} residuals against {residuals}, {solves} solves",
+                early.residuals
             );
         }
         // Full Newton's residual before its last increment is already within the tolerance
         // (quadratic convergence): every solve stops on that increment.
-        let (_, early_residuals, solves) = counted_sequence(JacobianReuse::Never, true);
-        assert_eq!(early_residuals, solves);
+        let full = counted_sequence(JacobianReuse::Never, true);
+        assert_eq!(full.residuals, full.solves);
     }
 
     /// The root of x^3 + x = c >= 0 by bisection on [0, max(c, 1)], to round-off: the
@@ -763,28 +779,14 @@ mod tests {
         0.5 * (lo + hi)
     }
 
-    /// Solves x^3 + x = c for c = 1.001, 1.002, ..., 1.2, each from the previous root, with
-    /// `policy`: the largest distance to the bisection root and the factorisations made.
+    /// The run of [`CubicRun`] with `policy` (every stop checked on a residual): the largest
+    /// distance to the bisection root and the factorisations made.
     fn cubic_sequence(policy: JacobianReuse) -> (f64, usize) {
-        let options = NewtonOptions {
-            jacobian_reuse: policy,
-            ..Default::default()
-        };
-        let mut solver: Box<dyn LinearSolver> = Box::new(DenseLu::new(1));
-        let (mut values, mut r) = (vec![0.0], vec![0.0]);
-        let mut matrix = IterationMatrix::default();
-        let mut problem = Cubic {
-            x: cubic_root(1.0),
-            c: 1.0,
-        };
-        let mut worst = 0.0f64;
-        for k in 1..=200 {
-            problem.c = 1.0 + 1e-3 * k as f64;
-            let work = LinearWork::new(&mut solver, &mut values, &mut r, &mut matrix);
-            solve(&mut problem, work, [1e-3, 1.0], &options).expect("converged");
-            worst = worst.max((problem.x - cubic_root(problem.c)).abs());
-        }
-        (worst, matrix.factorisations)
+        let run = counted_sequence(policy, false);
+        let worst = (1..=200).zip(&run.roots).fold(0.0f64, |worst, (k, x)| {
+            worst.max((x - cubic_root(1.0 + 1e-3 * k as f64)).abs())
+        });
+        (worst, run.factorisations)
     }
 
     /// The default keeps a matrix while it contracts fast (here from each solve's first
