@@ -142,8 +142,11 @@ def run_vinculo(
         )
         seconds = time.perf_counter() - start
         if best is None or seconds < best.seconds:
-            iterations = np.mean(solution.newton_iterations[1:])
-            note = f"{solution.linear_solver}, {iterations:.1f} Newton it./step"
+            # Run totals (only the last state is stored).
+            note = (
+                f"{solution.linear_solver}, {solution.residual_evaluations / chain.steps:.2f} "
+                f"residuals/step, {solution.factorisations / chain.steps:.2f} factorisations/step"
+            )
             best = Result(seconds, np.array([solution.point(c)[-1] for c in centres]), note)
     assert best is not None
     return best
