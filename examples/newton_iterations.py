@@ -66,8 +66,8 @@ def main() -> None:
                              label=name)
         axes[0].set(xlabel="t (s)", ylabel="iterations", title="Newton iterations per step")
         axes[0].legend(fontsize=8)
-        axes[1].set(xlabel="t (s)", ylabel="final scaled residual (m)",
-                    title="where each step stopped")
+        axes[1].set(xlabel="t (s)", ylabel="last scaled residual evaluated (m)",
+                    title="where each step last evaluated its residual")
         axes[1].legend(fontsize=8, markerscale=6)
         fig.savefig(args.plot, dpi=110)
         print(f"plot: {args.plot}")

@@ -978,7 +978,7 @@ class RunResult:
         """Size of each stored step, shape (s,), in s."""
     @property
     def residual_norms(self) -> npt.NDArray[np.float64]:
-        """Final scaled residual norm of each stored step, shape (s,), in m."""
+        """The last scaled residual norm Newton evaluated in each stored step, shape (s,), in m."""
     @property
     def increment_norms(self) -> npt.NDArray[np.float64]:
         """Last scaled Newton increment norm of each stored step, shape (s,), in m."""

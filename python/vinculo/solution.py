@@ -74,7 +74,9 @@ class Solution:
             ``formulation='ggl'`` both levels hold at every step, to the Newton tolerance.
         newton_iterations: (s,) Newton iterations of each step.
         step_sizes: (s,) size of each step, in s (smaller than ``dt`` where steps were halved).
-        residual_norms: (s,) final residual norm of each step's Newton solve.
+        residual_norms: (s,) the last scaled residual norm each step's Newton solve evaluated:
+            at the step's answer, or at the iterate before its last increment when Newton stopped
+            on that increment (docs/theory/newton.md).
         increment_norms: (s,) norm of each step's last Newton increment.
         error: None after a complete run; for the partial solution carried by a
             :class:`vinculo.ConvergenceError`, the core's description of the failure (keys

@@ -137,7 +137,7 @@ impl PyRunResult {
         self.stat(py, |x| x.step_size)
     }
 
-    /// Final scaled residual norm of each stored step, shape (s,), in m.
+    /// The last scaled residual norm Newton evaluated in each stored step, shape (s,), in m.
     #[getter]
     fn residual_norms<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.stat(py, |x| x.residual_norm)

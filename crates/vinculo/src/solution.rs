@@ -11,7 +11,8 @@ pub struct StepStats {
     pub newton_iterations: usize,
     /// Step size used (0 for the initial state).
     pub step_size: f64,
-    /// Final scaled residual norm (m).
+    /// The last scaled residual norm Newton evaluated (m): at the step's answer, or at the iterate
+    /// before its last increment when Newton stopped on that increment (`integrators/newton.rs`).
     pub residual_norm: f64,
     /// Last scaled Newton increment norm (m).
     pub increment_norm: f64,
