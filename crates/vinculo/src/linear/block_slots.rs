@@ -150,31 +150,48 @@ fn longest_run(
         return None;
     }
     let block = |b: usize| &slots[first_entry(b)..first_entry(b) + per_block];
-    let step = |a: usize| -> Option<Vec<i64>> {
+    // The step of each entry from block a to a + 1 (a fill entry stays fill: step 0), into `d`;
+    // false when a fill entry becomes a slot or back.
+    let step_into = |a: usize, d: &mut Vec<i64>| {
+        d.clear();
+        for (&s, &t) in block(a).iter().zip(block(a + 1)) {
+            match (s == ABSENT, t == ABSENT) {
+                (true, true) => d.push(0),
+                (false, false) => d.push(t as i64 - s as i64),
+                _ => return false,
+            }
+        }
+        true
+    };
+    // Whether block a + 1's slots are block a's advanced by `d`.
+    let same_step = |a: usize, d: &[i64]| {
         block(a)
             .iter()
             .zip(block(a + 1))
-            .map(|(&s, &t)| match (s == ABSENT, t == ABSENT) {
-                (true, true) => Some(0),
-                (false, false) => Some(t as i64 - s as i64),
-                _ => None,
+            .zip(d)
+            .all(|((&s, &t), &d)| {
+                if s == ABSENT {
+                    t == ABSENT
+                } else {
+                    t != ABSENT && t as i64 - s as i64 == d
+                }
             })
-            .collect()
     };
     // Scan the candidates: a run grows while the step between neighbours stays the same.
     let mut best: Option<(usize, usize, Vec<i64>)> = None;
+    let mut d = Vec::with_capacity(per_block);
     let mut b = candidates.start;
     while b + 1 < candidates.end {
-        let Some(d) = step(b) else {
+        if !step_into(b, &mut d) {
             b += 1;
             continue;
-        };
+        }
         let mut end = b + 2;
-        while end < candidates.end && step(end - 1).as_ref() == Some(&d) {
+        while end < candidates.end && same_step(end - 1, &d) {
             end += 1;
         }
         if best.as_ref().is_none_or(|(s, e, _)| end - b > e - s) {
-            best = Some((b, end, d));
+            best = Some((b, end, d.clone()));
         }
         b = end - 1;
     }
