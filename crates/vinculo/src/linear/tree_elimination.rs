@@ -182,9 +182,7 @@ pub struct TreeElimination {
     up_slots: BlockSlots,
     /// LU factors of D_b, the A_ub (G_b = A_Pb D_b^-1 once a uniform chain is factorised, see
     /// the module documentation), and W_b = D_b^-1 [A_bu for u in U_b], in the slots' layout.
-    diag: Vec<f64>,
-    low: Vec<f64>,
-    w: Vec<f64>,
+    store: BlockStore,
     /// Row interchanges of each block's LU (local indices).
     perm: Vec<u32>,
     /// Work vector in local (block) order.
@@ -208,6 +206,45 @@ pub struct TreeElimination {
     on_fallback: bool,
     /// Factorisations made by the fallback.
     fallbacks: usize,
+}
+
+/// The blocks' storage, one array: the D_b (`diag`), then the A_ub or G_b (`low`), then the
+/// W_b (`w`), each in the layout of its slots.
+struct BlockStore {
+    values: Vec<f64>,
+    /// Where `low` and `w` start.
+    low_at: usize,
+    w_at: usize,
+}
+
+impl BlockStore {
+    /// Zeroed storage of `diag` entries of diagonal blocks and `coupling` entries of couplings.
+    fn new(diag: usize, coupling: usize) -> BlockStore {
+        BlockStore {
+            values: vec![0.0; diag + 2 * coupling],
+            low_at: diag,
+            w_at: diag + coupling,
+        }
+    }
+
+    fn diag(&self) -> &[f64] {
+        &self.values[..self.low_at]
+    }
+
+    fn low(&self) -> &[f64] {
+        &self.values[self.low_at..self.w_at]
+    }
+
+    fn w(&self) -> &[f64] {
+        &self.values[self.w_at..]
+    }
+
+    /// The three parts, to write.
+    fn parts_mut(&mut self) -> (&mut [f64], &mut [f64], &mut [f64]) {
+        let (diag, rest) = self.values.split_at_mut(self.low_at);
+        let (low, w) = rest.split_at_mut(self.w_at - self.low_at);
+        (diag, low, w)
+    }
 }
 
 /// Union-find root with path halving.
@@ -657,9 +694,7 @@ impl TreeElimination {
             head,
             tail,
             gathered: vec![false; blocks],
-            diag: vec![0.0; diag_at[blocks]],
-            low: vec![0.0; coupling_at[blocks]],
-            w: vec![0.0; coupling_at[blocks]],
+            store: BlockStore::new(diag_at[blocks], coupling_at[blocks]),
             perm: vec![0; n],
             z: vec![0.0; n],
             start,
@@ -700,7 +735,7 @@ impl TreeElimination {
     /// entry for entry, so the slots are the same), for the fallback's analysis.
     fn pattern(&self) -> Pattern {
         let n = self.unknowns.len();
-        let mut entries = Vec::with_capacity(self.diag.len() + 2 * self.low.len());
+        let mut entries = Vec::with_capacity(self.store.values.len());
         for b in 0..self.blocks() {
             let local = &self.unknowns[self.start[b]..self.start[b + 1]];
             let nb = local.len();
@@ -771,10 +806,10 @@ impl TreeElimination {
     fn gather_block(&mut self, b: usize, values: &[f64]) {
         let (da, db) = (self.diag_at[b], self.diag_at[b + 1]);
         let (ca, cb) = (self.coupling_at[b], self.coupling_at[b + 1]);
-        self.diag_slots
-            .gather(da..db, &mut self.diag[da..db], values);
-        self.low_slots.gather(ca..cb, &mut self.low[ca..cb], values);
-        self.up_slots.gather(ca..cb, &mut self.w[ca..cb], values);
+        let (diag, low, w) = self.store.parts_mut();
+        self.diag_slots.gather(da..db, &mut diag[da..db], values);
+        self.low_slots.gather(ca..cb, &mut low[ca..cb], values);
+        self.up_slots.gather(ca..cb, &mut w[ca..cb], values);
         self.gathered[b] = true;
     }
 
@@ -787,7 +822,8 @@ impl TreeElimination {
     fn eliminate(&mut self, b: usize, nb: usize, k: usize) -> Result<(), usize> {
         let s = self.start[b];
         let (da, db) = (self.diag_at[b], self.diag_at[b + 1]);
-        let (own_diag, rest_diag) = self.diag.split_at_mut(db);
+        let (diag, low, w) = self.store.parts_mut();
+        let (own_diag, rest_diag) = diag.split_at_mut(db);
         let d = &mut own_diag[da..];
         let perm = &mut self.perm[s..s + nb];
         lu_in_place(d, nb, perm)?;
@@ -797,8 +833,8 @@ impl TreeElimination {
             return Ok(());
         }
         let (ca, cb) = (self.coupling_at[b], self.coupling_at[b + 1]);
-        let (own_w, rest_w) = self.w.split_at_mut(cb);
-        let (own_low, rest_low) = self.low.split_at_mut(cb);
+        let (own_w, rest_w) = w.split_at_mut(cb);
+        let (own_low, rest_low) = low.split_at_mut(cb);
         let (w, low) = (
             &mut own_w[ca..ca + 3 * nb * k],
             &own_low[ca..ca + 3 * nb * k],
@@ -1114,7 +1150,7 @@ impl TreeElimination {
     #[inline]
     fn forward_general(&mut self, b: usize) {
         let (s, e) = (self.start[b], self.start[b + 1]);
-        let d = &self.diag[self.diag_at[b]..self.diag_at[b + 1]];
+        let d = &self.store.diag()[self.diag_at[b]..self.diag_at[b + 1]];
         let (head, tail) = self.z.split_at_mut(e);
         let zb = &mut head[s..];
         let perm = &self.perm[s..e];
@@ -1126,7 +1162,7 @@ impl TreeElimination {
             nb => lu_solve(d, nb, perm, zb, 1),
         }
         let nb = e - s;
-        let low = &self.low[self.coupling_at[b]..self.coupling_at[b + 1]];
+        let low = &self.store.low()[self.coupling_at[b]..self.coupling_at[b + 1]];
         let set = &self.ancestors[self.coupled_at[b]..self.coupled_at[b + 1]];
         for (i, &u) in set.iter().enumerate() {
             let zu = &mut tail[self.start[u as usize] - e..];
@@ -1145,7 +1181,7 @@ impl TreeElimination {
         let (s, e) = (self.start[b], self.start[b + 1]);
         let (head, tail) = self.z.split_at_mut(e);
         let zb = &mut head[s..];
-        let w = &self.w[self.coupling_at[b]..self.coupling_at[b] + 3 * k * (e - s)];
+        let w = &self.store.w()[self.coupling_at[b]..self.coupling_at[b] + 3 * k * (e - s)];
         for (i, &u) in set.iter().enumerate() {
             let at = self.start[u as usize] - e;
             let xu = [tail[at], tail[at + 1], tail[at + 2]];
@@ -1160,10 +1196,11 @@ impl TreeElimination {
     /// becomes G_b = A_Pb D_b^-1, each of its rows solved from the factors transposed.
     fn make_explicit<const N: usize>(&mut self) {
         let (h, t) = (self.head, self.tail);
-        let blocks = self.diag[self.diag_at[h]..self.diag_at[t]]
+        let (diag, low, _) = self.store.parts_mut();
+        let blocks = diag[self.diag_at[h]..self.diag_at[t]]
             .chunks_exact(N * N)
             .zip(self.perm[self.start[h]..self.start[t]].chunks_exact(N))
-            .zip(self.low[self.coupling_at[h]..self.coupling_at[t]].chunks_exact_mut(3 * N));
+            .zip(low[self.coupling_at[h]..self.coupling_at[t]].chunks_exact_mut(3 * N));
         for ((d, perm), low) in blocks {
             for row in low.chunks_exact_mut(N) {
                 let row: &mut [f64; N] = row.try_into().expect("N entries");
@@ -1189,7 +1226,7 @@ impl TreeElimination {
         // written to memory and read back at once as a block, it would wait for the stores.
         let mut carry = [0.0f64; 3];
         let mut carried_to = usize::MAX;
-        let low = self.low[c0..].chunks_exact(3 * N);
+        let low = self.store.low()[c0..].chunks_exact(3 * N);
         for (k, (g, &pb)) in low.zip(&self.parent[h..t]).enumerate() {
             let b = h + k;
             if carried_to != b {
@@ -1229,10 +1266,10 @@ impl TreeElimination {
         }
         let start = &self.start;
         let z = &mut self.z;
-        let blocks = self.diag[d0..]
+        let blocks = self.store.diag()[d0..]
             .chunks_exact(N * N)
             .zip(self.perm[z0..].chunks_exact(N))
-            .zip(self.w[c0..].chunks_exact(3 * N))
+            .zip(self.store.w()[c0..].chunks_exact(3 * N))
             .zip(&self.parent[h..t]);
         for (k, (((d, perm), w), &pb)) in blocks.enumerate().rev() {
             let (before, after) = z.split_at_mut(z0 + N * k + N);
@@ -1335,7 +1372,7 @@ mod tests {
             let kept = self.diag_slots.explicit_len()
                 + self.low_slots.explicit_len()
                 + self.up_slots.explicit_len();
-            (kept, self.diag.len() + self.low.len() + self.w.len())
+            (kept, self.store.values.len())
         }
     }
 
