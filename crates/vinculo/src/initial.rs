@@ -16,41 +16,57 @@ use crate::assembly::{Layout, NONE};
 use crate::constraints::Constraint;
 use crate::error::{Error, Result};
 use crate::integrators::StepWorkspace;
-use crate::linear::Singular;
+use crate::linear::{assemble_and_factor, Singular};
 use crate::math::{dot, Vec3};
 use crate::model::System;
 
-/// Fills `[M/m_ref, -s G^T; s G, 0]` at positions q, time t. The row of a compliant
-/// constraint (`docs/theory/moorings.md`) is instead its scaled multiplier lambda / (s m_ref)
-/// alone: the multiplier (the tension) follows from the stretch, `c lambda = -Phi`, and puts
-/// no condition on the accelerations or on the positions.
-fn fill_saddle(system: &System, ws: &mut StepWorkspace, q: &[Vec3], t: f64) {
-    fill_saddle_rows(system, ws, (q, t), true)
-}
-
-/// [`fill_saddle`], with the compliant constraints' rows as exact ones when `compliant` is
-/// false.
-fn fill_saddle_rows(
+/// Assembles `[M/m_ref, -s G^T; s G, 0]` at positions q, time t, and factorises it in
+/// `ws.solver`. The row of a compliant constraint (`docs/theory/moorings.md`) is instead its
+/// scaled multiplier lambda / (s m_ref) alone: the multiplier (the tension) follows from the
+/// stretch, `c lambda = -Phi`, and puts no condition on the accelerations or on the positions.
+/// With `compliant` false, the compliant constraints' rows are exact ones.
+fn factor_saddle_rows(
     system: &System,
     ws: &mut StepWorkspace,
     (q, t): (&[Vec3], f64),
     compliant: bool,
+) -> std::result::Result<(), Singular> {
+    let StepWorkspace {
+        layout,
+        solver,
+        values,
+        inertia,
+        axial_added_mass: axial,
+        scales,
+        mass_ref,
+        ..
+    } = ws;
+    let (layout, mass_ref) = (&*layout, *mass_ref);
+    let fill = |values: &mut [f64]| {
+        for (i, m) in inertia.iter().enumerate() {
+            layout.add_to_particle_diagonal(values, i, m / mass_ref);
+        }
+        // The line nodes' axial added-mass correction at q (`assembly/axial_added_mass.rs`).
+        let blocks = &layout.particle_block[..];
+        axial.add_mass_blocks(values, blocks, q, 1.0 / mass_ref);
+        fill_constraint_rows(system, layout, scales, (q, t), compliant, values);
+    };
+    assemble_and_factor(solver.as_mut(), values, fill)
+}
+
+/// The constraints' rows and columns of the saddle matrix (see [`factor_saddle_rows`]).
+fn fill_constraint_rows(
+    system: &System,
+    layout: &Layout,
+    scales: &[f64],
+    (q, t): (&[Vec3], f64),
+    compliant: bool,
+    values: &mut [f64],
 ) {
-    let layout = &ws.layout;
-    let values = &mut ws.values;
-    values.fill(0.0);
-    for (i, m) in ws.inertia.iter().enumerate() {
-        layout.add_to_particle_diagonal(values, i, m / ws.mass_ref);
-    }
-    // The line nodes' axial added-mass correction at q (`assembly/axial_added_mass.rs`).
-    let blocks = &layout.particle_block[..];
-    let axial = &ws.axial_added_mass;
-    axial.add_mass_blocks(&mut values[..], blocks, q, 1.0 / ws.mass_ref);
     for (c, con) in system.constraints().iter().enumerate() {
         let g = con.gradient(q, t);
         // The saddle matrix has no Hessian term: no blocks.
-        let values: &mut [f64] = values;
-        let s = ws.scales[c];
+        let s = scales[c];
         if compliant && con.is_compliant() {
             // The row is the unknown lambda / (s m_ref) itself (1 on the diagonal, whatever
             // the compliance: well conditioned as EA grows); its right-hand side says what
@@ -89,9 +105,7 @@ pub(crate) fn factor_saddle(
     q: &[Vec3],
     t: f64,
 ) -> Result<()> {
-    fill_saddle(system, ws, q, t);
-    ws.solver
-        .factor(&ws.values)
+    factor_saddle_rows(system, ws, (q, t), true)
         .map_err(|s| singular_error(system, &ws.layout, t, s))
 }
 
@@ -135,9 +149,7 @@ pub(crate) fn rigid_multipliers(
     let v = vec![[0.0; 3]; q.len()];
     rest_right_hand_side(system, ws, q, &v, t, false);
     ws.matrix.invalidate();
-    fill_saddle_rows(system, ws, (q, t), false);
-    ws.solver
-        .factor(&ws.values)
+    factor_saddle_rows(system, ws, (q, t), false)
         .map_err(|s| singular_error(system, &ws.layout, t, s))?;
     ws.solver.solve_in_place(&mut ws.r);
     let m3 = 3 * ws.layout.free;

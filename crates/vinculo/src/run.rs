@@ -410,7 +410,10 @@ pub(crate) struct HeldMatrix {
     pub(crate) point: Vec<f64>,
     /// Whether it is the GGL formulation's matrix (else the index-3 one's).
     pub(crate) ggl: bool,
-    /// Its values, in the order of the formulation's pattern.
+    /// Whether `values` are the factors of a solver that factorises in place (see
+    /// [`crate::linear::LinearSolver::factors`]) rather than the matrix.
+    pub(crate) factored: bool,
+    /// Its values, in the order of the formulation's pattern (or its factors).
     pub(crate) values: Vec<f64>,
 }
 
@@ -804,6 +807,12 @@ impl<'a> Simulation<'a> {
         &self.sol.status
     }
 
+    /// The run's workspace (its solver's statistics, for tests).
+    #[cfg(test)]
+    pub(crate) fn workspace(&self) -> &StepWorkspace {
+        &self.ws
+    }
+
     /// The stored states and statistics, ending the simulation.
     pub fn into_solution(self) -> Solution {
         self.sol
@@ -822,16 +831,19 @@ impl<'a> Simulation<'a> {
             status: self.sol.status.clone(),
             fingerprint: self.fingerprint,
             run: self.run,
-            matrix: self.ws.matrix.held().map(|(key, rate, point)| HeldMatrix {
-                key,
-                rate,
-                point: point.to_vec(),
-                ggl: self.stabilized.is_some(),
-                values: match &self.stabilized {
-                    Some(g) => g.values(),
-                    None => self.ws.values(),
-                }
-                .to_vec(),
+            matrix: self.ws.matrix.held().and_then(|(key, rate, point)| {
+                let (values, factored) = match &self.stabilized {
+                    Some(g) => (g.values().to_vec(), false),
+                    None => self.ws.matrix_record()?,
+                };
+                Some(HeldMatrix {
+                    key,
+                    rate,
+                    point: point.to_vec(),
+                    ggl: self.stabilized.is_some(),
+                    factored,
+                    values,
+                })
             }),
         }
     }
@@ -896,7 +908,7 @@ impl<'a> Simulation<'a> {
     fn adopt_matrix(&mut self, held: &HeldMatrix) {
         let factored = match &mut self.stabilized {
             Some(g) if held.ggl => g.refactor(&held.values),
-            None if !held.ggl => self.ws.refactor(&held.values),
+            None if !held.ggl => self.ws.refactor(&held.values, held.factored),
             _ => false,
         };
         if factored {

@@ -16,7 +16,7 @@
 //! | the time rule's state: 4 arrays of 3-vectors, each a u64 length then length x 3 f64 | |
 //! | step controller tag: 0 (fixed steps) or 1 (error control), then its state (below) | u8 |
 //! | accepted steps, next output, stored rows, steps taken, steps rejected, accepted step sizes, factorisations, residual evaluations | 8 x u64 |
-//! | held iteration matrix: 0 (none) or 1, then its formulation (0: index-3, 1: GGL), its key (step size and scheme coefficient), its last contraction ratio, a u64 count and that many values, a u64 count and that many values of the iterate it was assembled at | u8, then u8, 3 x f64, u64, f64s, u64, f64s |
+//! | held iteration matrix: 0 (none) or 1, then its kind (bit 0: the GGL formulation's, else the index-3 one's; bit 1: the values are the factors of a solver that factorises in place, see `LinearSolver::factors`, else the matrix in the pattern's order), its key (step size and scheme coefficient), its last contraction ratio, a u64 count and that many values, a u64 count and that many values of the iterate it was assembled at | u8, then u8, 3 x f64, u64, f64s, u64, f64s |
 //! | checksum: FNV-1a 64 of every byte before it | u64 |
 //!
 //! Fixed steps (tag 0): top u32, unit f64, units u64, level u32, t_grid f64, and the contact
@@ -320,7 +320,7 @@ impl Snapshot {
             None => w.0.push(0),
             Some(held) => {
                 w.0.push(1);
-                w.0.push(held.ggl as u8);
+                w.0.push(held.ggl as u8 | (held.factored as u8) << 1);
                 w.f64s(&[held.key[0], held.key[1], held.rate]);
                 w.sized_f64s(&held.values);
                 w.sized_f64s(&held.point);
@@ -445,7 +445,8 @@ impl Snapshot {
             *x = r.usize()?;
         }
         let matrix = if version >= 5 && r.take(1)?[0] == 1 {
-            let ggl = r.take(1)?[0] == 1;
+            let kind = r.take(1)?[0];
+            let (ggl, factored) = (kind & 1 == 1, kind & 2 == 2);
             let (key, rate) = ([r.f64()?, r.f64()?], r.f64()?);
             let values = r.sized_f64s()?;
             let point = r.sized_f64s()?;
@@ -454,6 +455,7 @@ impl Snapshot {
                 rate,
                 point,
                 ggl,
+                factored,
                 values,
             })
         } else {

@@ -34,6 +34,7 @@ use crate::integrators::newton::{
     self, JacobianReuse, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem,
 };
 use crate::integrators::{Index3Rule, StepPoint, StepProblem, StepStart, StepWorkspace};
+use crate::linear::assemble_and_factor;
 use crate::math::{Mat3, Vec3};
 use crate::model::System;
 
@@ -490,14 +491,13 @@ pub fn point_stiffness(system: &System, statics: &Statics, particle: usize) -> R
         solver, values, r, ..
     } = work;
     problem.residual(r);
-    values.fill(0.0);
-    problem.jacobian(values);
     let singular = |detail: String| Error::SingularMatrix {
         t,
         equation: format!("the static equilibrium's stiffness at particle {particle}"),
         detail,
     };
-    solver.factor(values).map_err(|s| singular(s.detail))?;
+    assemble_and_factor(solver, values, |values| problem.jacobian(values))
+        .map_err(|s| singular(s.detail))?;
     // (J^-1)_pp, column by column: the inverse of the Schur complement S on the point.
     let mut x = [[0.0; 3]; 3];
     for k in 0..3 {

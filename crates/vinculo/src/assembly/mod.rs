@@ -196,6 +196,33 @@ impl Layout {
         }
     }
 
+    /// Moves every slot of the tables to `map[slot]`: the matrix is then assembled into another
+    /// array, where the pattern's entry of slot s lies at `map[s]` (a solver's own storage, see
+    /// [`crate::linear::TreeElimination::assemble_in_place`]). The pattern's structure must have
+    /// been released: it no longer describes where the values are.
+    pub fn move_slots(&mut self, map: &[Slot]) {
+        assert!(
+            self.pattern.is_released(),
+            "the slots move only once the pattern's structure is released"
+        );
+        let moved = |s: &mut Slot| {
+            if *s != NO_SLOT {
+                *s = map[*s as usize];
+            }
+        };
+        let blocks = self.particle_block.iter_mut();
+        let blocks = blocks
+            .chain(&mut self.constraint_hessian)
+            .chain(&mut self.force_block);
+        blocks.flatten().for_each(moved);
+        let strips = self
+            .constraint_column
+            .iter_mut()
+            .chain(&mut self.constraint_row);
+        strips.flatten().for_each(moved);
+        self.constraint_diagonal.iter_mut().for_each(moved);
+    }
+
     /// Total number of unknowns.
     pub fn unknowns(&self) -> usize {
         3 * self.free + self.constraints

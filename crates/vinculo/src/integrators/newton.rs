@@ -87,7 +87,7 @@
 //! ([`NewtonProblem::stops_on_increment`]: the index-3 steps, and the GGL steps, whose velocities
 //! are unknowns of their own).
 
-use crate::linear::{LinearSolver, Singular};
+use crate::linear::{assemble_and_factor, LinearSolver, Singular};
 
 /// Options of the Newton loop.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -439,10 +439,9 @@ pub fn solve(
         }
         fresh = refresh || stale_iterations >= MAX_STALE_ITERATIONS;
         if fresh {
-            values.fill(0.0);
-            problem.jacobian(values);
             matrix.invalidate();
-            solver.factor(values).map_err(NewtonFailure::Singular)?;
+            assemble_and_factor(solver, values, |values| problem.jacobian(values))
+                .map_err(NewtonFailure::Singular)?;
             matrix.key = Some(key);
             matrix.factorisations += 1;
             factorisations += 1;

@@ -9,8 +9,20 @@ use crate::model::System;
 use super::newton::IterationMatrix;
 
 /// Patterns with more entries than this (about 100,000 chain links) are released once the
-/// solver has analysed them (see [`crate::assembly::Pattern::release_structure`]).
+/// solver has analysed them (see [`crate::assembly::Pattern::release_structure`]), and a tree
+/// elimination's matrix is then assembled into its own storage and factorised there
+/// ([`TreeElimination::assemble_in_place`]): no value array in the pattern's order is kept.
 pub const RELEASE_PATTERN_ABOVE: usize = 1 << 22;
+
+/// The release threshold, and whether trees are then assembled in place (tests set them for a
+/// thread, to run small models as large ones).
+fn release_above() -> (usize, bool) {
+    #[cfg(test)]
+    if let Some(set) = tests::RELEASE.with(|r| r.get()) {
+        return set;
+    }
+    (RELEASE_PATTERN_ABOVE, true)
+}
 
 /// Matrices, solver and buffers reused by every step of a run (no allocation per step).
 pub struct StepWorkspace {
@@ -20,7 +32,8 @@ pub struct StepWorkspace {
     pub solver: Box<dyn LinearSolver>,
     /// What that factorisation is (for modified Newton) and how many were made.
     pub matrix: IterationMatrix,
-    /// Matrix values in pattern order.
+    /// Matrix values in pattern order (empty when the solver factorises in place: the matrix
+    /// is assembled into its storage, see [`crate::linear::assemble_and_factor`]).
     pub values: Vec<f64>,
     /// Residual / increment.
     pub r: Vec<f64>,
@@ -69,15 +82,29 @@ pub(crate) fn refactor(own: &mut [f64], solver: &mut dyn LinearSolver, values: &
 }
 
 impl StepWorkspace {
-    /// The values of the last iteration matrix assembled (the one factorised last).
-    pub(crate) fn values(&self) -> &[f64] {
-        &self.values
+    /// The last iteration matrix factorised, for a snapshot: its values in the pattern's order
+    /// (false), or the factors of a solver that factorised it in place (true); None when
+    /// neither is at hand (a factorisation in place made by the fallback).
+    pub(crate) fn matrix_record(&self) -> Option<(Vec<f64>, bool)> {
+        if self.solver.in_place() {
+            self.solver.factors().map(|f| (f, true))
+        } else {
+            Some((self.values.clone(), false))
+        }
     }
 
-    /// Factorises the iteration matrix `values` again; false when they are not of this
-    /// workspace's pattern (another length) or do not factorise.
-    pub(crate) fn refactor(&mut self, values: &[f64]) -> bool {
-        refactor(&mut self.values, self.solver.as_mut(), values)
+    /// Factorises the iteration matrix `values` again (`factored`: takes the factors a
+    /// solver in place gave); false when they are not of this workspace's pattern (another
+    /// length) or do not factorise.
+    pub(crate) fn refactor(&mut self, values: &[f64], factored: bool) -> bool {
+        match (factored, self.solver.in_place()) {
+            (true, _) => self.solver.adopt_factors(values),
+            // A solver in place gathers a matrix in the pattern's order too.
+            (false, true) => {
+                values.len() == self.layout.pattern.nnz() && self.solver.factor(values).is_ok()
+            }
+            (false, false) => refactor(&mut self.values, self.solver.as_mut(), values),
+        }
     }
 
     /// Analyses the system once (solver chosen automatically).
@@ -90,11 +117,18 @@ impl StepWorkspace {
         // Tree-shaped constraint graphs get the tree elimination at every size (on a pendulum
         // or a 10-link chain it is 3x faster than the dense LU); the dense LU serves small
         // graphs with loops, the sparse LU large ones.
+        let (above, in_place) = release_above();
         let tree = match sparse {
             SparseSolver::Auto => {
-                let layout = Layout::new(system, 0);
-                TreeElimination::analyse(&layout.pattern, 3 * layout.free)
-                    .map(|tree| (layout, Box::new(tree) as Box<dyn LinearSolver>))
+                let mut layout = Layout::new(system, 0);
+                TreeElimination::analyse(&layout.pattern, 3 * layout.free).map(|mut tree| {
+                    // Large trees are assembled into the elimination's own storage.
+                    if in_place && layout.pattern.nnz() > above {
+                        layout.pattern.release_structure();
+                        layout.move_slots(&tree.assemble_in_place());
+                    }
+                    (layout, Box::new(tree) as Box<dyn LinearSolver>)
+                })
             }
             SparseSolver::SparseLu => None,
         };
@@ -104,9 +138,14 @@ impl StepWorkspace {
             (layout, solver)
         });
         // Assembly uses the slot tables only: large models free the pattern's index arrays.
-        if layout.pattern.nnz() > RELEASE_PATTERN_ABOVE {
+        if layout.pattern.nnz() > above {
             layout.pattern.release_structure();
         }
+        let entries = if solver.in_place() {
+            0
+        } else {
+            layout.pattern.nnz()
+        };
         let n = system.particles().len();
         let free: Vec<f64> = system
             .particles()
@@ -120,7 +159,7 @@ impl StepWorkspace {
             free.iter().sum::<f64>() / free.len() as f64
         };
         StepWorkspace {
-            values: vec![0.0; layout.pattern.nnz()],
+            values: vec![0.0; entries],
             r: vec![0.0; layout.unknowns()],
             solver,
             matrix: IterationMatrix::default(),
@@ -148,5 +187,220 @@ impl StepWorkspace {
     pub fn assemble_in_parallel_from(&mut self, system: &System, threshold: usize) {
         self.parallel = (self.layout.free >= threshold && !system.has_user_groups())
             .then(|| ParallelAssembly::new(system, &self.layout));
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::laws::Law;
+    use crate::run::Snapshot;
+    use crate::statics::{point_stiffness, solve_statics, StaticsOptions};
+    use crate::{Simulation, SimulationOptions, Solution};
+    use std::cell::Cell;
+
+    thread_local! {
+        /// The release threshold and in-place switch of this thread's workspaces (None: the
+        /// defaults, [`RELEASE_PATTERN_ABOVE`] and in place).
+        pub(crate) static RELEASE: Cell<Option<(usize, bool)>> = const { Cell::new(None) };
+    }
+
+    /// `f` with workspaces that release every pattern and assemble trees in place or not.
+    fn released<T>(in_place: bool, f: impl FnOnce() -> T) -> T {
+        RELEASE.with(|r| r.set(Some((0, in_place))));
+        let out = f();
+        RELEASE.with(|r| r.set(None));
+        out
+    }
+
+    /// A line of `n` elastic segments between a fixed anchor and a fixed end, with bending
+    /// stiffness, a spring-damper across two segments and drag on its middle node, released
+    /// from a straight span shorter than the line (it sags and swings).
+    fn line(n: usize) -> System {
+        let mut s = System::new([0.0, 0.0, -9.81]);
+        let mut ids = vec![s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap()];
+        for i in 1..=n {
+            let x = [0.9 * i as f64 / n as f64, 0.0, 0.0];
+            ids.push(s.add_particle(0.1, x, [0.0; 3], i == n).unwrap());
+            let segment = (Law::Constant(1.0 / n as f64), 1.0);
+            s.add_elastic_distance(ids[i - 1], ids[i], segment, 1e5)
+                .unwrap();
+        }
+        for i in 1..n {
+            s.add_bending(ids[i - 1], ids[i], ids[i + 1], 1e-3, None)
+                .unwrap();
+        }
+        s.add_spring_damper(ids[2], ids[4], 5.0, 0.1, None).unwrap();
+        s.add_quadratic_drag(ids[n / 2], 0.05).unwrap();
+        s
+    }
+
+    /// A chain of `n` links released horizontally from a fixed anchor (a uniform chain: the
+    /// elimination's explicit sweeps).
+    fn swinging(n: usize) -> System {
+        let mut s = System::new([0.0, 0.0, -9.81]);
+        let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
+        for i in 1..=n {
+            let p = s
+                .add_particle(0.1, [0.1 * i as f64, 0.0, 0.0], [0.0; 3], false)
+                .unwrap();
+            s.add_distance(prev, p, None).unwrap();
+            prev = p;
+        }
+        s
+    }
+
+    /// A chain hung as a V of two straight legs between two fixed points: the block of the
+    /// node at the bottom holds two parallel conditions at rest, and the elimination falls back
+    /// to the general sparse LU (`linear/tree_elimination.rs`).
+    fn v_chain(n: usize) -> System {
+        let mut s = System::new([0.0, 0.0, -9.81]);
+        let left = s
+            .add_particle(1.0, [-1.0, 0.0, 0.0], [0.0; 3], true)
+            .unwrap();
+        let right = s
+            .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], true)
+            .unwrap();
+        let mut prev = left;
+        for i in 1..2 * n {
+            let x = -1.0 + i as f64 / n as f64;
+            let p = s
+                .add_particle(0.1, [x, 0.0, -(1.0 - x.abs())], [0.0; 3], false)
+                .unwrap();
+            s.add_distance(prev, p, None).unwrap();
+            prev = p;
+        }
+        s.add_distance(prev, right, None).unwrap();
+        s
+    }
+
+    /// Asserts that two runs stored the same numbers, bit for bit, with the same work.
+    fn assert_same(a: &Solution, b: &Solution, what: &str) {
+        let pairs = [
+            (&a.times, &b.times, "times"),
+            (&a.positions, &b.positions, "positions"),
+            (&a.velocities, &b.velocities, "velocities"),
+            (&a.multipliers, &b.multipliers, "multipliers"),
+        ];
+        for (x, y, name) in pairs {
+            assert_eq!(x.len(), y.len(), "{what}: {name}");
+            for (k, (u, v)) in x.iter().zip(y.iter()).enumerate() {
+                assert_eq!(u.to_bits(), v.to_bits(), "{what}: {name}[{k}]: {u} vs {v}");
+            }
+        }
+        assert_eq!(a.factorisations, b.factorisations, "{what}: factorisations");
+        assert_eq!(a.residual_evaluations, b.residual_evaluations, "{what}");
+        assert_eq!(a.status, b.status, "{what}: status");
+    }
+
+    /// The matrix assembled into the tree elimination's storage and factorised there gives the
+    /// runs of the matrix gathered from the pattern's value array, bit for bit (the same sums in
+    /// the same order, at other addresses): a line with bending and forces across particles,
+    /// a uniform chain, and a V chain whose singular blocks send factorisations to the sparse
+    /// LU (after the matrix is assembled again), under the three Newton policies.
+    #[test]
+    fn assembling_in_place_changes_no_number() {
+        use crate::integrators::JacobianReuse;
+        let systems = [
+            ("line", line(16)),
+            ("chain", swinging(30)),
+            ("V", v_chain(8)),
+        ];
+        for (name, system) in &systems {
+            for reuse in [
+                JacobianReuse::WhileFast,
+                JacobianReuse::Never,
+                JacobianReuse::Always,
+            ] {
+                let mut options = SimulationOptions {
+                    t_end: 0.1,
+                    dt: 2e-3,
+                    ..Default::default()
+                };
+                options.newton.jacobian_reuse = reuse;
+                let run = |in_place| {
+                    released(in_place, || {
+                        let ws = StepWorkspace::new(system, options.dense_limit);
+                        assert_eq!(ws.solver.in_place(), in_place, "{name}");
+                        assert_eq!(ws.values.is_empty(), in_place, "{name}");
+                        let mut sim = Simulation::new(system, &options).unwrap();
+                        sim.step_to(options.t_end);
+                        let fallbacks = sim.workspace().solver.fallbacks();
+                        (sim.into_solution(), fallbacks)
+                    })
+                };
+                let ((gathered, fell), (in_place, fell_in_place)) = (run(false), run(true));
+                assert!(in_place.status.is_ok(), "{name}: {:?}", in_place.status);
+                assert_eq!(in_place.linear_solver, "tree elimination");
+                assert_same(&gathered, &in_place, &format!("{name}, {reuse:?}"));
+                assert_eq!(fell, fell_in_place, "{name}: fallbacks");
+                if *name == "V" {
+                    assert!(fell_in_place > 0, "the V chain's blocks fell back");
+                }
+            }
+        }
+    }
+
+    /// A run snapshotted with its factors held in place, saved and loaded, and restored into
+    /// a new simulation steps on as the run that went straight on, bit for bit: a swinging
+    /// chain under modified Newton, which keeps its factors across steps (26 factorisations in
+    /// 200 steps), so that a restored run that factorised afresh would take other iterates.
+    #[test]
+    fn a_snapshot_in_place_holds_the_factors() {
+        let system = swinging(30);
+        let mut options = SimulationOptions {
+            t_end: 0.2,
+            dt: 1e-3,
+            ..Default::default()
+        };
+        options.newton.jacobian_reuse = crate::integrators::JacobianReuse::Always;
+        released(true, || {
+            let mut straight = Simulation::new(&system, &options).unwrap();
+            straight.step_to(0.1);
+            let snapshot = straight.snapshot();
+            let held = snapshot.matrix.as_ref().expect("a matrix is held");
+            assert!(held.factored, "the factors, not the matrix");
+            straight.step_to(options.t_end);
+            let path = std::env::temp_dir()
+                .join(format!("vinculo-in-place-{}.snapshot", std::process::id()));
+            snapshot.save(&path).unwrap();
+            let loaded = Snapshot::load(&path).unwrap();
+            std::fs::remove_file(&path).unwrap();
+            for restored in [&snapshot, &loaded] {
+                let mut again = Simulation::new(&system, &options).unwrap();
+                again.step_to(0.05);
+                again.try_restore(restored).unwrap();
+                again.step_to(options.t_end);
+                let (a, b) = (straight.solution(), again.solution());
+                let last =
+                    |s: &Solution| s.positions[s.positions.len() - 3 * s.particles..].to_vec();
+                assert_eq!(
+                    last(a).iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                    last(b).iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+                );
+                assert_eq!(a.factorisations, b.factorisations);
+            }
+        });
+    }
+
+    /// The static equilibrium (the continuation from a V, then Newton) and the stiffness at
+    /// the fairlead are those of the matrix in the pattern's order, bit for bit.
+    #[test]
+    fn statics_in_place_are_the_same() {
+        let system = line(12);
+        let options = StaticsOptions {
+            newton_first: false,
+            ..StaticsOptions::default()
+        };
+        let solve = |in_place| {
+            released(in_place, || {
+                let st = solve_statics(&system, &options).unwrap();
+                let k = point_stiffness(&system, &st, 12).unwrap();
+                (st, k)
+            })
+        };
+        let ((a, ka), (b, kb)) = (solve(false), solve(true));
+        assert_eq!(a, b);
+        assert_eq!(ka, kb);
     }
 }

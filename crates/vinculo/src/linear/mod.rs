@@ -35,6 +35,82 @@ pub trait LinearSolver: Send {
     fn fallbacks(&self) -> usize {
         0
     }
+    /// Whether the matrix is assembled into the solver's own storage and factorised there
+    /// ([`TreeElimination::assemble_in_place`]), instead of being read from the caller's value
+    /// array: see [`assemble_and_factor`].
+    fn in_place(&self) -> bool {
+        false
+    }
+    /// The storage to assemble the matrix into, in the layout of the slots the solver gave
+    /// (solvers that factorise in place; None for the others).
+    fn storage(&mut self) -> Option<&mut [f64]> {
+        None
+    }
+    /// Factorises the matrix assembled in [`LinearSolver::storage`], overwriting it with the
+    /// factors.
+    fn factor_stored(&mut self) -> Result<Stored, Singular> {
+        Err(not_in_place())
+    }
+    /// After [`Stored::AssembleAgain`], with the matrix assembled into the storage again:
+    /// factorises it with the general sparse LU.
+    fn factor_stored_by_fallback(&mut self) -> Result<(), Singular> {
+        Err(not_in_place())
+    }
+    /// The last factorisation as numbers, for a snapshot: solvers that factorise in place, whose
+    /// matrix no caller keeps (None for the others, and when the factorisation is not in the
+    /// storage).
+    fn factors(&self) -> Option<Vec<f64>> {
+        None
+    }
+    /// Takes the factors that [`LinearSolver::factors`] gave for a solver of the same analysis;
+    /// false (and nothing factorised) when they are not of its size.
+    fn adopt_factors(&mut self, _factors: &[f64]) -> bool {
+        false
+    }
+}
+
+fn not_in_place() -> Singular {
+    Singular {
+        column: None,
+        detail: "this solver reads the matrix from the caller's value array".into(),
+    }
+}
+
+/// What a factorisation of a solver's own storage came to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stored {
+    /// Factorised.
+    Factorised,
+    /// A block was (nearly) singular, and the elimination had already overwritten part of the
+    /// matrix: assemble it into the storage again and call
+    /// [`LinearSolver::factor_stored_by_fallback`].
+    AssembleAgain,
+}
+
+/// Assembles a matrix and factorises it: `assemble` adds its entries into a zeroed array, the
+/// solver's own storage when it factorises in place (a second time when a singular block sends
+/// the factorisation to the general sparse LU), else `values`, in the pattern's order.
+pub fn assemble_and_factor(
+    solver: &mut dyn LinearSolver,
+    values: &mut [f64],
+    mut assemble: impl FnMut(&mut [f64]),
+) -> Result<(), Singular> {
+    if !solver.in_place() {
+        values.fill(0.0);
+        assemble(values);
+        return solver.factor(values);
+    }
+    let mut fill = |solver: &mut dyn LinearSolver| {
+        let store = solver.storage().expect("a solver in place has a storage");
+        store.fill(0.0);
+        assemble(store);
+    };
+    fill(solver);
+    if solver.factor_stored()? == Stored::AssembleAgain {
+        fill(solver);
+        solver.factor_stored_by_fallback()?;
+    }
+    Ok(())
 }
 
 /// Which solver a sparse pattern gets.
