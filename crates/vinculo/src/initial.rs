@@ -47,8 +47,7 @@ fn factor_saddle_rows(
             layout.add_to_particle_diagonal(values, i, m / mass_ref);
         }
         // The line nodes' axial added-mass correction at q (`assembly/axial_added_mass.rs`).
-        let blocks = &layout.particle_block[..];
-        axial.add_mass_blocks(values, blocks, q, 1.0 / mass_ref);
+        axial.add_mass_blocks(values, &layout.particle_block, q, 1.0 / mass_ref);
         fill_constraint_rows(system, layout, scales, (q, t), compliant, values);
     };
     assemble_and_factor(solver.as_mut(), values, fill)

@@ -24,7 +24,10 @@
 //! energy ([`crate::model::System::kinetic_energy`]) stays 1/2 m |v|^2 with the particle's own
 //! mass: the added mass's energy is the fluid's, not counted.
 
-use super::{Block, Entries, Layout, NONE};
+use super::{Block, Entries, SlotTable, NONE};
+
+/// What receives a table's blocks (see [`AxialAddedMass::add_jacobian`]).
+pub type BlockVisit<'a> = dyn FnMut(&[Block]) + 'a;
 use crate::forces::{Force, Jacobian, LineHydro};
 use crate::math::{Mat3, Vec3};
 use crate::model::System;
@@ -90,49 +93,47 @@ impl AxialAddedMass {
     pub fn add_mass_blocks<V: Entries + ?Sized>(
         &self,
         values: &mut V,
-        diagonal: &[Block],
+        diagonal: &SlotTable<9>,
         q: &[Vec3],
         weight: f64,
     ) {
         for (_, h) in &self.nodes {
-            values.add_block(&diagonal[h.node.node()], weight, &h.axial_correction(q));
+            values.add_block(&diagonal.get(h.node.node()), weight, &h.axial_correction(q));
         }
     }
 
     /// Adds the correction's part of a step's iteration matrix (module documentation): for each
     /// free node i at the evaluation point `q_eval`, `mass_weight` C_i into its diagonal block
-    /// `diagonal[i]`, and `force_weight` d(-C_i a_i)/dq into the node's row of its
-    /// [`LineHydro`] element's blocks (`force_blocks(k)`, k the force's index), a_i =
-    /// `acceleration(i)`.
-    pub fn add_jacobian<'b, V: Entries + ?Sized>(
+    /// `diagonal(i)`, and `force_weight` d(-C_i a_i)/dq into the node's row of its
+    /// [`LineHydro`] element's blocks (`force_row(k, n, f)` calls f with the first n blocks of
+    /// force k's table, k the force's index), a_i = `acceleration(i)`.
+    pub fn add_jacobian<V: Entries + ?Sized>(
         &self,
         values: &mut V,
-        (diagonal, force_blocks): (&[Block], impl Fn(usize) -> &'b [Block]),
+        (diagonal, force_row): (
+            impl Fn(usize) -> Block,
+            impl Fn(usize, usize, &mut BlockVisit),
+        ),
         (q_eval, mass_weight, force_weight): (&[Vec3], f64, f64),
         acceleration: impl Fn(usize) -> Vec3,
     ) {
         let mut dq = Jacobian::zeros(0);
         for (k, h) in &self.nodes {
             let i = h.node.node();
-            if diagonal[i][0] == super::NO_SLOT {
+            let diagonal = diagonal(i);
+            if diagonal[0] == super::NO_SLOT {
                 continue;
             }
             let n = h.node.particles().len();
             dq.reset(n);
             let c: Mat3 = h.axial_inertia_jacobian(q_eval, acceleration(i), &mut dq);
-            values.add_block(&diagonal[i], mass_weight, &c);
-            let blocks = force_blocks(*k);
+            values.add_block(&diagonal, mass_weight, &c);
             // The node's row: blocks (0, y) of the element's n x n table.
-            for (b, m) in blocks[..n].iter().zip(&dq[0][..n]) {
-                values.add_block(b, force_weight, m);
-            }
+            force_row(*k, n, &mut |blocks| {
+                for (b, m) in blocks.iter().zip(&dq[0][..n]) {
+                    values.add_block(b, force_weight, m);
+                }
+            });
         }
-    }
-}
-
-impl Layout {
-    /// The blocks of force `k`'s Jacobian in the index-3 matrix.
-    pub fn force_blocks(&self, k: usize) -> &[Block] {
-        &self.force_block[self.force_offsets.pairs(k)]
     }
 }

@@ -9,11 +9,13 @@ mod elements;
 mod parallel;
 mod pattern;
 mod serial;
+mod slot_table;
 
-pub use axial_added_mass::AxialAddedMass;
+pub use axial_added_mass::{AxialAddedMass, BlockVisit};
 pub use elements::{push_column, push_pair_blocks, push_row, ElementOffsets};
 pub use parallel::{JacobianTerms, ParallelAssembly, ResidualTerms, MIN_TASK};
-pub use pattern::{Pattern, Storage};
+pub use pattern::{EntryIndex, Pattern, Storage};
+pub use slot_table::SlotTable;
 
 use crate::model::System;
 
@@ -43,22 +45,22 @@ pub struct Layout {
     /// Sparsity pattern (or dense storage for small systems).
     pub pattern: Pattern,
     /// Diagonal block of each particle (all NONE for fixed particles).
-    pub particle_block: Vec<Block>,
+    pub particle_block: SlotTable<9>,
     /// Where each constraint's entries start in the tables below.
     pub constraint_offsets: ElementOffsets,
     /// Per constraint and ordered pair (a, b) of its particles: the block of the Hessian term.
-    pub constraint_hessian: Vec<Block>,
+    pub constraint_hessian: SlotTable<9>,
     /// Per constraint and particle a: slots of -Phi_q^T (rows of a, the multiplier's column).
-    pub constraint_column: Vec<[Slot; 3]>,
+    pub constraint_column: SlotTable<3>,
     /// Per constraint and particle a: slots of Phi_q (the constraint's row, columns of a).
-    pub constraint_row: Vec<[Slot; 3]>,
+    pub constraint_row: SlotTable<3>,
     /// Per constraint: the slot of its multiplier's diagonal entry, which holds the compliance
     /// of a compliant constraint (NO_SLOT for an exact one).
     pub constraint_diagonal: Vec<Slot>,
     /// Where each force's entries start in `force_block`.
     pub force_offsets: ElementOffsets,
     /// Per force and ordered pair (a, b) of its particles: the block of its Jacobian.
-    pub force_block: Vec<Block>,
+    pub force_block: SlotTable<9>,
 }
 
 impl Layout {
@@ -88,12 +90,15 @@ impl Layout {
                 .filter(|f| f.has_jacobian())
                 .map(|f| count(f.particles()))
                 .sum::<usize>();
-        let mut entries: Vec<(usize, usize)> = Vec::with_capacity(reserve);
-        let block = |entries: &mut Vec<(usize, usize)>, a: usize, b: usize| {
+        // 32-bit rows and columns: half the memory of the list, the peak of a large model's
+        // set-up (n is below the 32-bit slots' bound, which the pattern checks).
+        let at = |k: usize| u32::try_from(k).expect("fewer than 2^32 unknowns");
+        let mut entries: Vec<(u32, u32)> = Vec::with_capacity(reserve);
+        let block = |entries: &mut Vec<(u32, u32)>, a: usize, b: usize| {
             if a != NONE && b != NONE {
                 for r in 0..3 {
                     for c in 0..3 {
-                        entries.push((a + r, b + c));
+                        entries.push((at(a + r), at(b + c)));
                     }
                 }
             }
@@ -117,13 +122,13 @@ impl Layout {
             for &p in c.particles() {
                 if dof[p] != NONE {
                     for r in 0..3 {
-                        entries.push((dof[p] + r, lambda(k)));
-                        entries.push((lambda(k), dof[p] + r));
+                        entries.push((at(dof[p] + r), at(lambda(k))));
+                        entries.push((at(lambda(k)), at(dof[p] + r)));
                     }
                 }
             }
             if c.is_compliant() {
-                entries.push((lambda(k), lambda(k)));
+                entries.push((at(lambda(k)), at(lambda(k))));
             }
         }
         for f in system.forces().iter().filter(|f| f.has_jacobian()) {
@@ -135,7 +140,7 @@ impl Layout {
             }
         }
         let pattern = Pattern::new(n, entries, n <= dense_limit);
-        let particle_block = dof.iter().map(|&d| pattern.block_slots(d, d)).collect();
+        let particle_block: Vec<Block> = dof.iter().map(|&d| pattern.block_slots(d, d)).collect();
         let constraint_offsets =
             ElementOffsets::new(system.constraints().iter().map(|c| c.particles()));
         let mut constraint_hessian = Vec::with_capacity(constraint_offsets.pair_entries());
@@ -185,14 +190,14 @@ impl Layout {
             free,
             constraints: m,
             pattern,
-            particle_block,
+            particle_block: particle_block.into(),
             constraint_offsets,
-            constraint_hessian,
-            constraint_column,
-            constraint_row,
+            constraint_hessian: constraint_hessian.into(),
+            constraint_column: constraint_column.into(),
+            constraint_row: constraint_row.into(),
             constraint_diagonal,
             force_offsets,
-            force_block,
+            force_block: force_block.into(),
         }
     }
 
@@ -210,17 +215,33 @@ impl Layout {
                 *s = map[*s as usize];
             }
         };
-        let blocks = self.particle_block.iter_mut();
+        let blocks = self.particle_block.plain_mut().iter_mut();
         let blocks = blocks
-            .chain(&mut self.constraint_hessian)
-            .chain(&mut self.force_block);
+            .chain(self.constraint_hessian.plain_mut())
+            .chain(self.force_block.plain_mut());
         blocks.flatten().for_each(moved);
-        let strips = self
-            .constraint_column
-            .iter_mut()
-            .chain(&mut self.constraint_row);
+        let strips = self.constraint_column.plain_mut().iter_mut();
+        let strips = strips.chain(self.constraint_row.plain_mut());
         strips.flatten().for_each(moved);
         self.constraint_diagonal.iter_mut().for_each(moved);
+    }
+
+    /// Compresses the periodic runs of the slot tables ([`SlotTable::compress`]: a chain's,
+    /// whose elements' slots advance by a fixed step from one to the next), for large models:
+    /// an element of a run then has its slots computed where it is read.
+    pub fn compress_slots(&mut self) {
+        let (particles, constraints) = (self.dof.len(), self.constraint_offsets.len());
+        self.particle_block.compress(particles, |i| i..i + 1);
+        let offsets = &self.constraint_offsets;
+        self.constraint_hessian
+            .compress(constraints, |c| offsets.pairs(c));
+        self.constraint_column
+            .compress(constraints, |c| offsets.particles(c));
+        self.constraint_row
+            .compress(constraints, |c| offsets.particles(c));
+        let offsets = &self.force_offsets;
+        self.force_block
+            .compress(offsets.len(), |f| offsets.pairs(f));
     }
 
     /// Total number of unknowns.
@@ -262,13 +283,15 @@ impl Layout {
         dq.reset(n);
         dv.reset(n);
         f.add_jacobian(at.q_eval, at.v_eval, at.t_eval, dq, dv);
-        let blocks = &self.force_block[self.force_offsets.pairs(fi)];
-        add_force_blocks(
-            values,
-            (blocks, blocks),
-            (at.force_dq, dq),
-            (at.force_dv, dv),
-        );
+        let mut place = |blocks: &[Block]| {
+            let weights = ((at.force_dq, &*dq), (at.force_dv, &*dv));
+            add_force_blocks(values, (blocks, blocks), weights.0, weights.1)
+        };
+        let pairs = self.force_offsets.pairs(fi);
+        match self.force_block.as_plain() {
+            Some(blocks) => place(&blocks[pairs]),
+            None => self.force_block.with(pairs, place),
+        }
     }
 
     /// Adds constraint `c` (`con`)'s part of the iteration matrix `values` at the Jacobian's
@@ -341,24 +364,49 @@ impl Layout {
         s: (f64, f64),
         (grad_column, grad_row): (&[crate::math::Vec3], &[crate::math::Vec3]),
     ) {
-        let blocks = &self.constraint_hessian[self.constraint_offsets.pairs(c)];
-        let range = self.constraint_offsets.particles(c);
-        let strips = (
-            &self.constraint_column[range.clone()],
-            &self.constraint_row[range],
+        let (pairs, range) = (
+            self.constraint_offsets.pairs(c),
+            self.constraint_offsets.particles(c),
         );
         let grads = (grad_column, grad_row);
-        // Most constraints are distances: their two particles get loops of fixed length.
-        match two_particles(blocks, hess, strips, grads) {
-            Some((blocks, hess, (columns, rows), (gc, gr))) => {
-                let (strips, grads) = ((&columns[..], &rows[..]), (&gc[..], &gr[..]));
-                place_constraint(values, (blocks, hess), s, strips, grads)
+        let (hessian, columns, rows) = (
+            &self.constraint_hessian,
+            &self.constraint_column,
+            &self.constraint_row,
+        );
+        match (hessian.as_plain(), columns.as_plain(), rows.as_plain()) {
+            (Some(blocks), Some(columns), Some(rows)) => {
+                let strips = (&columns[range.clone()], &rows[range]);
+                place_element(values, (&blocks[pairs], hess), s, strips, grads)
             }
-            None => {
-                let blocks = (blocks, hess);
-                place_constraint(values, blocks, s, strips, grads)
-            }
+            // Compressed tables (a large model's): the element's slots computed.
+            _ => hessian.with(pairs, |blocks| {
+                columns.with(range.clone(), |columns| {
+                    rows.with(range.clone(), |rows| {
+                        place_element(values, (blocks, hess), s, (columns, rows), grads)
+                    })
+                })
+            }),
         }
+    }
+}
+
+/// [`place_constraint`], with loops of fixed length for the two particles of most constraints
+/// (distances).
+#[inline(always)]
+fn place_element<V: Entries + ?Sized>(
+    values: &mut V,
+    (blocks, hess): (&[Block], &[crate::math::Mat3]),
+    s: (f64, f64),
+    strips: Strips<'_>,
+    grads: Grads<'_>,
+) {
+    match two_particles(blocks, hess, strips, grads) {
+        Some((blocks, hess, (columns, rows), (gc, gr))) => {
+            let (strips, grads) = ((&columns[..], &rows[..]), (&gc[..], &gr[..]));
+            place_constraint(values, (blocks, hess), s, strips, grads)
+        }
+        None => place_constraint(values, (blocks, hess), s, strips, grads),
     }
 }
 
@@ -415,7 +463,7 @@ impl Layout {
     /// particle): the mass term of the iteration matrix.
     #[inline]
     pub fn add_to_particle_diagonal(&self, values: &mut [f64], i: usize, m: f64) {
-        let blk = &self.particle_block[i];
+        let blk = self.particle_block.get(i);
         if blk[0] != NO_SLOT {
             for k in 0..3 {
                 values[blk[4 * k] as usize] += m;

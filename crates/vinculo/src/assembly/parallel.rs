@@ -477,7 +477,7 @@ impl ParallelAssembly {
         let shared = SharedValues::new(values);
         let shared = &shared;
         self.free.par_iter().with_min_len(MIN_TASK).for_each(|&i| {
-            let blk = &layout.particle_block[i];
+            let blk = layout.particle_block.get(i);
             let m = mass(i);
             for k in 0..3 {
                 // SAFETY: particle i's own diagonal entries, written by this task only.

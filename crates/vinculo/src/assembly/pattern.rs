@@ -27,13 +27,33 @@ pub struct Pattern {
     stored: usize,
 }
 
+/// A row or column index of the entries a pattern is built from: `usize`, or `u32` where the
+/// entries are many (a model's layout: 58 million entries for a chain of 10^6 particles, whose
+/// list at 16 bytes an entry was the peak memory of the run).
+pub trait EntryIndex: Copy {
+    /// The index.
+    fn index(self) -> usize;
+}
+
+impl EntryIndex for usize {
+    fn index(self) -> usize {
+        self
+    }
+}
+
+impl EntryIndex for u32 {
+    fn index(self) -> usize {
+        self as usize
+    }
+}
+
 impl Pattern {
     /// Builds the pattern from (row, column) entries (duplicates allowed).
     ///
     /// # Panics
     /// If the matrix has more entries than 32-bit slots can address (about four billion, far
     /// beyond any model that fits in memory).
-    pub fn new(n: usize, entries: Vec<(usize, usize)>, dense: bool) -> Pattern {
+    pub fn new<E: EntryIndex>(n: usize, entries: Vec<(E, E)>, dense: bool) -> Pattern {
         let pattern = Pattern::build(n, entries, dense);
         assert!(
             pattern.nnz() < NO_SLOT as usize,
@@ -43,7 +63,7 @@ impl Pattern {
         pattern
     }
 
-    fn build(n: usize, entries: Vec<(usize, usize)>, dense: bool) -> Pattern {
+    fn build<E: EntryIndex>(n: usize, entries: Vec<(E, E)>, dense: bool) -> Pattern {
         if dense {
             return Pattern {
                 n,
@@ -60,7 +80,7 @@ impl Pattern {
         // advances it to where the column ends, so that column c is end[c - 1]..end[c] after.
         let mut end = vec![0usize; n + 1];
         for &(_, c) in &entries {
-            end[c + 1] += 1;
+            end[c.index() + 1] += 1;
         }
         for c in 0..n {
             end[c + 1] += end[c];
@@ -68,7 +88,8 @@ impl Pattern {
         // Rows as 32 bits while sorting (n is below the 32-bit slots' bound, checked after).
         let mut rows = vec![0u32; entries.len()];
         for &(r, c) in &entries {
-            rows[end[c]] = r as u32;
+            let c = c.index();
+            rows[end[c]] = r.index() as u32;
             end[c] += 1;
         }
         drop(entries);

@@ -106,7 +106,7 @@ use super::rule::{GglBase, RuleState, StepPoint, StepStart, TimeRule};
 use super::stabilized_layout::StabilizedLayout;
 use super::workspace::{refactor, StepBuffers, StepWorkspace};
 
-use crate::assembly::{add, add_block, add_force_blocks, NONE};
+use crate::assembly::{add, add_block, add_force_blocks, BlockVisit, NONE};
 use crate::constraints::{Constraint, Gradient, Hessian};
 use crate::forces::Jacobian;
 use crate::linear::{for_layout, LinearSolver, SparseSolver};
@@ -449,9 +449,12 @@ impl NewtonProblem for StabilizedProblem<'_> {
         }
         if !self.axial.is_empty() {
             // d(sigma C qdd)/dv~ = sigma c_v C / kappa = C / m_ref; through t, as a force.
-            let blocks = (&layout.dynamic_v[..], |k| {
-                &layout.force_q[layout.force_offsets.pairs(k)]
-            });
+            let diagonal = |i| layout.dynamic_v[i];
+            let force_row = |k, n, f: &mut BlockVisit| {
+                let pairs = layout.force_offsets.pairs(k);
+                f(&layout.force_q[pairs.start..pairs.start + n])
+            };
+            let blocks = (diagonal, force_row);
             let weights = (&*self.q_eval, 1.0 / mass_ref, -point.sigma * rule.w);
             self.axial
                 .add_jacobian(values, blocks, weights, self.acceleration());

@@ -30,7 +30,8 @@ use super::newton::{self, LinearWork, NewtonFailure, NewtonOptions, NewtonProble
 use super::rule::{Index3Rule, RuleState, StepPoint, StepStart, TimeRule};
 use super::workspace::{StepBuffers, StepWorkspace};
 use crate::assembly::{
-    AxialAddedMass, InertiaRows, JacobianTerms, Layout, ParallelAssembly, ResidualTerms, MIN_TASK,
+    AxialAddedMass, BlockVisit, InertiaRows, JacobianTerms, Layout, ParallelAssembly,
+    ResidualTerms, MIN_TASK,
 };
 use crate::math::Vec3;
 use crate::model::Particle;
@@ -205,10 +206,15 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
         }
         if !self.axial.is_empty() {
             let layout = self.layout;
-            let blocks = (&layout.particle_block[..], |k| layout.force_blocks(k));
+            let diagonal = |i| layout.particle_block.get(i);
+            let force_row = |k, n, f: &mut BlockVisit| {
+                let pairs = layout.force_offsets.pairs(k);
+                layout.force_block.with(pairs.start..pairs.start + n, f)
+            };
             let weights = (q_eval, rule.mass_diagonal(point.sigma, 1.0), force_dq);
             let qdd = |i: usize| acceleration(rule, b, i);
-            self.axial.add_jacobian(values, blocks, weights, qdd);
+            self.axial
+                .add_jacobian(values, (diagonal, force_row), weights, qdd);
         }
     }
 

@@ -137,9 +137,11 @@ impl StepWorkspace {
             let solver = for_layout(&layout.pattern, 3 * layout.free, SparseSolver::SparseLu);
             (layout, solver)
         });
-        // Assembly uses the slot tables only: large models free the pattern's index arrays.
+        // Assembly uses the slot tables only: large models free the pattern's index arrays,
+        // and keep the slots of a chain's elements as periodic runs.
         if layout.pattern.nnz() > above {
             layout.pattern.release_structure();
+            layout.compress_slots();
         }
         let entries = if solver.in_place() {
             0
@@ -205,17 +207,20 @@ pub(crate) mod tests {
         pub(crate) static RELEASE: Cell<Option<(usize, bool)>> = const { Cell::new(None) };
     }
 
-    /// `f` with workspaces that release every pattern and assemble trees in place or not.
-    fn released<T>(in_place: bool, f: impl FnOnce() -> T) -> T {
-        RELEASE.with(|r| r.set(Some((0, in_place))));
+    /// `f` with workspaces that release every pattern (and compress the slot tables'
+    /// periodic runs), and assemble trees in place or not (None: the defaults, which leave a
+    /// small model's pattern and tables as they are).
+    fn released<T>(in_place: Option<bool>, f: impl FnOnce() -> T) -> T {
+        RELEASE.with(|r| r.set(in_place.map(|p| (0, p))));
         let out = f();
         RELEASE.with(|r| r.set(None));
         out
     }
 
     /// A line of `n` elastic segments between a fixed anchor and a fixed end, with bending
-    /// stiffness, a spring-damper across two segments and drag on its middle node, released
-    /// from a straight span shorter than the line (it sags and swings).
+    /// stiffness, line hydrodynamics in a current (the axial added mass unlike the normal one:
+    /// the nodes' axial correction), a spring-damper across two segments and drag on its
+    /// middle node, released from a straight span shorter than the line (it sags and swings).
     fn line(n: usize) -> System {
         let mut s = System::new([0.0, 0.0, -9.81]);
         let mut ids = vec![s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap()];
@@ -230,6 +235,22 @@ pub(crate) mod tests {
             s.add_bending(ids[i - 1], ids[i], ids[i + 1], 1e-3, None)
                 .unwrap();
         }
+        for i in 1..n {
+            let spec = crate::model::LineHydroSpec {
+                density: 1025.0,
+                diameter: 0.02,
+                length: 1.0 / n as f64,
+                cd: 1.2,
+                cdax: 0.1,
+                ca: 1.0,
+                caax: 0.3,
+            };
+            s.add_line_hydrodynamics(ids[i], Some((ids[i - 1], ids[i + 1])), &spec)
+                .unwrap();
+        }
+        let mut water = crate::water::Water::everywhere(9.81);
+        water.current = crate::water::Current::Uniform([0.2, 0.1, 0.0]);
+        s.set_water(water);
         s.add_spring_damper(ids[2], ids[4], 5.0, 0.1, None).unwrap();
         s.add_quadratic_drag(ids[n / 2], 0.05).unwrap();
         s
@@ -293,11 +314,12 @@ pub(crate) mod tests {
         assert_eq!(a.status, b.status, "{what}: status");
     }
 
-    /// The matrix assembled into the tree elimination's storage and factorised there gives the
-    /// runs of the matrix gathered from the pattern's value array, bit for bit (the same sums in
-    /// the same order, at other addresses): a line with bending and forces across particles,
-    /// a uniform chain, and a V chain whose singular blocks send factorisations to the sparse
-    /// LU (after the matrix is assembled again), under the three Newton policies.
+    /// The matrix assembled into the tree elimination's storage and factorised there, and the
+    /// slots of periodic elements computed from a run's first ones, give the runs of the plain
+    /// tables and of the matrix gathered from the pattern's value array, bit for bit (the same
+    /// sums in the same order, at other addresses): a line with bending and forces across
+    /// particles, a uniform chain, and a V chain whose singular blocks send factorisations to
+    /// the sparse LU (after the matrix is assembled again), under the three Newton policies.
     #[test]
     fn assembling_in_place_changes_no_number() {
         use crate::integrators::JacobianReuse;
@@ -318,24 +340,30 @@ pub(crate) mod tests {
                     ..Default::default()
                 };
                 options.newton.jacobian_reuse = reuse;
-                let run = |in_place| {
+                let run = |in_place: Option<bool>| {
                     released(in_place, || {
                         let ws = StepWorkspace::new(system, options.dense_limit);
-                        assert_eq!(ws.solver.in_place(), in_place, "{name}");
-                        assert_eq!(ws.values.is_empty(), in_place, "{name}");
+                        let tables = &ws.layout.constraint_hessian;
+                        assert_eq!(tables.is_compressed(), in_place.is_some(), "{name}");
+                        assert_eq!(ws.solver.in_place(), in_place == Some(true), "{name}");
+                        assert_eq!(ws.values.is_empty(), in_place == Some(true), "{name}");
                         let mut sim = Simulation::new(system, &options).unwrap();
                         sim.step_to(options.t_end);
                         let fallbacks = sim.workspace().solver.fallbacks();
                         (sim.into_solution(), fallbacks)
                     })
                 };
-                let ((gathered, fell), (in_place, fell_in_place)) = (run(false), run(true));
-                assert!(in_place.status.is_ok(), "{name}: {:?}", in_place.status);
-                assert_eq!(in_place.linear_solver, "tree elimination");
-                assert_same(&gathered, &in_place, &format!("{name}, {reuse:?}"));
-                assert_eq!(fell, fell_in_place, "{name}: fallbacks");
+                let (plain, fell) = run(None);
+                assert!(plain.status.is_ok(), "{name}: {:?}", plain.status);
+                assert_eq!(plain.linear_solver, "tree elimination");
+                for in_place in [false, true] {
+                    let (other, fell_other) = run(Some(in_place));
+                    let what = format!("{name}, {reuse:?}, in place {in_place}");
+                    assert_same(&plain, &other, &what);
+                    assert_eq!(fell, fell_other, "{what}: fallbacks");
+                }
                 if *name == "V" {
-                    assert!(fell_in_place > 0, "the V chain's blocks fell back");
+                    assert!(fell > 0, "the V chain's blocks fell back");
                 }
             }
         }
@@ -354,7 +382,7 @@ pub(crate) mod tests {
             ..Default::default()
         };
         options.newton.jacobian_reuse = crate::integrators::JacobianReuse::Always;
-        released(true, || {
+        released(Some(true), || {
             let mut straight = Simulation::new(&system, &options).unwrap();
             straight.step_to(0.1);
             let snapshot = straight.snapshot();
@@ -399,8 +427,11 @@ pub(crate) mod tests {
                 (st, k)
             })
         };
-        let ((a, ka), (b, kb)) = (solve(false), solve(true));
-        assert_eq!(a, b);
-        assert_eq!(ka, kb);
+        let (a, ka) = solve(None);
+        for in_place in [false, true] {
+            let (b, kb) = solve(Some(in_place));
+            assert_eq!(a, b);
+            assert_eq!(ka, kb);
+        }
     }
 }

@@ -16,7 +16,7 @@
 use std::ops::Range;
 
 /// A storage entry with no slot: a fill entry, zero in the matrix.
-pub(super) const ABSENT: u32 = u32::MAX;
+pub(crate) const ABSENT: u32 = u32::MAX;
 
 /// A run of consecutive blocks of equal storage whose slots are periodic.
 #[derive(Debug, Clone, PartialEq)]
@@ -33,7 +33,7 @@ struct Run {
 
 /// The slots of one block storage (module documentation).
 #[derive(Debug, Clone, PartialEq)]
-pub(super) struct BlockSlots {
+pub(crate) struct BlockSlots {
     /// The slots of the storage entries before the run, then of those after it (all of them
     /// without a run).
     explicit: Vec<u32>,
@@ -47,7 +47,7 @@ impl BlockSlots {
     /// The slots `slots` of a storage whose block b holds the entries
     /// `first_entry(b)..first_entry(b + 1)`, with the longest periodic run found among the
     /// blocks `candidates` (consecutive blocks of `per_block` entries each).
-    pub(super) fn new(
+    pub(crate) fn new(
         slots: Vec<u32>,
         candidates: Range<usize>,
         per_block: usize,
@@ -70,7 +70,7 @@ impl BlockSlots {
     }
 
     /// The slot of storage entry `e` (ABSENT for fill).
-    pub(super) fn get(&self, e: usize) -> u32 {
+    pub(crate) fn get(&self, e: usize) -> u32 {
         match &self.run {
             Some(run) if e >= run.entries.end => self.explicit[e - run.entries.len()],
             Some(run) if e >= run.entries.start => {
@@ -84,9 +84,39 @@ impl BlockSlots {
         }
     }
 
+    /// The slots of the entries `entries.start..entries.start + out.len()`, which lie in one
+    /// block, into `out`.
+    pub(crate) fn copy(&self, start: usize, out: &mut [u32]) {
+        match &self.run {
+            Some(run) if start >= run.entries.start && start < run.entries.end => {
+                let offset = start - run.entries.start;
+                let (block, k) = (offset / run.per_block, offset % run.per_block);
+                let first = &run.first[k..k + out.len()];
+                let step = &run.step[k..k + out.len()];
+                for ((o, &s), &d) in out.iter_mut().zip(first).zip(step) {
+                    *o = if s == ABSENT {
+                        ABSENT
+                    } else {
+                        (s as i64 + block as i64 * d) as u32
+                    };
+                }
+            }
+            Some(run) if start >= run.entries.end => {
+                let at = start - run.entries.len();
+                out.copy_from_slice(&self.explicit[at..at + out.len()]);
+            }
+            _ => out.copy_from_slice(&self.explicit[start..start + out.len()]),
+        }
+    }
+
+    /// Whether a periodic run was found.
+    pub(crate) fn has_run(&self) -> bool {
+        self.run.is_some()
+    }
+
     /// Slots kept one by one (the run's are computed).
     #[cfg(test)]
-    pub(super) fn explicit_len(&self) -> usize {
+    pub(crate) fn explicit_len(&self) -> usize {
         self.explicit.len()
     }
 

@@ -2,7 +2,7 @@
 //! factorise new values, solve in place. Symbolic work and workspace are allocated once, so the
 //! Newton loop does not allocate.
 
-mod block_slots;
+pub(crate) mod block_slots;
 mod dense_lu;
 mod sparse_lu;
 mod tree_elimination;
