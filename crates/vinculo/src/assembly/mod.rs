@@ -290,7 +290,7 @@ impl Layout {
         let pairs = self.force_offsets.pairs(fi);
         match self.force_block.as_plain() {
             Some(blocks) => place(&blocks[pairs]),
-            None => self.force_block.with(pairs, place),
+            None => self.force_block.with(fi, pairs, place),
         }
     }
 
@@ -379,10 +379,20 @@ impl Layout {
                 let strips = (&columns[range.clone()], &rows[range]);
                 place_element(values, (&blocks[pairs], hess), s, strips, grads)
             }
-            // Compressed tables (a large model's): the element's slots computed.
-            _ => hessian.with(pairs, |blocks| {
-                columns.with(range.clone(), |columns| {
-                    rows.with(range.clone(), |rows| {
+            // Compressed tables (a large model's): the element's slots computed, into arrays
+            // for a distance's two particles.
+            _ if pairs.len() == 4 && range.len() == 2 => {
+                let mut blocks = [[0; 9]; 4];
+                let mut strips = ([[0; 3]; 2], [[0; 3]; 2]);
+                hessian.fill(c, pairs.start, &mut blocks);
+                columns.fill(c, range.start, &mut strips.0);
+                rows.fill(c, range.start, &mut strips.1);
+                let strips = (&strips.0[..], &strips.1[..]);
+                place_element(values, (&blocks, hess), s, strips, grads)
+            }
+            _ => hessian.with(c, pairs, |blocks| {
+                columns.with(c, range.clone(), |columns| {
+                    rows.with(c, range.clone(), |rows| {
                         place_element(values, (blocks, hess), s, (columns, rows), grads)
                     })
                 })
@@ -463,10 +473,10 @@ impl Layout {
     /// particle): the mass term of the iteration matrix.
     #[inline]
     pub fn add_to_particle_diagonal(&self, values: &mut [f64], i: usize, m: f64) {
-        let blk = self.particle_block.get(i);
-        if blk[0] != NO_SLOT {
-            for k in 0..3 {
-                values[blk[4 * k] as usize] += m;
+        let diagonal = self.particle_block.picked(i, [0, 4, 8]);
+        if diagonal[0] != NO_SLOT {
+            for slot in diagonal {
+                values[slot as usize] += m;
             }
         }
     }

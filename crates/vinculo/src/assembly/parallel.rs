@@ -477,11 +477,10 @@ impl ParallelAssembly {
         let shared = SharedValues::new(values);
         let shared = &shared;
         self.free.par_iter().with_min_len(MIN_TASK).for_each(|&i| {
-            let blk = layout.particle_block.get(i);
             let m = mass(i);
-            for k in 0..3 {
+            for slot in layout.particle_block.picked(i, [0, 4, 8]) {
                 // SAFETY: particle i's own diagonal entries, written by this task only.
-                unsafe { shared.add(blk[4 * k], m) };
+                unsafe { shared.add(slot, m) };
             }
         });
         let forces = system.forces();

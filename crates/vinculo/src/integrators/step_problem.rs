@@ -209,7 +209,7 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
             let diagonal = |i| layout.particle_block.get(i);
             let force_row = |k, n, f: &mut BlockVisit| {
                 let pairs = layout.force_offsets.pairs(k);
-                layout.force_block.with(pairs.start..pairs.start + n, f)
+                layout.force_block.with(k, pairs.start..pairs.start + n, f)
             };
             let weights = (q_eval, rule.mass_diagonal(point.sigma, 1.0), force_dq);
             let qdd = |i: usize| acceleration(rule, b, i);

@@ -29,6 +29,9 @@ struct Run {
     first: Vec<u32>,
     /// The change of each entry's slot from one block to the next.
     step: Vec<i64>,
+    /// The steps modulo 2^32 (0 for fill): `first + block step` in wrapping u32 arithmetic is
+    /// the slot (every slot is below 2^32, and fill stays ABSENT), a loop without branches.
+    wrapping_step: Vec<u32>,
 }
 
 /// The slots of one block storage (module documentation).
@@ -86,19 +89,17 @@ impl BlockSlots {
 
     /// The slots of the entries `entries.start..entries.start + out.len()`, which lie in one
     /// block, into `out`.
+    #[inline]
     pub(crate) fn copy(&self, start: usize, out: &mut [u32]) {
         match &self.run {
             Some(run) if start >= run.entries.start && start < run.entries.end => {
                 let offset = start - run.entries.start;
                 let (block, k) = (offset / run.per_block, offset % run.per_block);
                 let first = &run.first[k..k + out.len()];
-                let step = &run.step[k..k + out.len()];
+                let step = &run.wrapping_step[k..k + out.len()];
+                let block = block as u32;
                 for ((o, &s), &d) in out.iter_mut().zip(first).zip(step) {
-                    *o = if s == ABSENT {
-                        ABSENT
-                    } else {
-                        (s as i64 + block as i64 * d) as u32
-                    };
+                    *o = s.wrapping_add(block.wrapping_mul(d));
                 }
             }
             Some(run) if start >= run.entries.end => {
@@ -109,9 +110,33 @@ impl BlockSlots {
         }
     }
 
-    /// Whether a periodic run was found.
-    pub(crate) fn has_run(&self) -> bool {
-        self.run.is_some()
+    /// The storage entries of the periodic run, if one was found.
+    pub(crate) fn run_entries(&self) -> Option<Range<usize>> {
+        self.run.as_ref().map(|run| run.entries.clone())
+    }
+
+    /// The run's first block's slots and their steps modulo 2^32: block k's slot e is
+    /// `first[e].wrapping_add(k.wrapping_mul(step[e]))`.
+    #[inline(always)]
+    pub(crate) fn run_slots(&self) -> (&[u32], &[u32]) {
+        let run = self.run.as_ref().expect("a run");
+        (&run.first, &run.wrapping_step)
+    }
+
+    /// The slots of block `block` of the run (counted from its first), its first `out.len()`
+    /// entries, into `out`.
+    #[inline(always)]
+    pub(crate) fn copy_run(&self, block: usize, out: &mut [u32]) {
+        let run = self.run.as_ref().expect("a run");
+        let n = out.len();
+        let block = block as u32;
+        for ((o, &s), &d) in out
+            .iter_mut()
+            .zip(&run.first[..n])
+            .zip(&run.wrapping_step[..n])
+        {
+            *o = s.wrapping_add(block.wrapping_mul(d));
+        }
     }
 
     /// Slots kept one by one (the run's are computed).
@@ -230,6 +255,7 @@ fn longest_run(
         entries: first_entry(from)..first_entry(to),
         per_block,
         first: block(from).to_vec(),
+        wrapping_step: step.iter().map(|&d| d as u32).collect(),
         step,
     })
 }
