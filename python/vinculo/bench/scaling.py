@@ -99,8 +99,10 @@ def run(sizes: tuple[int, ...] = SIZES, hanging: bool = True, out=print) -> floa
 
 
 if __name__ == "__main__":
-    if len(sys.argv) > 1:
+    # No argument: the table of hanging chains; "swinging": of swinging ones; N [swinging
+    # [steps]]: one size, in this process (the table's subprocesses).
+    if len(sys.argv) > 1 and sys.argv[1] != "swinging":
         count = int(sys.argv[3]) if len(sys.argv) > 3 else 1 + steps_for(int(sys.argv[1]))
         print(json.dumps(one(int(sys.argv[1]), sys.argv[2:3] != ["swinging"], count)))
     else:
-        run()
+        run(hanging=sys.argv[1:2] != ["swinging"])
