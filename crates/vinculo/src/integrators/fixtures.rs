@@ -299,3 +299,49 @@ pub(crate) fn assert_same_assembly(serial: &(Vec<f64>, Vec<f64>), parallel: &(Ve
         );
     }
 }
+
+/// Well-posed chains whose tree blocks are singular. `pinned` false: a chain hung from two
+/// anchors 2 m apart as a V of two straight legs of `n` links each, at rest (the end particle
+/// of the leg eliminated first holds two parallel conditions, its anchor and its link).
+/// `pinned` true: a chain of `n` links hanging straight down from a free particle whose
+/// three coordinates are prescribed, released with a sideways speed (the pinned particle's
+/// block would hold four conditions on three coordinates, were it not the root).
+pub(crate) fn awkward_chain(n: usize, pinned: bool) -> System {
+    let mut s = System::new([0.0, 0.0, -9.81]);
+    if pinned {
+        // The tip first, the pinned top last (not the first particle, which the analysis
+        // used to take as the root).
+        let mut below = None;
+        for i in (1..=n).rev() {
+            let z = -(i as f64) / n as f64;
+            let v = [0.5 * i as f64 / n as f64, 0.0, 0.0];
+            let p = s.add_particle(0.1, [0.0, 0.0, z], v, false).unwrap();
+            if let Some(b) = below {
+                s.add_distance(p, b, None).unwrap();
+            }
+            below = Some(p);
+        }
+        let top = s.add_particle(1.0, [0.0; 3], [0.0; 3], false).unwrap();
+        for axis in 0..3 {
+            s.add_fixed_coordinate(top, axis, None).unwrap();
+        }
+        s.add_distance(top, below.unwrap(), None).unwrap();
+        return s;
+    }
+    let left = s
+        .add_particle(1.0, [-1.0, 0.0, 0.0], [0.0; 3], true)
+        .unwrap();
+    let right = s
+        .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], true)
+        .unwrap();
+    let mut prev = left;
+    for i in 1..2 * n {
+        let x = -1.0 + i as f64 / n as f64;
+        let z = -(1.0 - x.abs());
+        let p = s.add_particle(0.1, [x, 0.0, z], [0.0; 3], false).unwrap();
+        s.add_distance(prev, p, None).unwrap();
+        prev = p;
+    }
+    s.add_distance(prev, right, None).unwrap();
+    s
+}

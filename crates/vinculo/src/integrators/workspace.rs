@@ -195,6 +195,7 @@ impl StepWorkspace {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::integrators::fixtures::{awkward_chain, chain};
     use crate::laws::Law;
     use crate::run::Snapshot;
     use crate::statics::{point_stiffness, solve_statics, StaticsOptions};
@@ -256,45 +257,6 @@ pub(crate) mod tests {
         s
     }
 
-    /// A chain of `n` links released horizontally from a fixed anchor (a uniform chain: the
-    /// elimination's explicit sweeps).
-    fn swinging(n: usize) -> System {
-        let mut s = System::new([0.0, 0.0, -9.81]);
-        let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
-        for i in 1..=n {
-            let p = s
-                .add_particle(0.1, [0.1 * i as f64, 0.0, 0.0], [0.0; 3], false)
-                .unwrap();
-            s.add_distance(prev, p, None).unwrap();
-            prev = p;
-        }
-        s
-    }
-
-    /// A chain hung as a V of two straight legs between two fixed points: the block of the
-    /// node at the bottom holds two parallel conditions at rest, and the elimination falls back
-    /// to the general sparse LU (`linear/tree_elimination.rs`).
-    fn v_chain(n: usize) -> System {
-        let mut s = System::new([0.0, 0.0, -9.81]);
-        let left = s
-            .add_particle(1.0, [-1.0, 0.0, 0.0], [0.0; 3], true)
-            .unwrap();
-        let right = s
-            .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], true)
-            .unwrap();
-        let mut prev = left;
-        for i in 1..2 * n {
-            let x = -1.0 + i as f64 / n as f64;
-            let p = s
-                .add_particle(0.1, [x, 0.0, -(1.0 - x.abs())], [0.0; 3], false)
-                .unwrap();
-            s.add_distance(prev, p, None).unwrap();
-            prev = p;
-        }
-        s.add_distance(prev, right, None).unwrap();
-        s
-    }
-
     /// Asserts that two runs stored the same numbers, bit for bit, with the same work.
     fn assert_same(a: &Solution, b: &Solution, what: &str) {
         let pairs = [
@@ -323,10 +285,12 @@ pub(crate) mod tests {
     #[test]
     fn assembling_in_place_changes_no_number() {
         use crate::integrators::JacobianReuse;
+        // A uniform chain (the elimination's explicit sweeps), and a chain hung as a V whose
+        // bottom block holds two parallel conditions at rest.
         let systems = [
             ("line", line(16)),
-            ("chain", swinging(30)),
-            ("V", v_chain(8)),
+            ("chain", chain(30)),
+            ("V", awkward_chain(8, false)),
         ];
         for (name, system) in &systems {
             for reuse in [
@@ -375,7 +339,7 @@ pub(crate) mod tests {
     /// 200 steps), so that a restored run that factorised afresh would take other iterates.
     #[test]
     fn a_snapshot_in_place_holds_the_factors() {
-        let system = swinging(30);
+        let system = chain(30);
         let mut options = SimulationOptions {
             t_end: 0.2,
             dt: 1e-3,

@@ -1827,59 +1827,13 @@ mod tests {
         assert!(TreeElimination::analyse(&pattern, particle_unknowns).is_some());
     }
 
-    /// Well-posed chains whose tree blocks are singular. `pinned` false: a chain hung from two
-    /// anchors 2 m apart as a V of two straight legs of `n` links each, at rest (the end particle
-    /// of the leg eliminated first holds two parallel conditions, its anchor and its link).
-    /// `pinned` true: a chain of `n` links hanging straight down from a free particle whose
-    /// three coordinates are prescribed, released with a sideways speed (the pinned particle's
-    /// block would hold four conditions on three coordinates, were it not the root).
-    fn awkward_chain(n: usize, pinned: bool) -> System {
-        let mut s = System::new([0.0, 0.0, -9.81]);
-        if pinned {
-            // The tip first, the pinned top last (not the first particle, which the analysis
-            // used to take as the root).
-            let mut below = None;
-            for i in (1..=n).rev() {
-                let z = -(i as f64) / n as f64;
-                let v = [0.5 * i as f64 / n as f64, 0.0, 0.0];
-                let p = s.add_particle(0.1, [0.0, 0.0, z], v, false).unwrap();
-                if let Some(b) = below {
-                    s.add_distance(p, b, None).unwrap();
-                }
-                below = Some(p);
-            }
-            let top = s.add_particle(1.0, [0.0; 3], [0.0; 3], false).unwrap();
-            for axis in 0..3 {
-                s.add_fixed_coordinate(top, axis, None).unwrap();
-            }
-            s.add_distance(top, below.unwrap(), None).unwrap();
-            return s;
-        }
-        let left = s
-            .add_particle(1.0, [-1.0, 0.0, 0.0], [0.0; 3], true)
-            .unwrap();
-        let right = s
-            .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], true)
-            .unwrap();
-        let mut prev = left;
-        for i in 1..2 * n {
-            let x = -1.0 + i as f64 / n as f64;
-            let z = -(1.0 - x.abs());
-            let p = s.add_particle(0.1, [x, 0.0, z], [0.0; 3], false).unwrap();
-            s.add_distance(prev, p, None).unwrap();
-            prev = p;
-        }
-        s.add_distance(prev, right, None).unwrap();
-        s
-    }
-
     /// A V chain and a chain hanging from a pinned particle run with the tree elimination and
     /// agree with the general sparse LU run to round-off (the reference: the same steps with
     /// partial pivoting across the whole matrix), the chains having moved.
     #[test]
     fn singular_blocks_of_a_regular_matrix_fall_back_to_sparse_lu() {
         for pinned in [false, true] {
-            let system = awkward_chain(12, pinned);
+            let system = crate::integrators::fixtures::awkward_chain(12, pinned);
             let run = |sparse_solver| {
                 let options = crate::SimulationOptions {
                     t_end: 0.05,
