@@ -482,11 +482,10 @@ impl Fnv {
 /// Identifies each simulation (a snapshot remembers its run).
 static NEXT_RUN: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
 
-/// The scratch arrays of a step (written before they are read: not part of a snapshot).
+/// The scratch arrays of a step (written before they are read: not part of a snapshot). A
+/// converged step's positions, velocities and multipliers are the workspace's
+/// (`ws.state`), swapped with the carried state's when the step is accepted.
 struct Scratch {
-    q_new: Vec<Vec3>,
-    v_new: Vec<Vec3>,
-    lambda_new: Vec<f64>,
     acc_new: Vec<Vec3>,
     q_out: Vec<Vec3>,
     v_out: Vec<Vec3>,
@@ -732,9 +731,6 @@ impl<'a> Simulation<'a> {
         let dense = options.output_times.is_some();
         let if_dense = |x: &Vec<Vec3>| if dense { x.clone() } else { Vec::new() };
         let scratch = Scratch {
-            q_new: q.clone(),
-            v_new: v.clone(),
-            lambda_new: lambda.clone(),
             acc_new: acc.clone(),
             q_out: if_dense(&q),
             v_out: if_dense(&v),
@@ -1322,9 +1318,9 @@ impl Simulation<'_> {
             }
         };
         std::mem::swap(&mut c.acc, &mut s.acc_new);
-        s.q_new.copy_from_slice(&ws.state.q);
-        s.v_new.copy_from_slice(&ws.state.v);
-        s.lambda_new.copy_from_slice(&ws.state.lambda);
+        // The step's end: the workspace's state (swapped into the carried state below; the
+        // next step's predictor overwrites what the swap leaves there).
+        let new = &mut ws.state;
         c.step += 1;
         self.sol.accepted_step_sizes.push(h);
         let stats = StepStats {
@@ -1333,7 +1329,7 @@ impl Simulation<'_> {
             residual_norm: report.residual,
             increment_norm: report.increment,
         };
-        let slack = negative_tension(system, &s.lambda_new, t_new, self.tension_floor);
+        let slack = negative_tension(system, &new.lambda, t_new, self.tension_floor);
         let sol = &mut self.sol;
         if let Some(outputs) = self.options.output_times.as_deref() {
             let whole = StepEnds {
@@ -1342,9 +1338,9 @@ impl Simulation<'_> {
                 q_0: &c.q,
                 v_0: &c.v,
                 lambda_0: &c.lambda,
-                q_1: &s.q_new,
-                v_1: &s.v_new,
-                lambda_1: &s.lambda_new,
+                q_1: &new.q,
+                v_1: &new.v,
+                lambda_1: &new.lambda,
             };
             // An error-controlled step ends with its two half steps: interpolated in each (on the
             // kicked pendulum of tests/test_adaptive.py the largest velocity error is 119 times
@@ -1381,13 +1377,7 @@ impl Simulation<'_> {
                 };
                 if t_out == t_new {
                     // A time on the step's end (a fixed step's grid time): its state itself.
-                    store(
-                        sol,
-                        system,
-                        t_out,
-                        (&s.q_new, &s.v_new, &s.lambda_new),
-                        stats,
-                    );
+                    store(sol, system, t_out, (&new.q, &new.v, &new.lambda), stats);
                 } else {
                     ends.interpolate(t_out, &mut s.q_out, &mut s.v_out, &mut s.lambda_out);
                     store(
@@ -1402,33 +1392,21 @@ impl Simulation<'_> {
             }
             // A run that stops here shows the state where it stopped.
             if slack.is_some() && sol.times.last() != Some(&t_new) {
-                store(
-                    sol,
-                    system,
-                    t_new,
-                    (&s.q_new, &s.v_new, &s.lambda_new),
-                    stats,
-                );
+                store(sol, system, t_new, (&new.q, &new.v, &new.lambda), stats);
             }
         } else if c.step % self.options.save_every == 0 || ends_run || slack.is_some() {
-            store(
-                sol,
-                system,
-                t_new,
-                (&s.q_new, &s.v_new, &s.lambda_new),
-                stats,
-            );
+            store(sol, system, t_new, (&new.q, &new.v, &new.lambda), stats);
         }
-        std::mem::swap(&mut c.q, &mut s.q_new);
-        std::mem::swap(&mut c.v, &mut s.v_new);
-        for (rate, (&new, &old)) in c
+        std::mem::swap(&mut c.q, &mut new.q);
+        std::mem::swap(&mut c.v, &mut new.v);
+        for (rate, (&end, &old)) in c
             .lambda_rate
             .iter_mut()
-            .zip(s.lambda_new.iter().zip(&c.lambda))
+            .zip(new.lambda.iter().zip(&c.lambda))
         {
-            *rate = (new - old) / h;
+            *rate = (end - old) / h;
         }
-        std::mem::swap(&mut c.lambda, &mut s.lambda_new);
+        std::mem::swap(&mut c.lambda, &mut new.lambda);
         c.t = t_new;
         if let Some(e) = slack {
             sol.status = Err(e);
