@@ -25,12 +25,12 @@
 //! mass: the added mass's energy is the fluid's, not counted.
 
 use super::{Block, Entries, SlotTable, NONE};
-
-/// What receives a table's blocks (see [`AxialAddedMass::add_jacobian`]).
-pub type BlockVisit<'a> = dyn FnMut(&[Block]) + 'a;
 use crate::forces::{Force, Jacobian, LineHydro};
 use crate::math::{Mat3, Vec3};
 use crate::model::System;
+
+/// What receives a table's blocks (see [`AxialAddedMass::add_jacobian`]).
+pub type BlockVisit<'a> = dyn FnMut(&[Block]) + 'a;
 
 /// The line nodes whose added mass is anisotropic (CaAx != Ca), found once per run.
 #[derive(Debug, Clone, Default)]

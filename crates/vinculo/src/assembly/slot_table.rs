@@ -93,10 +93,8 @@ impl<const W: usize> SlotTable<W> {
                 }
             }
             Inner::Periodic { slots, run, .. } if run.contains(&i) => {
-                let (first, step) = slots.run_slots();
-                let k = (i - run.start) as u32;
                 for (o, &j) in out.iter_mut().zip(&picked) {
-                    *o = first[j].wrapping_add(k.wrapping_mul(step[j]));
+                    slots.copy_run(i - run.start, j, std::slice::from_mut(o));
                 }
             }
             Inner::Periodic { .. } => {
@@ -116,17 +114,7 @@ impl<const W: usize> SlotTable<W> {
     pub fn fill<const N: usize>(&self, element: usize, start: usize, out: &mut [[Slot; W]; N]) {
         match &self.inner {
             Inner::Plain(v) => out.copy_from_slice(&v[start..start + N]),
-            Inner::Periodic { slots, run, .. } if run.contains(&element) => {
-                // Loops of known length over the run's first slots and steps.
-                let (first, step) = slots.run_slots();
-                let (first, step) = (&first[..N * W], &step[..N * W]);
-                let k = (element - run.start) as u32;
-                let out = out.as_flattened_mut();
-                for ((o, &f), &d) in out.iter_mut().zip(first).zip(step) {
-                    *o = f.wrapping_add(k.wrapping_mul(d));
-                }
-            }
-            Inner::Periodic { slots, .. } => slots.copy(W * start, out.as_flattened_mut()),
+            Inner::Periodic { slots, run, .. } => copy(slots, run, element, start, out),
         }
     }
 
@@ -142,13 +130,7 @@ impl<const W: usize> SlotTable<W> {
         match &self.inner {
             Inner::Plain(v) => f(&v[range]),
             Inner::Periodic { slots, run, .. } => {
-                let copy = |out: &mut [[Slot; W]]| {
-                    if run.contains(&element) {
-                        slots.copy_run(element - run.start, out.as_flattened_mut());
-                    } else {
-                        slots.copy(W * range.start, out.as_flattened_mut());
-                    }
-                };
+                let copy = |out: &mut [[Slot; W]]| copy(slots, run, element, range.start, out);
                 let n = range.len();
                 if n <= 4 {
                     // A two-particle element's blocks, or a particle's strip of one.
@@ -220,6 +202,24 @@ impl<const W: usize> SlotTable<W> {
     /// Whether a run is compressed.
     pub fn is_compressed(&self) -> bool {
         matches!(self.inner, Inner::Periodic { .. })
+    }
+}
+
+/// The slots of the entries from `start` (element `element`'s, or the first of them) into
+/// `out`: computed from the run's first element's for an element of the run `run`, read for
+/// another.
+#[inline(always)]
+fn copy<const W: usize>(
+    slots: &BlockSlots,
+    run: &Range<usize>,
+    element: usize,
+    start: usize,
+    out: &mut [[Slot; W]],
+) {
+    if run.contains(&element) {
+        slots.copy_run(element - run.start, 0, out.as_flattened_mut());
+    } else {
+        slots.copy(W * start, out.as_flattened_mut());
     }
 }
 

@@ -94,13 +94,7 @@ impl BlockSlots {
         match &self.run {
             Some(run) if start >= run.entries.start && start < run.entries.end => {
                 let offset = start - run.entries.start;
-                let (block, k) = (offset / run.per_block, offset % run.per_block);
-                let first = &run.first[k..k + out.len()];
-                let step = &run.wrapping_step[k..k + out.len()];
-                let block = block as u32;
-                for ((o, &s), &d) in out.iter_mut().zip(first).zip(step) {
-                    *o = s.wrapping_add(block.wrapping_mul(d));
-                }
+                self.copy_run(offset / run.per_block, offset % run.per_block, out);
             }
             Some(run) if start >= run.entries.end => {
                 let at = start - run.entries.len();
@@ -115,26 +109,15 @@ impl BlockSlots {
         self.run.as_ref().map(|run| run.entries.clone())
     }
 
-    /// The run's first block's slots and their steps modulo 2^32: block k's slot e is
-    /// `first[e].wrapping_add(k.wrapping_mul(step[e]))`.
+    /// The slots of the entries `k..k + out.len()` of block `block` of the run (counted from
+    /// its first), into `out`.
     #[inline(always)]
-    pub(crate) fn run_slots(&self) -> (&[u32], &[u32]) {
-        let run = self.run.as_ref().expect("a run");
-        (&run.first, &run.wrapping_step)
-    }
-
-    /// The slots of block `block` of the run (counted from its first), its first `out.len()`
-    /// entries, into `out`.
-    #[inline(always)]
-    pub(crate) fn copy_run(&self, block: usize, out: &mut [u32]) {
+    pub(crate) fn copy_run(&self, block: usize, k: usize, out: &mut [u32]) {
         let run = self.run.as_ref().expect("a run");
         let n = out.len();
         let block = block as u32;
-        for ((o, &s), &d) in out
-            .iter_mut()
-            .zip(&run.first[..n])
-            .zip(&run.wrapping_step[..n])
-        {
+        let (first, step) = (&run.first[k..k + n], &run.wrapping_step[k..k + n]);
+        for ((o, &s), &d) in out.iter_mut().zip(first).zip(step) {
             *o = s.wrapping_add(block.wrapping_mul(d));
         }
     }

@@ -211,6 +211,9 @@ pub struct TreeElimination {
     in_place: bool,
     /// The local unknown of the (nearly) singular pivot of the last elimination that failed.
     failed: usize,
+    /// Entries of the pattern (the storage entries with a slot), counted when the solver is
+    /// made to factorise in place: the length of the fallback's value array.
+    pattern_entries: usize,
 }
 
 /// The blocks' storage, one array: the D_b (`diag`), then the A_ub or G_b (`low`), then the
@@ -720,6 +723,7 @@ impl TreeElimination {
             fallbacks: 0,
             in_place: false,
             failed: 0,
+            pattern_entries: 0,
         })
     }
 
@@ -890,6 +894,7 @@ impl TreeElimination {
             at[w_at + e] = self.up_slots.get(e);
         }
         let entries = at.iter().filter(|&&s| s != ABSENT).count();
+        self.pattern_entries = entries;
         let mut map = vec![ABSENT; entries];
         for (e, &slot) in at.iter().enumerate() {
             if slot != ABSENT {
@@ -906,7 +911,7 @@ impl TreeElimination {
     /// The matrix in the storage, in the pattern's order (for the fallback).
     fn stored_matrix(&self) -> Vec<f64> {
         let (low_at, w_at) = (self.store.low_at, self.store.w_at);
-        let mut values = vec![0.0; self.pattern_entries()];
+        let mut values = vec![0.0; self.pattern_entries];
         let mut put = |slot: u32, x: f64| {
             if slot != ABSENT {
                 values[slot as usize] = x;
@@ -920,16 +925,6 @@ impl TreeElimination {
             put(self.up_slots.get(e), self.store.w()[e]);
         }
         values
-    }
-
-    /// Entries of the pattern: the storage entries with a slot.
-    fn pattern_entries(&self) -> usize {
-        let (low_at, w_at) = (self.store.low_at, self.store.w_at);
-        let count =
-            |slots: &BlockSlots, n: usize| (0..n).filter(|&e| slots.get(e) != ABSENT).count();
-        count(&self.diag_slots, low_at)
-            + count(&self.low_slots, w_at - low_at)
-            + count(&self.up_slots, w_at - low_at)
     }
 
     /// Gathers the matrix entries of block b's storage: D_b, the A_ub and the A_bu (fill
