@@ -132,28 +132,33 @@ DAMPED = [s for s in SCHEMES if s[0].get("rho_inf") != 1.0]
 @pytest.mark.parametrize(("kwargs", "order", "label"), DAMPED, ids=[s[2] for s in DAMPED])
 @pytest.mark.parametrize("jacobian_reuse", [False, True], ids=["full", "modified"])
 def test_step_halving_keeps_the_scheme_on_track(kwargs, order, label, jacobian_reuse):
-    # At dt = 50 ms with 3 Newton iterations allowed, some steps of the horizontally released
-    # pendulum fail and are retried with half the step. The run must still reach t = 1 s with
-    # the constraint held, and near the DOP853 solution: within 5 cm (the schemes' own errors at
-    # these steps are below 2 cm, from C dt^2 with the constants of the order test above, and
-    # 6 cm for backward Euler whose error at dt = 4 ms is 6 cm).
+    # At dt = 60 ms with 3 Newton iterations allowed, some steps of the horizontally released
+    # pendulum fail and are retried with half the step (at 50 ms the generalised-alpha steps
+    # predicted from the extrapolated accelerations all converge in 3). The run must still
+    # reach t = 1 s with the constraint held, and end no farther from the DOP853 solution than
+    # the scheme's own run at dt does (halved steps are shorter, not worse), within 25 % and
+    # 1 mm: a step restarted from a state the failed attempt left behind would put the bob
+    # centimetres off (the schemes' own errors here are 0.5 cm to 0.5 m, backward Euler's the
+    # largest).
     model = demos.build_pendulum()
+    dt = 0.06
     solution = vinculo.simulate(
         model.system,
         1.0,
-        0.05,
+        dt,
         max_iterations=3,
         max_halvings=4,
         jacobian_reuse=jacobian_reuse,
         **kwargs,
     )
     assert solution.times[-1] == pytest.approx(1.0, abs=1e-12)
-    assert np.min(solution.step_sizes[1:]) < 0.05  # some steps were halved
+    assert np.min(solution.step_sizes[1:]) < dt  # some steps were halved
     assert np.max(solution.position_violation) < 1e-10
-    if order == 2.0:
-        theta = angle_reference(np.pi / 2, 1.0)
-        reference = np.array([np.sin(theta), 0.0, -np.cos(theta)])
-        assert np.max(np.abs(solution.particle(model.bob)[-1] - reference)) < 0.05
+    theta = angle_reference(np.pi / 2, 1.0)
+    reference = np.array([np.sin(theta), 0.0, -np.cos(theta)])
+    own = bob_error({**kwargs, "jacobian_reuse": False}, dt, 1.0, reference)
+    error = np.max(np.abs(solution.particle(model.bob)[-1] - reference))
+    assert error < 1.25 * own + 1e-3, (error, own)
 
 
 @pytest.mark.parametrize("formulation", ["index-3", "ggl"])

@@ -69,9 +69,14 @@ def test_floating_cylinder_equilibrium_and_heave_period():
     radius, height, draft = 0.8, 3.0, 1.7
     mass = RHO * math.pi * radius**2 * draft
     added = 0.3 * mass
-    # The hull from its keel (z = 0) up; the body's centre at half height.
-    hull = cylinder(radius, -height / 2, height / 2)
-    z_centre_eq = height / 2 - draft
+    # A ballasted cylinder: its centre (of mass) 0.5 m above the keel, so that it floats
+    # upright. The metacentric height is GM = KB + BM - KG = T/2 + R^2/(4T) - KG = 0.44 m; with
+    # its centre at half height (KG = 1.5 m) GM would be -0.56 m, and the upright cylinder
+    # would capsize from the round-off of its first steps (the tilt grows as exp(2.5 t), at
+    # the rate sqrt(m g |GM| / I)).
+    keel_to_centre = 0.5
+    hull = cylinder(radius, -keel_to_centre, height - keel_to_centre)
+    z_centre_eq = keel_to_centre - draft
     inertia = np.diag([mass * (3 * radius**2 + height**2) / 12] * 2 + [mass * radius**2 / 2])
     t, z = free_heave(mass, inertia, hull, z_centre_eq - 0.02, added, t_end=16.0)
     period, mean = period_and_mean(t, z)

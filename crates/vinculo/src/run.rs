@@ -34,19 +34,27 @@
 //! to t2 is bit for bit the run straight to t2. A stop between grid points shortens the step
 //! to land on it and starts the grid afresh there.
 //!
-//! The predictor of a step of size h (Newton's first iterate): the positions extrapolated at
-//! constant acceleration, q_n + h v_n + h^2/2 a_n, and, with fixed steps, the multipliers
-//! linearly, lambda_n + h (lambda_n - lambda_{n-1}) / h_{n-1} (the rate of the last accepted
-//! step; none before the first). Against the last multipliers alone, the linear extrapolation
-//! takes the first increment from O(h) to O(h^2) of the tension's change: measured on the
-//! benchmark's 100-segment hanging chain at dt = 5 ms (modified Newton, `vinculo.mooring`), 2.0
-//! Newton iterations a step instead of 3.0; on the pendulum of `python -m vinculo.bench`
-//! (generalised-alpha, 10^4 steps of 1 ms), modified Newton's bob ends 2.8e-6 m from full
-//! Newton's instead of 1.0e-4 m. Error-controlled steps keep the last multipliers: at their
-//! tightest tolerances (rtol = atol = 1e-10, some 10^5 steps) the global error depends on where
-//! Newton stops each step, within its tolerance (a hundredth of the error tolerance), and the
-//! predictor moves those stops: the pendulum's error (generalised-alpha, `tests/
-//! test_adaptive_accuracy.py`) went from 45 to 109 times the tolerance, where with Newton
+//! The predictor of a step of size h (Newton's first iterate): with fixed steps, a step of the
+//! last accepted step's size starts from the time rule's own end of step with its step
+//! accelerations extrapolated linearly from their rate over the last step
+//! ([`crate::integrators::TimeRule::predict`], an error of O(h^4)); any other step (the first,
+//! the halves of a failed step, a step shortened to a stop, the steps of a contact event's
+//! transient, error-controlled steps) from the positions extrapolated at constant acceleration,
+//! q_n + h v_n + h^2/2 a_n (O(h^3)): the rate of a step of another size is centred elsewhere in
+//! time. On the benchmark pendulum (generalised-alpha, 10^4 steps of 1 ms) the first residual
+//! of a step falls from 2.4e-8 to 2.6e-10 and the default Newton factorises 0.086 times a step
+//! instead of 0.51 (`docs/theory/newton.md`). The multipliers, with fixed steps, are
+//! extrapolated linearly, lambda_n + h (lambda_n - lambda_{n-1}) / h_{n-1} (the rate of the last
+//! accepted step; none before the first). Against the last multipliers alone, the linear
+//! extrapolation takes the first increment from O(h) to O(h^2) of the tension's change:
+//! measured on the benchmark's 100-segment hanging chain at dt = 5 ms (modified Newton,
+//! `vinculo.mooring`), 2.0 Newton iterations a step instead of 3.0; on the pendulum of `python -m
+//! vinculo.bench`, modified Newton's bob ends 2.8e-6 m from full Newton's instead of 1.0e-4 m
+//! (1.1e-6 m with the extrapolated accelerations). Error-controlled steps keep the last
+//! multipliers: at their tightest tolerances (rtol = atol = 1e-10, some 10^5 steps) the global
+//! error depends on where Newton stops each step, within its tolerance (a hundredth of the error
+//! tolerance), and the predictor moves those stops: the pendulum's error (generalised-alpha,
+//! `tests/test_adaptive_accuracy.py`) went from 45 to 109 times the tolerance, where with Newton
 //! converged to 1e-14 it is 13 to 16 times with either predictor.
 //!
 //! Contact events: a converged fixed step during which a force jumps
@@ -365,6 +373,12 @@ pub(crate) struct Carried {
     /// (lambda_{n+1} - lambda_n) / h of the last accepted step (zero before the first): the
     /// predictor's rate of the multipliers.
     pub(crate) lambda_rate: Vec<f64>,
+    /// (acc_{n+1} - acc_n) / h of the last accepted fixed step (zero before the first, after
+    /// a contact event's restart and with error control): the predictor's rate of the
+    /// accelerations, used by a step of the same size only.
+    pub(crate) acc_rate: Vec<Vec3>,
+    /// The size h of the step over which `acc_rate` was measured (0: none).
+    pub(crate) acc_rate_step: f64,
     pub(crate) rule: RuleState,
     pub(crate) controller: Controller,
     /// Accepted steps so far.
@@ -752,6 +766,8 @@ impl<'a> Simulation<'a> {
                 t: t0,
                 q,
                 v,
+                acc_rate: vec![[0.0; 3]; acc.len()],
+                acc_rate_step: 0.0,
                 acc,
                 lambda_rate: vec![0.0; lambda.len()],
                 lambda,
@@ -1092,10 +1108,17 @@ impl Simulation<'_> {
         }
         let mut fresh_retry = false;
         loop {
-            // Predictor: constant-acceleration extrapolation of the positions, linear
-            // extrapolation of the multipliers (module documentation).
+            // Predictor: the rule's own step end with the accelerations extrapolated linearly
+            // (a fixed step of the last step's size), else constant-acceleration extrapolation;
+            // the multipliers extrapolated linearly (fixed steps) or the last ones (error
+            // control; module documentation).
             let ws = &mut self.ws;
-            extrapolate((&c.q, &c.v, &c.acc), h_try, &mut ws.state.q);
+            if c.acc_rate_step == h_try {
+                let start = StepStart::new(c.t, &c.q, &c.v, h_try);
+                scheme.predict(&c.rule, start, (&c.acc, &c.acc_rate), &mut ws.state.q);
+            } else {
+                extrapolate((&c.q, &c.v, &c.acc), h_try, &mut ws.state.q);
+            }
             let ahead = match c.controller {
                 Controller::Fixed(_) => h_try,
                 Controller::Adaptive(_) => 0.0,
@@ -1259,6 +1282,7 @@ impl Simulation<'_> {
         if let Ok((acc, _)) = start {
             c.rule = self.options.scheme.initial_state(&acc);
             c.acc = acc;
+            c.acc_rate_step = 0.0;
         }
     }
 
@@ -1317,6 +1341,12 @@ impl Simulation<'_> {
                 }
             }
         };
+        if matches!(c.controller, Controller::Fixed(_)) {
+            for (rate, (end, old)) in c.acc_rate.iter_mut().zip(s.acc_new.iter().zip(&c.acc)) {
+                *rate = std::array::from_fn(|k| (end[k] - old[k]) / h);
+            }
+            c.acc_rate_step = h;
+        }
         std::mem::swap(&mut c.acc, &mut s.acc_new);
         // The step's end: the workspace's state (swapped into the carried state below; the
         // next step's predictor overwrites what the swap leaves there).

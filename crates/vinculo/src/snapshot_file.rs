@@ -1,6 +1,6 @@
 //! Snapshot files: a [`Snapshot`] saved to and loaded from a small binary file.
 //!
-//! # Format (version 7)
+//! # Format (version 8)
 //!
 //! Little-endian throughout; every float is stored as its IEEE-754 bits, so a loaded snapshot
 //! is bit for bit the saved one.
@@ -8,10 +8,11 @@
 //! | field | type |
 //! |---|---|
 //! | magic `VNCLSNAP` | 8 bytes |
-//! | version (7) | u32 |
+//! | version (8) | u32 |
 //! | model fingerprint ([`crate::run::fingerprint`]), particles n, constraint equations m | 3 x u64 |
 //! | time | f64 |
-//! | positions, velocities, accelerations | 3 x (n x 3 f64) |
+//! | positions, velocities, accelerations, their rates over the last step (the predictor's, `run.rs`) | 4 x (n x 3 f64) |
+//! | the size of the step the accelerations' rates were measured over (0: none) | f64 |
 //! | multipliers, their rates over the last step (the predictor's, `run.rs`) | 2 x (m f64) |
 //! | the time rule's state: 4 arrays of 3-vectors, each a u64 length then length x 3 f64 | |
 //! | step controller tag: 0 (fixed steps) or 1 (error control), then its state (below) | u8 |
@@ -35,7 +36,9 @@
 //! | PI controller: order k, last error norm, last attempt rejected (0 or 1), hold | f64, f64, u8, f64 |
 //! | next step size h, error norm of the last judged step | 2 x f64 |
 //!
-//! Version 6 is version 7 without the residual evaluations (read as zero). Version 5 is version
+//! Version 7 is version 8 without the accelerations' rates (read as zero: the first step after
+//! restoring it predicts at constant acceleration). Version 6 is version 7 without the
+//! residual evaluations (read as zero). Version 5 is version
 //! 6 without the multipliers' rates (read as zero: the first step after
 //! restoring it predicts the last multipliers) and without the run's own grid (read as the
 //! current grid: a run restored during a contact event's transient stays on the event's grid). Version 4 is version 5 without the held iteration matrix (read as none: the first step after
@@ -56,7 +59,7 @@ use crate::run::{Carried, Controller, FixedSteps, Fnv, HeldMatrix, Snapshot};
 use crate::step_control::{AdaptiveOptions, ErrorWeights, PiController};
 
 const MAGIC: &[u8; 8] = b"VNCLSNAP";
-const VERSION: u32 = 7;
+const VERSION: u32 = 8;
 /// The oldest format version still read.
 const OLDEST: u32 = 1;
 
@@ -276,6 +279,8 @@ impl Snapshot {
         w.vecs(&c.q);
         w.vecs(&c.v);
         w.vecs(&c.acc);
+        w.vecs(&c.acc_rate);
+        w.f64(c.acc_rate_step);
         for &x in c.lambda.iter().chain(&c.lambda_rate) {
             w.f64(x);
         }
@@ -337,7 +342,7 @@ impl Snapshot {
     ///
     /// # Errors
     /// [`Error::Snapshot`] when the file cannot be read, is not a snapshot file, is of a format
-    /// version this vinculo does not read (1 to 7 are; of 2 only fixed steps), or is truncated or corrupt (its
+    /// version this vinculo does not read (1 to 8 are; of 2 only fixed steps), or is truncated or corrupt (its
     /// checksum does not match).
     pub fn load(path: impl AsRef<Path>) -> Result<Snapshot> {
         let path = path.as_ref();
@@ -381,6 +386,11 @@ impl Snapshot {
         let q = r.vecs(n)?;
         let v = r.vecs(n)?;
         let acc = r.vecs(n)?;
+        let (acc_rate, acc_rate_step) = if version >= 8 {
+            (r.vecs(n)?, r.f64()?)
+        } else {
+            (vec![[0.0; 3]; n], 0.0)
+        };
         let rates = if version >= 6 { m } else { 0 };
         if (m + rates).saturating_mul(8) > body.len() - r.at {
             return Err(file_error(path, "the file is truncated or corrupt"));
@@ -472,6 +482,8 @@ impl Snapshot {
                 q,
                 v,
                 acc,
+                acc_rate,
+                acc_rate_step,
                 lambda,
                 lambda_rate,
                 rule,

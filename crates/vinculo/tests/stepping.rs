@@ -297,7 +297,9 @@ fn with_checksum(mut body: Vec<u8>) -> Vec<u8> {
 /// contact events' state, none pending, without the run's own grid, read as the current grid,
 /// and without the held iteration matrix, none held) is still read, to the same snapshot
 /// (saved again, the version 6 file with zero rates and no matrix held), and so is one written
-/// as version 5 (without the rates and the run's own grid).
+/// as version 5 (without the rates and the run's own grid), 6 (without the residual
+/// evaluations) or 7 (without the accelerations' rates, read as zero: saved again, the
+/// version 8 file with zero rates).
 #[test]
 fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     let system = chain();
@@ -313,7 +315,27 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     run.step_to(0.05).clone().unwrap();
     run.snapshot().save(&path).unwrap();
     let good = std::fs::read(&path).unwrap();
-    assert_eq!(&good[8..12], &7u32.to_le_bytes());
+    assert_eq!(&good[8..12], &8u32.to_le_bytes());
+    let n = system.particles().len();
+    // Version 8 keeps the accelerations' rates and their step after the accelerations; the
+    // files below are written from version 7's layout (without them) and read back as version
+    // 8 (zero rates, no step).
+    let acc_rates_at = 8 + 4 + 24 + 8 + 3 * 24 * n;
+    let v7 = |v8: &[u8]| {
+        let mut b = [&v8[..acc_rates_at], &v8[acc_rates_at + 24 * n + 8..]].concat();
+        b[8..12].copy_from_slice(&7u32.to_le_bytes());
+        b
+    };
+    let v8 = |v7: Vec<u8>| {
+        let mut b = [
+            &v7[..acc_rates_at],
+            &vec![0u8; 24 * n + 8],
+            &v7[acc_rates_at..],
+        ]
+        .concat();
+        b[8..12].copy_from_slice(&8u32.to_le_bytes());
+        with_checksum(b)
+    };
     let refused = |bytes: &[u8], expected: &str| {
         let damaged = dir.join("damaged.snap");
         std::fs::write(&damaged, bytes).unwrap();
@@ -327,13 +349,12 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     // Truncated: the checksum no longer matches.
     refused(&good[..good.len() - 20], "checksum");
     // Cut short inside the error control's state, with a checksum of what is left.
-    let body = &good[..good.len() - 8];
+    let body = &v7(&good[..good.len() - 8]);
     refused(
         &with_checksum(body[..body.len() - 60].to_vec()),
         "truncated",
     );
     // The time rule's tag (right after the step controller's tag 1) made unknown.
-    let n = system.particles().len();
     let m = run.snapshot().constraints();
     // Header, counts, time, q, v, acc, lambda, its rates, then the rule's four sized arrays
     // (empty for the default trapezoidal rule: their lengths alone).
@@ -379,7 +400,13 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     let v2 = dir.join("fixed.snap");
     fixed.snapshot().save(&v2).unwrap();
     let v2_bytes = std::fs::read(&v2).unwrap();
-    let body = &v2_bytes[..v2_bytes.len() - 8];
+    assert!(
+        v2_bytes[acc_rates_at..acc_rates_at + 24 * n]
+            .iter()
+            .any(|&b| b != 0),
+        "the chain swings: non-zero accelerations' rates"
+    );
+    let body = &v7(&v2_bytes[..v2_bytes.len() - 8]);
     // The fixed-step state (top, unit, units, level, t_grid: 32 bytes after the controller's
     // tag) without the contact events' two numbers after it.
     assert_eq!(body[tag_at], 0, "the step controller's tag");
@@ -409,16 +436,14 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     let loaded = vinculo::Snapshot::load(&v1).unwrap();
     let again = dir.join("fixed-again.snap");
     loaded.save(&again).unwrap();
-    let without_matrix = with_checksum(
-        [
-            &body[..rates_at],
-            &zero_rates,
-            &body[rates_end..counts_end - 8],
-            &[0u8; 8][..],
-            &[0u8][..],
-        ]
-        .concat(),
-    );
+    let without_matrix = v8([
+        &body[..rates_at],
+        &zero_rates,
+        &body[rates_end..counts_end - 8],
+        &[0u8; 8][..],
+        &[0u8][..],
+    ]
+    .concat());
     assert_eq!(std::fs::read(&again).unwrap(), without_matrix);
     // A version 5 file: without the rates, the run's own grid (read as the current one) and
     // the residual evaluations (read as zero).
@@ -433,16 +458,14 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     let v5 = dir.join("fixed-v5.snap");
     std::fs::write(&v5, with_checksum(v5_body)).unwrap();
     vinculo::Snapshot::load(&v5).unwrap().save(&again).unwrap();
-    let zeroed = with_checksum(
-        [
-            &body[..rates_at],
-            &zero_rates,
-            &body[rates_end..counts_end - 8],
-            &[0u8; 8][..],
-            &body[counts_end..],
-        ]
-        .concat(),
-    );
+    let zeroed = v8([
+        &body[..rates_at],
+        &zero_rates,
+        &body[rates_end..counts_end - 8],
+        &[0u8; 8][..],
+        &body[counts_end..],
+    ]
+    .concat());
     assert_eq!(std::fs::read(&again).unwrap(), zeroed);
     // A version 6 file: without the residual evaluations.
     let mut v6_body = [&body[..counts_end - 8], &body[counts_end..]].concat();
@@ -451,9 +474,16 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     std::fs::write(&v6, with_checksum(v6_body)).unwrap();
     let restored = vinculo::Snapshot::load(&v6).unwrap();
     restored.save(&again).unwrap();
-    let counted_zero =
-        with_checksum([&body[..counts_end - 8], &[0u8; 8][..], &body[counts_end..]].concat());
+    let counted_zero = v8([&body[..counts_end - 8], &[0u8; 8][..], &body[counts_end..]].concat());
     assert_eq!(std::fs::read(&again).unwrap(), counted_zero);
+    // A version 7 file: without the accelerations' rates.
+    let v7_path = dir.join("fixed-v7.snap");
+    std::fs::write(&v7_path, with_checksum(body.to_vec())).unwrap();
+    vinculo::Snapshot::load(&v7_path)
+        .unwrap()
+        .save(&again)
+        .unwrap();
+    assert_eq!(std::fs::read(&again).unwrap(), v8(body.to_vec()));
     std::fs::remove_dir_all(&dir).ok();
 }
 

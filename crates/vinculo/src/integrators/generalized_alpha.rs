@@ -258,6 +258,33 @@ impl TimeRule for GeneralizedAlpha {
         }
     }
 
+    /// q_{n+1} = q_n + h v_n + h^2 ((1/2 - beta) a_n + beta a_{n+1}) in the algorithmic
+    /// accelerations, with a_{n+1} = a_n + h `rate`: the true accelerations' rate stands for
+    /// the algorithmic ones' (a_n follows qdd at a shift of (alpha_m - alpha_f) h, and the two
+    /// rates differ by O(h)), so q_n + h v_n + h^2 a_n / 2 + beta h^3 rate.
+    fn predict(
+        &self,
+        state: &RuleState,
+        start: StepStart,
+        (_, rate): (&[Vec3], &[Vec3]),
+        out: &mut [Vec3],
+    ) {
+        let (h, beta) = (start.h, self.coefficients().beta);
+        let (half, w) = (0.5 * h * h, beta * h * h * h);
+        for (o, (((q, v), a), r)) in out.iter_mut().zip(
+            start
+                .q_n
+                .iter()
+                .zip(start.v_n)
+                .zip(&state.algorithmic)
+                .zip(rate),
+        ) {
+            for k in 0..3 {
+                o[k] = q[k] + h * v[k] + half * a[k] + w * r[k];
+            }
+        }
+    }
+
     fn ggl(&self, state: &RuleState, start: StepStart, base: GglBase) -> GglCoefficients {
         let (k, h) = (self.coefficients(), start.h);
         let kappa = k.beta * h / k.gamma;

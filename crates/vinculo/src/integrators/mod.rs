@@ -135,6 +135,18 @@ impl Scheme {
         })
     }
 
+    /// Newton's first iterate of a fixed step from `start` into `out`, from the last step's end
+    /// acceleration and its rate `acc` ([`rule::TimeRule::predict`]).
+    pub fn predict(
+        &self,
+        state: &RuleState,
+        start: StepStart,
+        acc: (&[Vec3], &[Vec3]),
+        out: &mut [Vec3],
+    ) {
+        with_rule!(*self, rule => rule.predict(state, start, acc, out))
+    }
+
     /// The acceleration of a converged step from `start` to v_{n+1} = `v` (the rule's `state`
     /// already advanced), into `out`: the run loop's predictor and error sample.
     pub fn end_acceleration(

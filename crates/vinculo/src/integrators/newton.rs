@@ -7,7 +7,8 @@
 //!
 //! It also stops, converged, when the residual is below the tolerance and the increments have
 //! stopped decreasing: an increment made with a fresh matrix that is more than
-//! [`FLOOR_CONTRACTION`] of the one before. Newton's increments shrink quadratically until the
+//! [`FLOOR_CONTRACTION`] of the one before, while the residual no longer falls by more than
+//! [`FLOOR_RESIDUAL_DROP`] from one iterate to the next. Newton's increments shrink quadratically until the
 //! residual reaches the round-off of the terms that cancel in it; from there each new increment
 //! is the matrix's inverse applied to that round-off, a random vector that does not shrink.
 //! Near a singular configuration (a mechanism whose bars are all collinear, where the constraint
@@ -154,6 +155,15 @@ pub const REUSED_ERROR_SHARE: f64 = 1e-3;
 /// least linearly with ratio 1/2 even at a singular solution, so a ratio above 0.9 is not
 /// convergence still under way.
 pub const FLOOR_CONTRACTION: f64 = 0.9;
+
+/// Ratio |R(x_k)| / |R(x_{k-1})| below which the residual is still falling, so that increments
+/// that stopped shrinking are not yet the round-off floor: at the floor the residual is the
+/// round-off of its own evaluation, which does not fall by a hundred from one iterate to the
+/// next. An increment the size of the one before, made from a residual a thousand times smaller,
+/// is a step along a direction the matrix barely resists (a long chain under tension, whose
+/// multipliers are ill-determined by the residual), and the iteration goes on (module
+/// documentation).
+pub const FLOOR_RESIDUAL_DROP: f64 = 1e-2;
 
 /// What the linear solver's current factorisation is, for reuse by modified Newton.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -404,6 +414,7 @@ pub fn solve(
     for iteration in 0..=options.max_iterations {
         problem.residual(r);
         matrix.residuals += 1;
+        let residual_before = residual;
         residual = inf_norm(r);
         if !residual.is_finite() {
             return Err(NewtonFailure::NotConverged {
@@ -412,7 +423,9 @@ pub fn solve(
                 worst: worst_entry(r),
             });
         }
-        let at_floor = fresh && increment > FLOOR_CONTRACTION * increment_before;
+        let at_floor = fresh
+            && increment > FLOOR_CONTRACTION * increment_before
+            && residual > FLOOR_RESIDUAL_DROP * residual_before;
         // At the floor, a residual the evaluation cannot resolve is as good as zero.
         let floor = if at_floor && residual > options.tolerance {
             problem.round_off(values)

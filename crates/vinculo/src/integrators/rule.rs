@@ -199,6 +199,20 @@ pub trait TimeRule: Copy + Send + Sync {
     /// After a converged GGL step of size `h` from v_n to v_{n+1} = `v`: the rule's new state.
     fn advance_ggl(&self, state: &mut RuleState, h: f64, v_n: &[Vec3], v: &[Vec3]);
 
+    /// Newton's first iterate of a step from `start` into `out`: the step's own end,
+    /// q_{n+1} = q_n + h v_n + h^2 (w_n A_n + w A_{n+1}) in the rule's step accelerations A,
+    /// with A_{n+1} extrapolated linearly, A_n + h `rate`, from the last step's end acceleration
+    /// `acc` ([`TimeRule::end_acceleration`]) and its rate over that step (zero: constant
+    /// acceleration). Its error is O(h^4) where the constant-acceleration extrapolation
+    /// q_n + h v_n + h^2/2 qdd_n is O(h^3) (`docs/theory/newton.md`, "The predictor").
+    fn predict(
+        &self,
+        state: &RuleState,
+        start: StepStart,
+        acc: (&[Vec3], &[Vec3]),
+        out: &mut [Vec3],
+    );
+
     /// The acceleration of a converged step from `start` to v_{n+1} = `v` (with the state
     /// already advanced), into `out`: what the run loop's predictor extrapolates with.
     fn end_acceleration(&self, state: &RuleState, start: StepStart, v: &[Vec3], out: &mut [Vec3]);

@@ -88,6 +88,27 @@ impl TimeRule for GeneralizedTrapezoidal {
 
     fn advance(&self, _state: &mut RuleState, _h: f64, _q: &[Vec3]) {}
 
+    /// q_{n+1} = q_n + h ((1 - alpha) v_n + alpha v_{n+1}) with v_{n+1} = v_n + h A_{n+1}, A
+    /// the step's mean acceleration (v_{n+1} - v_n)/h ([`TimeRule::end_acceleration`]):
+    /// q_n + h v_n + alpha h^2 (A_n + h rate).
+    fn predict(
+        &self,
+        _: &RuleState,
+        start: StepStart,
+        (acc, rate): (&[Vec3], &[Vec3]),
+        out: &mut [Vec3],
+    ) {
+        let (h, w) = (start.h, self.alpha * start.h * start.h);
+        for (o, (((q, v), a), r)) in out
+            .iter_mut()
+            .zip(start.q_n.iter().zip(start.v_n).zip(acc).zip(rate))
+        {
+            for k in 0..3 {
+                o[k] = q[k] + h * v[k] + w * (a[k] + h * r[k]);
+            }
+        }
+    }
+
     fn ggl(&self, _: &RuleState, start: StepStart, base: GglBase) -> GglCoefficients {
         let (a, h) = (self.alpha, start.h);
         for (i, (q_n, v_n)) in start.q_n.iter().zip(start.v_n).enumerate() {
