@@ -210,12 +210,18 @@ pub fn time_spacing(t: f64) -> f64 {
 /// than [`STEP_IN_TIME_SPACINGS`] spacings at the larger of |t| and |t + h|), if it is one.
 pub(crate) fn unresolved_step(t: f64, h: f64) -> Option<Error> {
     let spacing = time_spacing(t.abs().max((t + h).abs()));
-    (h < STEP_IN_TIME_SPACINGS * spacing).then_some(Error::StepBelowTimeResolution {
-        t,
-        h,
-        spacing,
-        smallest: STEP_IN_TIME_SPACINGS * spacing,
-    })
+    // Built only when it is returned (an error made and dropped at every step costs a
+    // branch on its kind).
+    if h < STEP_IN_TIME_SPACINGS * spacing {
+        Some(Error::StepBelowTimeResolution {
+            t,
+            h,
+            spacing,
+            smallest: STEP_IN_TIME_SPACINGS * spacing,
+        })
+    } else {
+        None
+    }
 }
 
 impl FixedSteps {

@@ -104,7 +104,10 @@ impl EnergyGuard {
     /// beyond the bound.
     pub fn check(&self, system: &System, q: &[Vec3], v: &[Vec3], t: f64, h: f64) -> Option<Error> {
         let energy = system.kinetic_energy(v) + system.potential_energy(q);
-        (energy.is_nan() || energy > self.initial + self.slack).then_some(Error::EnergyGrowth {
+        if !(energy.is_nan() || energy > self.initial + self.slack) {
+            return None;
+        }
+        Some(Error::EnergyGrowth {
             t,
             dt: h,
             rho_inf: self.rho_inf,
