@@ -37,11 +37,11 @@
 //! The predictor of a step of size h (Newton's first iterate): with fixed steps, a step of the
 //! last accepted step's size starts from the time rule's own end of step with its step
 //! accelerations extrapolated linearly from their rate over the last step
-//! ([`crate::integrators::TimeRule::predict`], an error of O(h^4)); any other step (the first,
-//! the halves of a failed step, a step shortened to a stop, the steps of a contact event's
-//! transient, error-controlled steps) from the positions extrapolated at constant acceleration,
-//! q_n + h v_n + h^2/2 a_n (O(h^3)): the rate of a step of another size is centred elsewhere in
-//! time. On the benchmark pendulum (generalised-alpha, 10^4 steps of 1 ms) the first residual
+//! ([`crate::integrators::TimeRule::predict`], an error of O(h^4)); a step of another size (the
+//! first, the halves of a failed step, a step shortened to a stop or to a contact event), the
+//! first step after a contact event's restart and error-controlled steps start from the
+//! positions extrapolated at constant acceleration, q_n + h v_n + h^2/2 a_n (O(h^3)): the rate
+//! of a step of another size is centred elsewhere in time. On the benchmark pendulum (generalised-alpha, 10^4 steps of 1 ms) the first residual
 //! of a step falls from 2.4e-8 to 2.6e-10 and the default Newton factorises 0.086 times a step
 //! instead of 0.51 (`docs/theory/newton.md`). The multipliers, with fixed steps, are
 //! extrapolated linearly, lambda_n + h (lambda_n - lambda_{n-1}) / h_{n-1} (the rate of the last
@@ -379,9 +379,9 @@ pub(crate) struct Carried {
     /// (lambda_{n+1} - lambda_n) / h of the last accepted step (zero before the first): the
     /// predictor's rate of the multipliers.
     pub(crate) lambda_rate: Vec<f64>,
-    /// (acc_{n+1} - acc_n) / h of the last accepted fixed step (zero before the first, after
-    /// a contact event's restart and with error control): the predictor's rate of the
-    /// accelerations, used by a step of the same size only.
+    /// (acc_{n+1} - acc_n) / h of the last accepted fixed step: the predictor's rate of the
+    /// accelerations, used by a step of the same size only (none before the first step, after
+    /// a contact event's restart and with error control: `acc_rate_step` is then 0).
     pub(crate) acc_rate: Vec<Vec3>,
     /// The size h of the step over which `acc_rate` was measured (0: none).
     pub(crate) acc_rate_step: f64,
@@ -1113,13 +1113,17 @@ impl Simulation<'_> {
             return Next::Stop;
         }
         let mut fresh_retry = false;
+        // Whether this attempt is the one at constant acceleration after an extrapolated
+        // attempt that failed.
+        let mut plain_retry = false;
         loop {
             // Predictor: the rule's own step end with the accelerations extrapolated linearly
             // (a fixed step of the last step's size), else constant-acceleration extrapolation;
             // the multipliers extrapolated linearly (fixed steps) or the last ones (error
             // control; module documentation).
             let ws = &mut self.ws;
-            if c.acc_rate_step == h_try {
+            let extrapolated = c.acc_rate_step == h_try && !plain_retry;
+            if extrapolated {
                 let start = StepStart::new(c.t, &c.q, &c.v, h_try);
                 scheme.predict(&c.rule, start, (&c.acc, &c.acc_rate), &mut ws.state.q);
             } else {
@@ -1210,6 +1214,19 @@ impl Simulation<'_> {
                 Err(_) if stale => {
                     ws.matrix.invalidate();
                     fresh_retry = true;
+                }
+                // A step predicted from the extrapolated accelerations gets one more attempt
+                // from the constant-acceleration predictor (and a fresh matrix) before it counts
+                // as failed: where the accelerations turn faster than the steps resolve (the
+                // tip of a long chain whipping), the extrapolation can start Newton farther
+                // off than constant acceleration does.
+                Err(_) if extrapolated => {
+                    ws.matrix.invalidate();
+                    if may_reject {
+                        c.rule.copy_from(&self.scratch.rule_saved);
+                    }
+                    fresh_retry = true;
+                    plain_retry = true;
                 }
                 Err(failure) => {
                     self.sol.steps_rejected += 1;

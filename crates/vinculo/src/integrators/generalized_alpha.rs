@@ -67,7 +67,7 @@
 //! w = 1 (everything at t_{n+1}).
 
 use super::rule::{
-    GglBase, GglCoefficients, Index3Rule, RuleState, StepPoint, StepStart, TimeRule,
+    resolved_rate, GglBase, GglCoefficients, Index3Rule, RuleState, StepPoint, StepStart, TimeRule,
 };
 use crate::math::Vec3;
 
@@ -279,6 +279,7 @@ impl TimeRule for GeneralizedAlpha {
                 .zip(&state.algorithmic)
                 .zip(rate),
         ) {
+            let r = resolved_rate(h, a, r);
             for k in 0..3 {
                 o[k] = q[k] + h * v[k] + half * a[k] + w * r[k];
             }

@@ -29,7 +29,7 @@
 //! c_v = 1/h, c = -v_n/h, w = alpha.
 
 use super::rule::{
-    GglBase, GglCoefficients, Index3Rule, RuleState, StepPoint, StepStart, TimeRule,
+    resolved_rate, GglBase, GglCoefficients, Index3Rule, RuleState, StepPoint, StepStart, TimeRule,
 };
 use crate::math::Vec3;
 
@@ -103,6 +103,7 @@ impl TimeRule for GeneralizedTrapezoidal {
             .iter_mut()
             .zip(start.q_n.iter().zip(start.v_n).zip(acc).zip(rate))
         {
+            let r = resolved_rate(h, a, r);
             for k in 0..3 {
                 o[k] = q[k] + h * v[k] + w * (a[k] + h * r[k]);
             }
