@@ -36,8 +36,10 @@
 //!
 //! The predictor of a step of size h (Newton's first iterate): with fixed steps, a step of the
 //! last accepted step's size starts from the time rule's own end of step with its step
-//! accelerations extrapolated linearly from their rate over the last step
-//! ([`crate::integrators::TimeRule::predict`], an error of O(h^4)); a step of another size (the
+//! accelerations extrapolated linearly from their rate over the last step, where the step
+//! resolves their change ([`crate::integrators::TimeRule::predict`],
+//! [`crate::integrators::resolved_rate`], an error of O(h^4)), and gets one more attempt at
+//! constant acceleration if it fails; a step of another size (the
 //! first, the halves of a failed step, a step shortened to a stop or to a contact event), the
 //! first step after a contact event's restart and error-controlled steps start from the
 //! positions extrapolated at constant acceleration, q_n + h v_n + h^2/2 a_n (O(h^3)): the rate

@@ -28,7 +28,10 @@ pub use newton::{
     IterationMatrix, JacobianReuse, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem,
     NewtonReport,
 };
-pub use rule::{GglBase, GglCoefficients, Index3Rule, RuleState, StepPoint, StepStart, TimeRule};
+pub use rule::{
+    resolved_rate, GglBase, GglCoefficients, Index3Rule, RuleState, StepPoint, StepStart, TimeRule,
+    RESOLVED_CHANGE,
+};
 pub use stabilized::{phi_qt, Formulation, StabilizedWorkspace};
 pub use stabilized_layout::StabilizedLayout;
 pub use step_problem::{index3_step, StepProblem};
