@@ -1199,6 +1199,13 @@ impl LinearSolver for TreeElimination {
             lu.solve_in_place(rhs);
             return;
         }
+        if self.blocks() == 1 {
+            // One block (a single particle and its conditions, as a pendulum's bob): its
+            // factors' solve alone, without the sweeps' bookkeeping (a third of a step's
+            // instructions on the pendulum went to it).
+            self.solve_single_block(rhs);
+            return;
+        }
         for (z, &u) in self.z.iter_mut().zip(&self.unknowns) {
             *z = rhs[u as usize];
         }
@@ -1270,6 +1277,26 @@ impl LinearSolver for TreeElimination {
 }
 
 impl TreeElimination {
+    /// The solve of a matrix that is one block: D z = r with its factors, in place.
+    fn solve_single_block(&mut self, rhs: &mut [f64]) {
+        let n = self.unknowns.len();
+        let z = &mut self.z[..n];
+        for (z, &u) in z.iter_mut().zip(&self.unknowns) {
+            *z = rhs[u as usize];
+        }
+        let d = &self.store.diag()[self.diag_at[0]..self.diag_at[1]];
+        let perm = &self.perm[..n];
+        match n {
+            3 => block_solve_fixed::<3>(d, perm, z),
+            4 => block_solve_fixed::<4>(d, perm, z),
+            5 => block_solve_fixed::<5>(d, perm, z),
+            _ => lu_solve(d, n, perm, z, 1),
+        }
+        for (z, &u) in z.iter().zip(&self.unknowns) {
+            rhs[u as usize] = *z;
+        }
+    }
+
     /// The forward and backward sweeps of the solve on the work vector `z` (blocks of any size,
     /// any number of coupled ancestors).
     fn sweeps(&mut self) {
