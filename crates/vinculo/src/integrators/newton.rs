@@ -301,6 +301,17 @@ pub enum NewtonFailure {
 /// The infinity norm of `x`, NaN if any entry is NaN. Four independent running maxima and a
 /// NaN flag, with no early exit, so that the compiler turns the pass into vector instructions.
 fn inf_norm(x: &[f64]) -> f64 {
+    if x.len() < 8 {
+        // A small system (a pendulum's four unknowns): one running maximum, without the
+        // setting up and combining of the four lanes.
+        let (mut m, mut nan) = (0.0f64, false);
+        for v in x {
+            let a = v.abs();
+            m = if a > m { a } else { m };
+            nan |= a.is_nan();
+        }
+        return if nan { f64::NAN } else { m };
+    }
     let mut m = [0.0f64; 4];
     let mut nan = false;
     let chunks = x.chunks_exact(4);
