@@ -26,7 +26,7 @@
 
 use super::{Block, Entries, SlotTable, NONE};
 use crate::forces::{Force, Jacobian, LineHydro};
-use crate::math::{Mat3, Vec3};
+use crate::math::{dot, norm, scale, sub, Mat3, Vec3};
 use crate::model::System;
 
 /// What receives a table's blocks (see [`AxialAddedMass::add_jacobian`]).
@@ -37,6 +37,19 @@ pub type BlockVisit<'a> = dyn FnMut(&[Block]) + 'a;
 pub struct AxialAddedMass {
     /// (index of the [`LineHydro`] force, the element).
     nodes: Vec<(usize, LineHydro)>,
+    /// What the residual's rows need of each node, in the order of `nodes`.
+    rows: Vec<AxialRow>,
+}
+
+/// One node's correction in the residual: C_i a = -e t (t . a), t = unit(q_b - q_a).
+#[derive(Debug, Clone, Copy)]
+struct AxialRow {
+    /// The node's particle i.
+    node: usize,
+    /// The particles (a, b) of its tangent.
+    ends: [usize; 2],
+    /// e_i = (Ca - CaAx) rho V ([`LineHydro::axial_excess`]).
+    excess: f64,
 }
 
 impl AxialAddedMass {
@@ -52,8 +65,20 @@ impl AxialAddedMass {
                 }
                 _ => None,
             })
+            .collect::<Vec<_>>();
+        let rows = nodes
+            .iter()
+            .filter_map(|(_, h)| {
+                let [a, b] = h.node.tangent?;
+                let p = &h.node.particles;
+                Some(AxialRow {
+                    node: h.node.node(),
+                    ends: [p[a], p[b]],
+                    excess: h.axial_excess(),
+                })
+            })
             .collect();
-        AxialAddedMass { nodes }
+        AxialAddedMass { nodes, rows }
     }
 
     /// The number of corrected nodes.
@@ -76,11 +101,20 @@ impl AxialAddedMass {
         (q, weight): (&[Vec3], f64),
         acceleration: impl Fn(usize) -> Vec3,
     ) {
-        for (_, h) in &self.nodes {
-            let i = h.node.node();
-            let d = dof[i];
+        // The correction's inertia term C_i(q) a = -e t (t . a) from the node's own data (its
+        // tangent at q as [`LineHydro`]'s, zero without one).
+        for row in &self.rows {
+            let d = dof[row.node];
             if d != NONE {
-                let ca = h.axial_inertia(q, acceleration(i));
+                let a = acceleration(row.node);
+                let chord = sub(q[row.ends[1]], q[row.ends[0]]);
+                let len = norm(chord);
+                let ca = if len == 0.0 {
+                    [0.0; 3]
+                } else {
+                    let t = scale(1.0 / len, chord);
+                    scale(-row.excess * dot(t, a), t)
+                };
                 for k in 0..3 {
                     r[d + k] += weight * ca[k];
                 }

@@ -6,7 +6,7 @@
 use super::JacobianTerms;
 use super::{InertiaRows, Layout, ResidualTerms, NONE};
 use crate::constraints::Hessian;
-use crate::forces::Jacobian;
+use crate::forces::{Jacobian, TangentCache};
 use crate::math::Vec3;
 use crate::model::System;
 
@@ -30,12 +30,13 @@ impl Layout {
                 r[d..d + 3].copy_from_slice(&row.rows(i));
             }
         }
+        // The rows of the particles each force acts on (a line node's loads act on the node
+        // alone, its neighbours only giving the tangent).
+        let mut tangents = TangentCache::default();
+        let point = (at.q_eval, at.v_eval, at.t_eval);
         for f in system.forces() {
-            // The rows of the particles it acts on (a line node's loads act on the node alone,
-            // its neighbours only giving the tangent).
-            let acting = f.acting_particles();
-            f.with_force(at.q_eval, at.v_eval, at.t_eval, |fl| {
-                self.subtract_rows(r, acting, sigma, fl)
+            f.for_each_acting(point, &mut tangents, |p, fp| {
+                self.subtract_row(r, p, sigma, fp)
             });
         }
         let same_point = at.same_point();
@@ -78,6 +79,18 @@ impl Layout {
         let mut hess = Hessian::zeros(0);
         for (c, con) in system.constraints().iter().enumerate() {
             self.add_constraint_terms(values, (c, con, &mut hess), at);
+        }
+    }
+
+    /// Subtracts `weight f` from the dynamics rows of particle `p` (nothing for a fixed one).
+    #[inline(always)]
+    fn subtract_row(&self, r: &mut [f64], p: usize, weight: f64, f: Vec3) {
+        let d = self.dof[p];
+        if d != NONE {
+            let row: &mut [f64; 3] = (&mut r[d..d + 3]).try_into().expect("3 rows");
+            row[0] -= weight * f[0];
+            row[1] -= weight * f[1];
+            row[2] -= weight * f[2];
         }
     }
 

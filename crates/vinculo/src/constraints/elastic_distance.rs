@@ -65,6 +65,15 @@ impl ElasticDistance {
         self.share * self.length.value(t) - norm(d)
     }
 
+    /// [`ElasticDistance::residual`] and [`ElasticDistance::gradient`] from one difference
+    /// and one norm (the same numbers).
+    #[inline(always)]
+    pub(crate) fn residual_and_gradient(&self, q: &[Vec3], t: f64) -> (f64, [Vec3; 2]) {
+        let (u, l) = geometry(q, self.particles);
+        let phi = self.share * self.length.value(t) - l;
+        (phi, [[-u[0], -u[1], -u[2]], u])
+    }
+
     pub(crate) fn gradient(&self, q: &[Vec3], _t: f64) -> [Vec3; 2] {
         let (u, _) = geometry(q, self.particles);
         [[-u[0], -u[1], -u[2]], u]

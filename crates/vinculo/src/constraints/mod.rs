@@ -177,6 +177,11 @@ impl Constraint {
                 let (phi, g) = c.residual_and_gradient(q);
                 use_it(phi, &g)
             }
+            // And mooring lines of elastic segments.
+            Constraint::ElasticDistance(c) => {
+                let (phi, g) = c.residual_and_gradient(q, t);
+                use_it(phi, &g)
+            }
             other => use_it(other.residual(q, t), &other.gradient_rows(q, t)),
         }
     }

@@ -48,7 +48,7 @@
 //!
 //! where x is the node's own position and grad F = (grad eta, -1) / d inside the ramp of F.
 
-use super::line_node::{axial_part_by_tangent, mul, LineNode};
+use super::line_node::{axial_part_by_tangent, mul, LineNode, Tangent, TangentCache};
 use super::Jacobian;
 use crate::local::Rows;
 use crate::math::{add, add_mat, diag, dot, norm, outer, scale, scale_mat, sub, Mat3, Vec3};
@@ -163,11 +163,16 @@ impl LineHydro {
     /// The loads on the node over its wet fraction (the bracket of the module documentation).
     #[inline(always)]
     fn wet_force(&self, q: &[Vec3], v: &[Vec3], flow: Option<&Flow>) -> Vec3 {
+        self.wet_force_with(v, flow, self.node.tangent(q))
+    }
+
+    /// [`LineHydro::wet_force`] with the node's tangent given.
+    #[inline(always)]
+    fn wet_force_with(&self, v: &[Vec3], flow: Option<&Flow>, tangent: Option<Tangent>) -> Vec3 {
         let buoyancy = scale(-self.density * self.volume(), self.gravity);
         let u = flow.map_or([0.0; 3], |f| f.velocity);
         let r = sub(u, v[self.node.node()]);
         let (cn, ca) = self.drag_factors();
-        let tangent = self.node.tangent(q);
         let drag = match &tangent {
             Some(tg) => {
                 let ra = scale(dot(tg.t, r), tg.t);
@@ -199,12 +204,26 @@ impl LineHydro {
     /// Buoyancy, drag and the water's inertia force on the node at time `t`.
     #[inline(always)]
     pub(crate) fn node_force(&self, q: &[Vec3], v: &[Vec3], t: f64) -> Vec3 {
+        self.node_force_with(q, v, t, &mut TangentCache::default())
+    }
+
+    /// [`LineHydro::node_force`], the node's tangent taken from `tangents` (shared with the
+    /// next element on the same node in the assembler's loop).
+    #[inline(always)]
+    pub(crate) fn node_force_with(
+        &self,
+        q: &[Vec3],
+        v: &[Vec3],
+        t: f64,
+        tangents: &mut TangentCache,
+    ) -> Vec3 {
         let flow = self.flow(q, t, false);
         let (wet, _) = self.wet_fraction(q[self.node.node()][2], flow.as_ref());
         if wet == 0.0 {
             return [0.0; 3];
         }
-        scale(wet, self.wet_force(q, v, flow.as_ref()))
+        let tangent = tangents.tangent(&self.node, q);
+        scale(wet, self.wet_force_with(v, flow.as_ref(), tangent))
     }
 
     /// The axial correction of the node's mass block at positions `q`, C = -e t t^T with
@@ -213,14 +232,6 @@ impl LineHydro {
         match self.node.tangent(q) {
             Some(tg) => outer(-self.axial_excess(), tg.t, tg.t),
             None => [[0.0; 3]; 3],
-        }
-    }
-
-    /// The correction's inertia term C(q) a = -e t (t . a) for the node's acceleration `a`.
-    pub(crate) fn axial_inertia(&self, q: &[Vec3], a: Vec3) -> Vec3 {
-        match self.node.tangent(q) {
-            Some(tg) => scale(-self.axial_excess() * dot(tg.t, a), tg.t),
-            None => [0.0; 3],
         }
     }
 

@@ -32,6 +32,34 @@ pub struct LineNode {
     pub tangent: Option<[usize; 2]>,
 }
 
+/// The tangent of the last line node asked for, at one configuration: the elements on one node
+/// (its hydrodynamics, its seabed contact) share it within one evaluation of the residual
+/// instead of each computing it (a square root and a division). A cache lives for one
+/// configuration only (the assembler makes one per residual).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct TangentCache {
+    /// The last node asked for, as its touched particles and its tangent's local indices, and
+    /// its tangent.
+    last: Option<(([usize; 3], Option<[usize; 2]>), Option<Tangent>)>,
+}
+
+impl TangentCache {
+    /// The tangent of `node` at `q` ([`LineNode::tangent`]), computed unless it was the last
+    /// node asked for.
+    #[inline(always)]
+    pub(crate) fn tangent(&mut self, node: &LineNode, q: &[Vec3]) -> Option<Tangent> {
+        let key = (node.particles, node.tangent);
+        match self.last {
+            Some((kept, tangent)) if kept == key => tangent,
+            _ => {
+                let tangent = node.tangent(q);
+                self.last = Some((key, tangent));
+                tangent
+            }
+        }
+    }
+}
+
 /// A node's tangent at a configuration: t, and 1/|d|, the scale of its derivative
 /// dt/dq_b = (I - t t^T) / |d|.
 #[derive(Debug, Clone, Copy)]

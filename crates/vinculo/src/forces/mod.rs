@@ -42,6 +42,7 @@ pub use drag::{LinearDrag, QuadraticDrag};
 pub use floating_body::{FloatingBody, HullCell, HullLayer};
 pub use line_hydro::LineHydro;
 pub use line_node::LineNode;
+pub(crate) use line_node::TangentCache;
 pub use morison::{Morison, MorisonSpec};
 pub use on_points::ForceOnPoints;
 pub use seabed::{SeabedContact, SeabedFriction};
@@ -159,6 +160,37 @@ impl Force {
         use_it: impl FnOnce(&[Vec3]) -> R,
     ) -> R {
         use_it(&self.force_rows(q, v, t))
+    }
+
+    /// Calls `put(particle, f)` with the applied force on each particle the force acts on
+    /// ([`Force::acting_particles`], in order): the assembler's residual loop. The same values as
+    /// [`Force::with_force`]; springs and line elements hand them over directly (no local rows
+    /// built and read back), and consecutive line elements on one node share its tangent through
+    /// `tangents` (one cache per configuration).
+    #[inline(always)]
+    pub(crate) fn for_each_acting(
+        &self,
+        (q, v, t): (&[Vec3], &[Vec3], f64),
+        tangents: &mut TangentCache,
+        mut put: impl FnMut(usize, Vec3),
+    ) {
+        match self {
+            Force::SpringDamper(s) => {
+                let [fa, fb] = s.force(q, v, t);
+                put(s.particles[0], fa);
+                put(s.particles[1], fb);
+            }
+            Force::LineHydro(h) => put(h.node.node(), h.node_force_with(q, v, t, tangents)),
+            Force::SeabedContact(s) => put(s.node.node(), s.node_force_with(q, v, tangents)),
+            other => {
+                let acting = other.acting_particles();
+                other.with_force(q, v, t, |rows| {
+                    for (&p, &f) in acting.iter().zip(rows) {
+                        put(p, f);
+                    }
+                })
+            }
+        }
     }
 
     /// Adds df/dq into `dq` and df/dv into `dv`.

@@ -37,7 +37,7 @@
 //! u = w/|w|, df/dN = -mu sgn(N) u; dw/dv and dw/dt follow from w = t t^T S v or (I - t t^T) S v,
 //! S = diag(1, 1, 0), and dt/dq from [`super::line_node`].
 
-use super::line_node::{axial_part_by_tangent, mul, LineNode, Tangent};
+use super::line_node::{axial_part_by_tangent, mul, LineNode, Tangent, TangentCache};
 use super::Jacobian;
 use crate::local::Rows;
 use crate::math::{add, add_mat, diag, dot, norm, outer, scale, scale_mat, sub, Mat3, Vec3};
@@ -178,13 +178,25 @@ impl SeabedContact {
 
     /// The contact force on the node (normal and friction) at its position and velocity.
     pub(crate) fn node_force(&self, q: &[Vec3], v: &[Vec3]) -> Vec3 {
+        self.node_force_with(q, v, &mut TangentCache::default())
+    }
+
+    /// [`SeabedContact::node_force`], the node's tangent (where friction needs it) taken from
+    /// `tangents` (shared with the element before it on the same node in the assembler's loop).
+    #[inline(always)]
+    pub(crate) fn node_force_with(
+        &self,
+        q: &[Vec3],
+        v: &[Vec3],
+        tangents: &mut TangentCache,
+    ) -> Vec3 {
         let i = self.node.node();
         let Some((n, _, _)) = self.normal(q[i], v[i]) else {
             return [0.0; 3];
         };
         let mut f = [0.0, 0.0, n];
         if self.friction.acts() {
-            let tangent = self.node.tangent(q);
+            let tangent = tangents.tangent(&self.node, q);
             for (mu, w) in self.sliding(v[i], tangent.as_ref()).iter().flatten() {
                 f = add(f, self.friction_of(*mu, *w, n).0);
             }

@@ -535,6 +535,55 @@ mod tests {
         }
     }
 
+    /// The serial residual hands springs' and line elements' forces over directly and lets a
+    /// node's hydrodynamics and seabed contact share its tangent (`Force::for_each_acting`); the
+    /// parallel one reads each element's local rows. The two are equal bit for bit on a line in
+    /// a current lying partly on a seabed with anisotropic friction, with internal damping.
+    #[test]
+    fn line_elements_assemble_as_their_local_rows() {
+        use crate::forces::{Force, SeabedFriction};
+        use crate::model::{ParticleId, SeabedSpec};
+        let mut s = line_in_water();
+        let n = s.particles().len();
+        let system = s.id();
+        let id = |index: usize| ParticleId { system, index };
+        // The seabed 0.55 m up: the anchor and the first and last free nodes touch it.
+        let spec = SeabedSpec {
+            depth: -0.55,
+            diameter: 0.05,
+            length: 0.9,
+            stiffness: 3e6,
+            damping: 3e5,
+            damping_ramp: 0.0,
+            friction: SeabedFriction {
+                transverse: 1.0,
+                axial: Some(0.5),
+                damping: 200.0,
+                static_scale: 1.0,
+            },
+        };
+        for i in 0..n {
+            let tangent = match i {
+                0 => (id(0), id(1)),
+                _ if i == n - 1 => (id(i - 1), id(i)),
+                _ => (id(i - 1), id(i + 1)),
+            };
+            s.add_seabed_contact(id(i), Some(tangent), &spec).unwrap();
+        }
+        for i in 0..n - 1 {
+            s.add_spring_damper(id(i), id(i + 1), 0.0, 40.0, None)
+                .unwrap();
+        }
+        let (q, v) = (s.initial_positions(), s.initial_velocities());
+        let touching = s.forces().iter().filter(|f| match f {
+            Force::SeabedContact(c) => c.node_force(&q, &v) != [0.0; 3],
+            _ => false,
+        });
+        assert_eq!(touching.count(), 3);
+        assert_parallel_assembly_is_serial(&s, GeneralizedTrapezoidal { alpha: 0.6 });
+        assert_parallel_assembly_is_serial(&s, GeneralizedAlpha { rho_inf: 0.6 });
+    }
+
     /// The Jacobian with compliant rows (the compliance on the multipliers' diagonal, a winch's
     /// time-dependent compliance) equals finite differences of the residual, for both rules, with
     /// the sparse LU's layout, dense storage and the tree elimination's layout; and the parallel
