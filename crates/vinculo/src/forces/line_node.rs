@@ -38,10 +38,13 @@ pub struct LineNode {
 /// configuration only (the assembler makes one per residual).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct TangentCache {
-    /// The last node asked for, as its touched particles and its tangent's local indices, and
-    /// its tangent.
-    last: Option<(([usize; 3], Option<[usize; 2]>), Option<Tangent>)>,
+    /// The last node asked for and its tangent.
+    last: Option<(NodeKey, Option<Tangent>)>,
 }
+
+/// What identifies a line node's tangent: its touched particles and the local indices of its
+/// tangent's particles.
+type NodeKey = ([usize; 3], Option<[usize; 2]>);
 
 impl TangentCache {
     /// The tangent of `node` at `q` ([`LineNode::tangent`]), computed unless it was the last
