@@ -31,7 +31,10 @@ end point also holds the loads the two codes lump differently on the end node (M
 drag and added mass of the half segment at a moving fairlead).
 
 Run it with ``python -m vinculo.mooring.bench [--segments 20,100] [--t-end 60]``; it writes
-``bench.csv`` and ``bench.md`` (the README's table) into ``--output``.
+``bench.csv`` and ``bench.md`` (the README's table) into ``--output``. With ``--per-step DT``
+it measures instead the CPU time of one step of each code (:func:`per_step`: MoorDyn's
+explicit step against vinculo's implicit step of DT), and with ``--scaling DT`` vinculo's
+real-time factor against the number of segments.
 """
 
 from __future__ import annotations
@@ -431,6 +434,38 @@ def write_rows(rows: Sequence[BenchRow], path: str | Path) -> Path:
     return path
 
 
+def per_step(name: str, segments: int, dt: float, t_end: float) -> tuple[float, float, float]:
+    """The CPU time of one step of each code on one case: MoorDyn's at half its axial-wave step
+    (:func:`wave_step`, within its stable range: an explicit step costs the same whatever its
+    size), vinculo's at the step ``dt`` (its Newton iterations, and so its step's cost, depend
+    on the step); the least of :data:`REPEATS` runs each, from MoorDyn's initial state.
+
+    Arguments:
+        name: a key of :data:`CASES`.
+        segments: the number of segments.
+        dt: vinculo's step (s).
+        t_end: the simulated time (s).
+
+    Returns:
+        ``(MoorDyn's step (s), MoorDyn's CPU time a step (s), vinculo's CPU time a step (s))``.
+    """
+    from vinculo.mooring.analysis import run
+    from vinculo.mooring.peer import moordyn_initial_state, run_moordyn
+
+    model = CASES[name](segments)
+    motion = motion_for(model)
+    step = wave_step(model) / 2
+    with tempfile.TemporaryDirectory(prefix="vinculo-bench-") as folder:
+        state = moordyn_initial_state(model, motion, Path(folder) / "initial.state",
+                                      time_step=step)
+        moordyn = min(run_moordyn(model, motion, t_end, dt_output=0.1, time_step=step,
+                                  coupling_step=None, initial_state=state).cpu_time
+                      for _ in range(REPEATS))
+    runs = [run(model, motion, t_end, dt=dt, plots=False) for _ in range(REPEATS)]
+    vinculo = min(r.cpu_time / r.solution.steps_taken for r in runs)
+    return step, moordyn / round(t_end / step), vinculo
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the benchmark from the command line (``python -m vinculo.mooring.bench``).
 
@@ -452,6 +487,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--scaling", type=float, metavar="DT", default=None,
                         help="instead: vinculo's real-time factor against the number of segments "
                         "at the step DT (s), on each case")
+    parser.add_argument("--per-step", type=float, metavar="DT", default=None,
+                        help="instead: the CPU time of one step of each code on each case, "
+                        "vinculo's at the step DT (s)")
     parser.add_argument("--output", "-o", type=Path, default=Path("output") / "mooring-bench")
     args = parser.parse_args(argv)
     args.output.mkdir(parents=True, exist_ok=True)
@@ -462,6 +500,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         for name in [c.strip() for c in args.cases.split(",") if c.strip()]:
             for n, factor in scaling(name, segment_list, args.scaling, args.t_end):
                 print(f"| {name} | {n} | {args.scaling:g} | {factor:.3g} |", flush=True)
+        return 0
+    if args.per_step is not None:
+        print("| case | segments | MoorDyn step (s) | MoorDyn (us a step) | vinculo step (s) | "
+              "vinculo (us a step) | vinculo / MoorDyn |\n"
+              "| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
+        for name in [c.strip() for c in args.cases.split(",") if c.strip()]:
+            for n in segment_list:
+                step, moordyn, vinculo = per_step(name, n, args.per_step, args.t_end)
+                print(f"| {name} | {n} | {step:.3g} | {1e6 * moordyn:.1f} | {args.per_step:g} | "
+                      f"{1e6 * vinculo:.1f} | {vinculo / moordyn:.2f} |", flush=True)
         return 0
     rows: list[BenchRow] = []
     for name in [c.strip() for c in args.cases.split(",") if c.strip()]:
