@@ -1301,10 +1301,78 @@ impl TreeElimination {
     /// any number of coupled ancestors).
     fn sweeps(&mut self) {
         for b in 0..self.blocks() {
-            self.forward_general(b);
+            match self.sizes(b) {
+                (3, 1) => self.forward_fixed::<3, 1>(b),
+                (4, 1) => self.forward_fixed::<4, 1>(b),
+                (5, 1) => self.forward_fixed::<5, 1>(b),
+                (3, 2) => self.forward_fixed::<3, 2>(b),
+                (4, 2) => self.forward_fixed::<4, 2>(b),
+                (5, 2) => self.forward_fixed::<5, 2>(b),
+                _ => self.forward_general(b),
+            }
         }
         for b in (0..self.blocks()).rev() {
-            self.backward_general(b);
+            match self.sizes(b) {
+                (3, 1) => self.backward_fixed::<3, 1>(b),
+                (4, 1) => self.backward_fixed::<4, 1>(b),
+                (5, 1) => self.backward_fixed::<5, 1>(b),
+                (3, 2) => self.backward_fixed::<3, 2>(b),
+                (4, 2) => self.backward_fixed::<4, 2>(b),
+                (5, 2) => self.backward_fixed::<5, 2>(b),
+                _ => self.backward_general(b),
+            }
+        }
+    }
+
+    /// Block b's number of unknowns and of coupled ancestors.
+    #[inline(always)]
+    fn sizes(&self, b: usize) -> (usize, usize) {
+        let nb = self.start[b + 1] - self.start[b];
+        (nb, self.coupled_at[b + 1] - self.coupled_at[b])
+    }
+
+    /// [`TreeElimination::forward_general`] for a block of N unknowns coupled with K ancestors
+    /// known at compile time (a line with bending: 4 and 2), the same operations unrolled.
+    #[inline(always)]
+    fn forward_fixed<const N: usize, const K: usize>(&mut self, b: usize) {
+        let (s, e) = (self.start[b], self.start[b + 1]);
+        let d = &self.store.diag()[self.diag_at[b]..self.diag_at[b + 1]];
+        let (head, tail) = self.z.split_at_mut(e);
+        let zb = &mut head[s..];
+        block_solve_fixed::<N>(d, &self.perm[s..e], zb);
+        let zb: &[f64; N] = (&zb[..N]).try_into().expect("N unknowns");
+        let ca = self.coupling_at[b];
+        let low = &self.store.low()[ca..ca + 3 * N * K];
+        let set = &self.ancestors[self.coupled_at[b]..self.coupled_at[b] + K];
+        for (&u, low) in set.iter().zip(low.chunks_exact(3 * N)) {
+            let zu = &mut tail[self.start[u as usize] - e..][..3];
+            for (r, row) in low.chunks_exact(N).enumerate() {
+                let mut acc = 0.0;
+                for j in 0..N {
+                    acc += row[j] * zb[j];
+                }
+                zu[r] -= acc;
+            }
+        }
+    }
+
+    /// [`TreeElimination::backward_general`] for a block of N unknowns coupled with K ancestors
+    /// known at compile time, the same operations unrolled.
+    #[inline(always)]
+    fn backward_fixed<const N: usize, const K: usize>(&mut self, b: usize) {
+        let (s, e) = (self.start[b], self.start[b + 1]);
+        let (head, tail) = self.z.split_at_mut(e);
+        let zb = &mut head[s..s + N];
+        let ca = self.coupling_at[b];
+        let w = &self.store.w()[ca..ca + 3 * K * N];
+        let set = &self.ancestors[self.coupled_at[b]..self.coupled_at[b] + K];
+        for (i, &u) in set.iter().enumerate() {
+            let at = self.start[u as usize] - e;
+            let xu = [tail[at], tail[at + 1], tail[at + 2]];
+            for (x, wj) in zb.iter_mut().zip(w.chunks_exact(3 * K)) {
+                let wj = &wj[3 * i..3 * i + 3];
+                *x -= wj[0] * xu[0] + wj[1] * xu[1] + wj[2] * xu[2];
+            }
         }
     }
 
