@@ -180,6 +180,12 @@ impl Force {
                 put(s.particles[0], fa);
                 put(s.particles[1], fb);
             }
+            Force::Bending(b) => {
+                let f = b.force(q, v, t);
+                for (&p, f) in b.particles.iter().zip(f) {
+                    put(p, f);
+                }
+            }
             Force::LineHydro(h) => put(h.node.node(), h.node_force_with(q, v, t, tangents)),
             Force::SeabedContact(s) => put(s.node.node(), s.node_force_with(q, v, tangents)),
             other => {

@@ -535,10 +535,11 @@ mod tests {
         }
     }
 
-    /// The serial residual hands springs' and line elements' forces over directly and lets a
-    /// node's hydrodynamics and seabed contact share its tangent (`Force::for_each_acting`); the
-    /// parallel one reads each element's local rows. The two are equal bit for bit on a line in
-    /// a current lying partly on a seabed with anisotropic friction, with internal damping.
+    /// The serial residual hands springs', bending's and line elements' forces over directly
+    /// and lets a node's hydrodynamics and seabed contact share its tangent
+    /// (`Force::for_each_acting`); the parallel one reads each element's local rows. The two
+    /// are equal bit for bit on a line in a current lying partly on a seabed with anisotropic
+    /// friction, with internal damping and bending stiffness.
     #[test]
     fn line_elements_assemble_as_their_local_rows() {
         use crate::forces::{Force, SeabedFriction};
@@ -572,6 +573,10 @@ mod tests {
         }
         for i in 0..n - 1 {
             s.add_spring_damper(id(i), id(i + 1), 0.0, 40.0, None)
+                .unwrap();
+        }
+        for i in 1..n - 1 {
+            s.add_bending(id(i - 1), id(i), id(i + 1), 50.0, None)
                 .unwrap();
         }
         let (q, v) = (s.initial_positions(), s.initial_velocities());
