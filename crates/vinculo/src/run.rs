@@ -64,7 +64,7 @@
 //! Contact events: a converged fixed step during which a force jumps
 //! ([`Force::switch_time`]: a line node that touches the seabed or leaves it, where the
 //! seabed's damping force jumps by A cBot |v_z|) is rejected, and the run steps to the event
-//! instead (the earliest over the elements, from each node's Taylor polynomial at the step's
+//! instead (a step whose predictor already crosses the switch goes there before solving) (the earliest over the elements, from each node's Taylor polynomial at the step's
 //! start), then on from there on a grid started afresh, as after a stop between grid points,
 //! until the event's transient is over and the steps are dt again: then one step (or two halves
 //! of one) goes back to the run's own grid, its first point at least half a step ahead, with
@@ -1159,6 +1159,28 @@ impl Simulation<'_> {
             let events = matches!(c.controller, Controller::Fixed(_))
                 && !self.event_forces.is_empty()
                 && !to_event;
+            // A step whose predictor already switches a force goes to the switch without
+            // solving the whole step first (the time is found as after a solve: the root of
+            // the Taylor polynomial from the step's start): on the benchmark's chain on the
+            // seabed of 1,000 segments at 5 ms, 3.10 -> 2.91 s, the same error.
+            if events && !fresh_retry {
+                let start = (&c.q[..], &c.v[..], &c.acc[..]);
+                let switch = first_event(system, &self.event_forces, start, &ws.state.q, h_try);
+                if let (Some((s, f)), Controller::Fixed(fixed)) =
+                    (inside_step(switch, c.t, h_try), &mut c.controller)
+                {
+                    // Counted as a step rejected, as a solved step that found the switch.
+                    self.sol.steps_rejected += 1;
+                    let settle = system.forces()[f].settling_time(&ws.inertia);
+                    let s = if scheme.evaluates_at_end() {
+                        s * (1.0 - LAND_SHORT)
+                    } else {
+                        s
+                    };
+                    fixed.go_to_event(c.t + s, settle);
+                    return Next::Go;
+                }
+            }
             let may_reject = matches!(c.controller, Controller::Adaptive(_)) || events;
             if may_reject {
                 self.scratch.rule_saved.copy_from(&c.rule);
