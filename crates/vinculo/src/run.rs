@@ -64,8 +64,9 @@
 //! Contact events: a converged fixed step during which a force jumps
 //! ([`Force::switch_time`]: a line node that touches the seabed or leaves it, where the
 //! seabed's damping force jumps by A cBot |v_z|) is rejected, and the run steps to the event
-//! instead (a step whose predictor already crosses the switch goes there before solving) (the earliest over the elements, from each node's Taylor polynomial at the step's
-//! start), then on from there on a grid started afresh, as after a stop between grid points,
+//! instead (the earliest over the elements, from each node's Taylor polynomial at the step's
+//! start; a step whose predictor already crosses a switch goes there before it is solved),
+//! then on from there on a grid started afresh, as after a stop between grid points,
 //! until the event's transient is over and the steps are dt again: then one step (or two halves
 //! of one) goes back to the run's own grid, its first point at least half a step ahead, with
 //! the grid's count of units, so that the steps end on the same times as a run without the
@@ -1166,18 +1167,12 @@ impl Simulation<'_> {
             if events && !fresh_retry {
                 let start = (&c.q[..], &c.v[..], &c.acc[..]);
                 let switch = first_event(system, &self.event_forces, start, &ws.state.q, h_try);
-                if let (Some((s, f)), Controller::Fixed(fixed)) =
+                if let (Some(at), Controller::Fixed(fixed)) =
                     (inside_step(switch, c.t, h_try), &mut c.controller)
                 {
                     // Counted as a step rejected, as a solved step that found the switch.
                     self.sol.steps_rejected += 1;
-                    let settle = system.forces()[f].settling_time(&ws.inertia);
-                    let s = if scheme.evaluates_at_end() {
-                        s * (1.0 - LAND_SHORT)
-                    } else {
-                        s
-                    };
-                    fixed.go_to_event(c.t + s, settle);
+                    go_to_switch(fixed, (system, scheme, &ws.inertia), c.t, at);
                     return Next::Go;
                 }
             }
@@ -1208,18 +1203,12 @@ impl Simulation<'_> {
                     let restart = to_event || (switch.is_some() && event.is_none());
                     let mut settling = false;
                     if let Controller::Fixed(fixed) = &mut c.controller {
-                        if let Some((s, f)) = event {
+                        if let Some(at) = event {
                             // A force jumped within the step: the run steps to the jump instead,
                             // then through the transient it starts in short steps.
                             self.sol.steps_rejected += 1;
                             c.rule.copy_from(&self.scratch.rule_saved);
-                            let settle = system.forces()[f].settling_time(&ws.inertia);
-                            let s = if scheme.evaluates_at_end() {
-                                s * (1.0 - LAND_SHORT)
-                            } else {
-                                s
-                            };
-                            fixed.go_to_event(c.t + s, settle);
+                            go_to_switch(fixed, (system, scheme, &ws.inertia), c.t, at);
                             return Next::Go;
                         }
                         if to_event {
@@ -1252,7 +1241,8 @@ impl Simulation<'_> {
                 // then keeps to constant acceleration until a contact event's restart (a
                 // negative `acc_rate_step`): a model whose extrapolated steps fail does not pay
                 // for a failed attempt every other step (a cable with bending stiffness at 0.07 s
-                // steps: 8.8 residuals and 1.85 factorisations a step, against 6.4 and 0.15).
+                // steps, 20 s: 8.8 residuals and 1.85 factorisations a step, against 6.5 and
+                // 0.25).
                 Err(_) if extrapolated => {
                     ws.matrix.invalidate();
                     fresh_retry = true;
@@ -1534,6 +1524,24 @@ pub(crate) fn extrapolate((q, v, a): (&[Vec3], &[Vec3], &[Vec3]), h: f64, out: &
             o[k] = q[k] + h * v[k] + 0.5 * h * h * a[k];
         }
     }
+}
+
+/// Sends the fixed steps from `t` to the switch of force `f` at `s` into the step, and through
+/// its transient after it: a scheme that evaluates the forces at the step's end alone lands
+/// [`LAND_SHORT`] of the way short of it (module documentation).
+fn go_to_switch(
+    fixed: &mut FixedSteps,
+    (system, scheme, inertia): (&System, Scheme, &[f64]),
+    t: f64,
+    (s, f): (f64, usize),
+) {
+    let settle = system.forces()[f].settling_time(inertia);
+    let s = if scheme.evaluates_at_end() {
+        s * (1.0 - LAND_SHORT)
+    } else {
+        s
+    };
+    fixed.go_to_event(t + s, settle);
 }
 
 /// A force's switch at `s` into a step of size `h` from `t` (`found`), when a step can go to
