@@ -25,8 +25,8 @@
 //! mass: the added mass's energy is the fluid's, not counted.
 
 use super::{Block, Entries, SlotTable, NONE};
-use crate::forces::{Force, Jacobian, LineHydro};
-use crate::math::{dot, norm, scale, sub, Mat3, Vec3};
+use crate::forces::{unit_chord, Force, Jacobian, LineHydro};
+use crate::math::{dot, scale, Mat3, Vec3};
 use crate::model::System;
 
 /// What receives a table's blocks (see [`AxialAddedMass::add_jacobian`]).
@@ -107,13 +107,9 @@ impl AxialAddedMass {
             let d = dof[row.node];
             if d != NONE {
                 let a = acceleration(row.node);
-                let chord = sub(q[row.ends[1]], q[row.ends[0]]);
-                let len = norm(chord);
-                let ca = if len == 0.0 {
-                    [0.0; 3]
-                } else {
-                    let t = scale(1.0 / len, chord);
-                    scale(-row.excess * dot(t, a), t)
+                let ca = match unit_chord(q[row.ends[0]], q[row.ends[1]]) {
+                    Some((t, _)) => scale(-row.excess * dot(t, a), t),
+                    None => [0.0; 3],
                 };
                 for k in 0..3 {
                     r[d + k] += weight * ca[k];

@@ -116,14 +116,9 @@ impl LineNode {
     #[inline]
     pub(crate) fn tangent(&self, q: &[Vec3]) -> Option<Tangent> {
         let [a, b] = self.tangent?;
-        let d = sub(q[self.particles[b]], q[self.particles[a]]);
-        let len = norm(d);
-        if len == 0.0 {
-            return None;
-        }
-        let inv_len = 1.0 / len;
+        let (t, inv_len) = unit_chord(q[self.particles[a]], q[self.particles[b]])?;
         Some(Tangent {
-            t: scale(inv_len, d),
+            t,
             inv_len,
             ends: [a, b],
         })
@@ -138,6 +133,19 @@ impl LineNode {
             _ => [f, [0.0; 3], [0.0; 3]].into(),
         }
     }
+}
+
+/// The unit vector from `a` to `b` and 1 / |b - a| (None where they coincide): a line node's
+/// tangent.
+#[inline(always)]
+pub(crate) fn unit_chord(a: Vec3, b: Vec3) -> Option<(Vec3, f64)> {
+    let d = sub(b, a);
+    let len = norm(d);
+    if len == 0.0 {
+        return None;
+    }
+    let inv_len = 1.0 / len;
+    Some((scale(inv_len, d), inv_len))
 }
 
 /// The matrix product a b.

@@ -42,7 +42,7 @@ pub use drag::{LinearDrag, QuadraticDrag};
 pub use floating_body::{FloatingBody, HullCell, HullLayer};
 pub use line_hydro::LineHydro;
 pub use line_node::LineNode;
-pub(crate) use line_node::TangentCache;
+pub(crate) use line_node::{unit_chord, TangentCache};
 pub use morison::{Morison, MorisonSpec};
 pub use on_points::ForceOnPoints;
 pub use seabed::{SeabedContact, SeabedFriction};
