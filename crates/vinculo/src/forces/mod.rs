@@ -229,6 +229,16 @@ impl Force {
         }
     }
 
+    /// The particle and the height across which the element switches (a seabed contact's node
+    /// and the seabed: [`Force::switch_time`] is None while the particle stays on one side),
+    /// None for every element whose force is continuous.
+    pub fn switch_height(&self) -> Option<(usize, f64)> {
+        match self {
+            Force::SeabedContact(f) => Some((f.node.node(), f.seabed_z)),
+            _ => None,
+        }
+    }
+
     /// The time scale of the transient that the element's jump starts on a node of inertia
     /// `m` (0 for an element without jumps): the run loop's steps stay short for a few of it
     /// after a contact event ([`crate::run`]).
