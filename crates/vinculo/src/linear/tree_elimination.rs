@@ -151,6 +151,22 @@ const MAX_EDGE_BLOCKS: usize = 4;
 
 const ROOT: u32 = u32::MAX;
 
+/// Block `$b`'s part of a sweep: `$fixed::<N, K>` for blocks of 3 to 5 unknowns coupled with one
+/// or two ancestors (sizes known at compile time), `$general` for the others.
+macro_rules! by_size {
+    ($self:ident, $b:expr, $fixed:ident, $general:ident) => {
+        match $self.sizes($b) {
+            (3, 1) => $self.$fixed::<3, 1>($b),
+            (4, 1) => $self.$fixed::<4, 1>($b),
+            (5, 1) => $self.$fixed::<5, 1>($b),
+            (3, 2) => $self.$fixed::<3, 2>($b),
+            (4, 2) => $self.$fixed::<4, 2>($b),
+            (5, 2) => $self.$fixed::<5, 2>($b),
+            _ => $self.$general($b),
+        }
+    };
+}
+
 /// Tree-structured block LU (see the module documentation).
 pub struct TreeElimination {
     /// First local unknown of each block, in elimination order (one past the end last).
@@ -1142,6 +1158,19 @@ fn block_solve_fixed<const N: usize>(d: &[f64], perm: &[u32], zb: &mut [f64]) {
     }
 }
 
+/// Solves D z = z in place with the factors of `lu_in_place` for a block of `zb.len()`
+/// unknowns: blocks of 3 (a free particle), 4 (a particle and its link) and 5 get unrolled
+/// copies.
+#[inline(always)]
+fn solve_block(d: &[f64], perm: &[u32], zb: &mut [f64]) {
+    match zb.len() {
+        3 => block_solve_fixed::<3>(d, perm, zb),
+        4 => block_solve_fixed::<4>(d, perm, zb),
+        5 => block_solve_fixed::<5>(d, perm, zb),
+        nb => lu_solve(d, nb, perm, zb, 1),
+    }
+}
+
 /// z_u -= A_ub z_b for one ancestor u: `low` is A_ub (3 x nb, row-major), `zu` the particle
 /// part of z_u.
 #[inline(always)]
@@ -1285,13 +1314,7 @@ impl TreeElimination {
             *z = rhs[u as usize];
         }
         let d = &self.store.diag()[self.diag_at[0]..self.diag_at[1]];
-        let perm = &self.perm[..n];
-        match n {
-            3 => block_solve_fixed::<3>(d, perm, z),
-            4 => block_solve_fixed::<4>(d, perm, z),
-            5 => block_solve_fixed::<5>(d, perm, z),
-            _ => lu_solve(d, n, perm, z, 1),
-        }
+        solve_block(d, &self.perm[..n], z);
         for (z, &u) in z.iter().zip(&self.unknowns) {
             rhs[u as usize] = *z;
         }
@@ -1301,26 +1324,10 @@ impl TreeElimination {
     /// any number of coupled ancestors).
     fn sweeps(&mut self) {
         for b in 0..self.blocks() {
-            match self.sizes(b) {
-                (3, 1) => self.forward_fixed::<3, 1>(b),
-                (4, 1) => self.forward_fixed::<4, 1>(b),
-                (5, 1) => self.forward_fixed::<5, 1>(b),
-                (3, 2) => self.forward_fixed::<3, 2>(b),
-                (4, 2) => self.forward_fixed::<4, 2>(b),
-                (5, 2) => self.forward_fixed::<5, 2>(b),
-                _ => self.forward_general(b),
-            }
+            by_size!(self, b, forward_fixed, forward_general);
         }
         for b in (0..self.blocks()).rev() {
-            match self.sizes(b) {
-                (3, 1) => self.backward_fixed::<3, 1>(b),
-                (4, 1) => self.backward_fixed::<4, 1>(b),
-                (5, 1) => self.backward_fixed::<5, 1>(b),
-                (3, 2) => self.backward_fixed::<3, 2>(b),
-                (4, 2) => self.backward_fixed::<4, 2>(b),
-                (5, 2) => self.backward_fixed::<5, 2>(b),
-                _ => self.backward_general(b),
-            }
+            by_size!(self, b, backward_fixed, backward_general);
         }
     }
 
@@ -1345,14 +1352,7 @@ impl TreeElimination {
         let low = &self.store.low()[ca..ca + 3 * N * K];
         let set = &self.ancestors[self.coupled_at[b]..self.coupled_at[b] + K];
         for (&u, low) in set.iter().zip(low.chunks_exact(3 * N)) {
-            let zu = &mut tail[self.start[u as usize] - e..][..3];
-            for (r, row) in low.chunks_exact(N).enumerate() {
-                let mut acc = 0.0;
-                for j in 0..N {
-                    acc += row[j] * zb[j];
-                }
-                zu[r] -= acc;
-            }
+            subtract_coupling(low, zb, &mut tail[self.start[u as usize] - e..]);
         }
     }
 
@@ -1383,14 +1383,7 @@ impl TreeElimination {
         let d = &self.store.diag()[self.diag_at[b]..self.diag_at[b + 1]];
         let (head, tail) = self.z.split_at_mut(e);
         let zb = &mut head[s..];
-        let perm = &self.perm[s..e];
-        // Blocks of 3 (a free particle), 4 (a particle and its link) and 5 get unrolled copies.
-        match e - s {
-            3 => block_solve_fixed::<3>(d, perm, zb),
-            4 => block_solve_fixed::<4>(d, perm, zb),
-            5 => block_solve_fixed::<5>(d, perm, zb),
-            nb => lu_solve(d, nb, perm, zb, 1),
-        }
+        solve_block(d, &self.perm[s..e], zb);
         let nb = e - s;
         let low = &self.store.low()[self.coupling_at[b]..self.coupling_at[b + 1]];
         let set = &self.ancestors[self.coupled_at[b]..self.coupled_at[b + 1]];
