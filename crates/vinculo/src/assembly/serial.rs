@@ -98,14 +98,7 @@ impl Layout {
     #[inline(always)]
     fn subtract_rows(&self, r: &mut [f64], parts: &[usize], weight: f64, rows: &[Vec3]) {
         for (x, &p) in parts.iter().enumerate() {
-            let d = self.dof[p];
-            if d != NONE {
-                let row: &mut [f64; 3] = (&mut r[d..d + 3]).try_into().expect("3 rows");
-                let g = rows[x];
-                row[0] -= weight * g[0];
-                row[1] -= weight * g[1];
-                row[2] -= weight * g[2];
-            }
+            self.subtract_row(r, p, weight, rows[x]);
         }
     }
 }
