@@ -190,6 +190,9 @@ pub struct TreeElimination {
     coupling_at: Vec<usize>,
     /// Global unknown of each local unknown.
     unknowns: Vec<u32>,
+    /// Whether the local order is the global one (`unknowns[i] == i`, as for a single
+    /// particle and its conditions): a one-block solve then works in the right-hand side itself.
+    natural_order: bool,
     /// Slots of D_b (row-major), of A_ub for the ancestors u of U_b in turn (3 x n_b each,
     /// row-major) and of [A_bu for u in U_b] (n_b x 3|U_b|, row-major); a uniform chain's
     /// are periodic (`block_slots.rs`).
@@ -729,6 +732,7 @@ impl TreeElimination {
             pairs_at,
             fill_index,
             coupling_at,
+            natural_order: unknowns.iter().enumerate().all(|(i, &u)| u as usize == i),
             unknowns,
             diag_slots,
             low_slots,
@@ -1309,11 +1313,15 @@ impl TreeElimination {
     /// The solve of a matrix that is one block: D z = r with its factors, in place.
     fn solve_single_block(&mut self, rhs: &mut [f64]) {
         let n = self.unknowns.len();
+        let d = &self.store.diag()[self.diag_at[0]..self.diag_at[1]];
+        if self.natural_order {
+            solve_block(d, &self.perm[..n], &mut rhs[..n]);
+            return;
+        }
         let z = &mut self.z[..n];
         for (z, &u) in z.iter_mut().zip(&self.unknowns) {
             *z = rhs[u as usize];
         }
-        let d = &self.store.diag()[self.diag_at[0]..self.diag_at[1]];
         solve_block(d, &self.perm[..n], z);
         for (z, &u) in z.iter().zip(&self.unknowns) {
             rhs[u as usize] = *z;
@@ -1614,7 +1622,8 @@ mod tests {
     /// its parent alone) are solved by matrix-vector products (module documentation), and so
     /// are those of the other two chains but their ends' (the block of 5 of the node next to a
     /// second anchor, the block of 6 of an end with its three coordinates prescribed, the
-    /// root), the branched string's by the general sweeps. The chains' slots are periodic
+    /// root), the branched string's by the general sweeps; a pendulum's one block (its bob and
+    /// link, in the global order) is solved in the right-hand side itself. The chains' slots are periodic
     /// over their uniform run (`block_slots.rs`): at most six blocks keep theirs one by one.
     #[test]
     fn tree_elimination_matches_sparse_lu() {
@@ -1636,6 +1645,7 @@ mod tests {
             moved.add_fixed_coordinate(end, axis, None).unwrap();
         }
         let cases = [
+            (chain(1), 2, (4, 0, 1)),
             (chain(30), 5, (4, 0, 30)),
             (held, 3, (4, 1, 30)),
             (moved, 9, (4, 1, 30)),
@@ -1647,6 +1657,7 @@ mod tests {
             let mut tree = TreeElimination::analyse(&layout.pattern, 3 * layout.free)
                 .expect("a chain and a branched string are trees");
             assert_eq!((tree.uniform, tree.head, tree.tail), (uniform, head, tail));
+            assert_eq!(tree.natural_order, tree.blocks() == 1);
             let (kept, entries) = tree.slots_kept();
             if uniform > 0 {
                 assert!(kept <= 6 * entries / tree.blocks(), "{kept} of {entries}");
