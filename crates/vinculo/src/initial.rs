@@ -264,28 +264,59 @@ pub fn velocity_residual(c: &Constraint, q: &[Vec3], v: &[Vec3], t: f64) -> f64 
     gv + c.phi_t(q, t)
 }
 
+/// The constraints whose violations a state reports: all but the compliant ones, which any
+/// stretch satisfies with its tension (a mooring line's elastic segments). A run finds them
+/// once: looked at per stored state, the test cost a mooring line's step about as much as its
+/// constraint rows (two passes over every constraint's kind).
+pub fn rigid_constraints(system: &System) -> Vec<usize> {
+    let constraints = system.constraints().iter().enumerate();
+    constraints
+        .filter(|(_, c)| !c.is_compliant())
+        .map(|(k, _)| k)
+        .collect()
+}
+
 /// Largest scaled constraint residual max_k |s_k Phi_k(q, t)| and its index (compliant
 /// constraints, which any stretch satisfies with its tension, count as 0).
 pub fn scaled_violation(system: &System, q: &[Vec3], t: f64) -> (f64, usize) {
-    worst(system.constraints().iter().map(|c| {
-        if c.is_compliant() {
-            0.0
-        } else {
-            c.scale() * c.residual(q, t)
-        }
-    }))
+    scaled_violation_among(system, &rigid_constraints(system), q, t)
+}
+
+/// [`scaled_violation`] over the constraints `rigid` ([`rigid_constraints`]).
+pub fn scaled_violation_among(
+    system: &System,
+    rigid: &[usize],
+    q: &[Vec3],
+    t: f64,
+) -> (f64, usize) {
+    let constraints = system.constraints();
+    let (value, k) = worst(rigid.iter().map(|&c| {
+        let c = &constraints[c];
+        c.scale() * c.residual(q, t)
+    }));
+    (value, rigid.get(k).copied().unwrap_or(0))
 }
 
 /// Largest scaled velocity-constraint residual max_k |s_k (Phi_q v + Phi_t)| and its index
 /// (compliant constraints count as 0).
 pub fn scaled_velocity_violation(system: &System, q: &[Vec3], v: &[Vec3], t: f64) -> (f64, usize) {
-    worst(system.constraints().iter().map(|c| {
-        if c.is_compliant() {
-            0.0
-        } else {
-            c.scale() * velocity_residual(c, q, v, t)
-        }
-    }))
+    scaled_velocity_violation_among(system, &rigid_constraints(system), q, v, t)
+}
+
+/// [`scaled_velocity_violation`] over the constraints `rigid` ([`rigid_constraints`]).
+pub fn scaled_velocity_violation_among(
+    system: &System,
+    rigid: &[usize],
+    q: &[Vec3],
+    v: &[Vec3],
+    t: f64,
+) -> (f64, usize) {
+    let constraints = system.constraints();
+    let (value, k) = worst(rigid.iter().map(|&c| {
+        let c = &constraints[c];
+        c.scale() * velocity_residual(c, q, v, t)
+    }));
+    (value, rigid.get(k).copied().unwrap_or(0))
 }
 
 /// Moves the system's initial positions and velocities onto Phi = 0 and G v + Phi_t = 0 at time t

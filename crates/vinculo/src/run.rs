@@ -112,7 +112,8 @@ use crate::constraints::explain_singular;
 use crate::dense_output::StepEnds;
 use crate::error::{Error, Result};
 use crate::initial::{
-    consistent_accelerations, scaled_velocity_violation, scaled_violation, singular_error,
+    consistent_accelerations, rigid_constraints, scaled_velocity_violation_among,
+    scaled_violation_among, singular_error,
 };
 use crate::integrators::energy_guard::EnergyGuard;
 use crate::integrators::{
@@ -526,6 +527,8 @@ pub struct Simulation<'a> {
     options: SimulationOptions,
     newton: NewtonOptions,
     tension_floor: f64,
+    /// The constraints whose violations a stored state reports ([`rigid_constraints`]).
+    rigid: Vec<usize>,
     ws: StepWorkspace,
     stabilized: Option<StabilizedWorkspace>,
     carried: Carried,
@@ -601,8 +604,9 @@ impl<'a> Simulation<'a> {
         if let Some(e) = system.law_failure(t0) {
             return Err(e);
         }
-        let (worst, k) = scaled_violation(system, &q, t0);
-        let velocity_worst = scaled_velocity_violation(system, &q, &v, t0);
+        let rigid = rigid_constraints(system);
+        let (worst, k) = scaled_violation_among(system, &rigid, &q, t0);
+        let velocity_worst = scaled_velocity_violation_among(system, &rigid, &q, &v, t0);
         if let Some(e) = system.user_failure() {
             return Err(e);
         }
@@ -776,6 +780,7 @@ impl<'a> Simulation<'a> {
             options: options.clone(),
             newton,
             tension_floor,
+            rigid,
             ws,
             stabilized,
             carried: Carried {
@@ -929,7 +934,7 @@ impl<'a> Simulation<'a> {
             let c = &self.carried;
             store(
                 &mut self.sol,
-                self.system,
+                (self.system, &self.rigid),
                 c.t,
                 (&c.q, &c.v, &c.lambda),
                 StepStats::default(),
@@ -1436,6 +1441,7 @@ impl Simulation<'_> {
         };
         let slack = negative_tension(system, &new.lambda, t_new, self.tension_floor);
         let sol = &mut self.sol;
+        let rigid = &self.rigid[..];
         if let Some(outputs) = self.options.output_times.as_deref() {
             let whole = StepEnds {
                 t: c.t,
@@ -1482,12 +1488,18 @@ impl Simulation<'_> {
                 };
                 if t_out == t_new {
                     // A time on the step's end (a fixed step's grid time): its state itself.
-                    store(sol, system, t_out, (&new.q, &new.v, &new.lambda), stats);
+                    store(
+                        sol,
+                        (system, rigid),
+                        t_out,
+                        (&new.q, &new.v, &new.lambda),
+                        stats,
+                    );
                 } else {
                     ends.interpolate(t_out, &mut s.q_out, &mut s.v_out, &mut s.lambda_out);
                     store(
                         sol,
-                        system,
+                        (system, rigid),
                         t_out,
                         (&s.q_out, &s.v_out, &s.lambda_out),
                         stats,
@@ -1497,10 +1509,22 @@ impl Simulation<'_> {
             }
             // A run that stops here shows the state where it stopped.
             if slack.is_some() && sol.times.last() != Some(&t_new) {
-                store(sol, system, t_new, (&new.q, &new.v, &new.lambda), stats);
+                store(
+                    sol,
+                    (system, rigid),
+                    t_new,
+                    (&new.q, &new.v, &new.lambda),
+                    stats,
+                );
             }
         } else if c.step % self.options.save_every == 0 || ends_run || slack.is_some() {
-            store(sol, system, t_new, (&new.q, &new.v, &new.lambda), stats);
+            store(
+                sol,
+                (system, rigid),
+                t_new,
+                (&new.q, &new.v, &new.lambda),
+                stats,
+            );
         }
         std::mem::swap(&mut c.q, &mut new.q);
         std::mem::swap(&mut c.v, &mut new.v);
@@ -1536,7 +1560,7 @@ impl Simulation<'_> {
         if !observer.step(c.t, self.options.t_end) {
             // The state where the run stopped is kept, stored or not by `save_every`.
             if sol.times.last() != Some(&c.t) {
-                store(sol, system, c.t, (&c.q, &c.v, &c.lambda), stats);
+                store(sol, (system, rigid), c.t, (&c.q, &c.v, &c.lambda), stats);
             }
             sol.status = Err(Error::Interrupted { t: c.t });
             return Next::Stop;
@@ -1607,13 +1631,13 @@ fn first_event(
 /// Stores a state with its violations and the statistics of the step that produced it.
 fn store(
     sol: &mut Solution,
-    system: &System,
+    (system, rigid): (&System, &[usize]),
     t: f64,
     (q, v, lambda): (&[Vec3], &[Vec3], &[f64]),
     stats: StepStats,
 ) {
-    let position = scaled_violation(system, q, t).0;
-    let velocity = scaled_velocity_violation(system, q, v, t).0;
+    let position = scaled_violation_among(system, rigid, q, t).0;
+    let velocity = scaled_velocity_violation_among(system, rigid, q, v, t).0;
     sol.push(t, q, v, lambda, position, velocity, stats);
 }
 
