@@ -148,8 +148,8 @@ impl Solution {
         stats: StepStats,
     ) {
         self.times.push(t);
-        self.positions.extend(q.iter().flatten());
-        self.velocities.extend(v.iter().flatten());
+        self.positions.extend_from_slice(q.as_flattened());
+        self.velocities.extend_from_slice(v.as_flattened());
         self.multipliers.extend_from_slice(lambda);
         self.constraint_residual.push(residual);
         self.velocity_violation.push(velocity_violation);
