@@ -23,7 +23,8 @@ For each case and number of segments, both codes run the same MoorDyn file:
   tension, whichever is larger): equal accuracy in end tension.
 
 Each row reports the step, the CPU time of the time integration (``time.process_time``, the
-initial equilibrium excluded; the least of :data:`REPEATS` runs), the real-time factor (CPU time
+initial equilibrium excluded; the least of :data:`REPEATS` runs; both codes storing their state
+every :data:`OUTPUT_INTERVAL`), the real-time factor (CPU time
 over simulated time), the error against the code's own reference, and the difference in end
 tension between the two codes after the first period of the motion (:data:`DIFFERENCE_FROM`).
 The end tensions compared are those of each line's first and last segments: the force on an
@@ -48,6 +49,7 @@ import tempfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -61,6 +63,9 @@ from vinculo.mooring.moordyn_file import (
 )
 from vinculo.mooring.motion import Motion
 from vinculo.mooring.peer import PeerRun
+
+if TYPE_CHECKING:
+    from vinculo.mooring.analysis import MooringRun
 
 __all__ = ["CASES", "BenchRow", "bench_case", "main", "motion_for", "table"]
 
@@ -218,21 +223,22 @@ def _on(times: np.ndarray, values: np.ndarray, grid: np.ndarray) -> np.ndarray:
     return out.reshape((grid.size, *values.shape[1:]))
 
 
-def bench_moordyn(model: MoorDynFile, motion: Motion, t_end: float, dt_output: float = 0.1
-                  ) -> tuple[BenchRow, np.ndarray, np.ndarray]:
+def bench_moordyn(model: MoorDynFile, motion: Motion, t_end: float,
+                  dt_output: float | None = None) -> tuple[BenchRow, np.ndarray, np.ndarray]:
     """MoorDyn on one case: reference, largest stable step, timed run.
 
     Arguments:
         model: the case.
         motion: the fairlead motion.
         t_end: the simulated time (s).
-        dt_output: the output interval (s).
+        dt_output: the output interval (s; default :data:`OUTPUT_INTERVAL`).
 
     Returns:
         ``(row, times, reference end tensions)``.
     """
     from vinculo.mooring.peer import largest_stable_step, moordyn_initial_state, run_moordyn
 
+    dt_output = OUTPUT_INTERVAL if dt_output is None else dt_output
     estimate = wave_step(model)
     with tempfile.TemporaryDirectory(prefix="vinculo-bench-") as folder:
         # MoorDyn's initial condition once (a dynamic relaxation at half the axial-wave step,
@@ -266,6 +272,13 @@ def bench_moordyn(model: MoorDynFile, motion: Motion, t_end: float, dt_output: f
     return row, reference.times, reference.segment_tensions
 
 
+#: The interval at which both codes store their state in a timed run (s): MoorDyn's output
+#: interval ``dtOut`` and vinculo's output times. A state stored at every step cost vinculo a
+#: fifth of its run on the chain on the seabed at 5 ms steps (100 segments: 0.096 against
+#: 0.074 s for 20 s; the memory each new state fills is first touched then), where MoorDyn
+#: writes one state every 0.1 s.
+OUTPUT_INTERVAL = 0.1
+
 #: The time from which the two codes' end tensions are compared (s): one period of the motion.
 DIFFERENCE_FROM = 10.0
 
@@ -276,6 +289,25 @@ REPEATS = 3
 #: vinculo's steps tried, largest first (s). The smallest ones serve the chain on the seabed,
 #: whose touchdown impacts both codes must resolve.
 STEPS = (0.5, 0.3, 0.2, 0.15, 0.1, 0.07, 0.05, 0.03, 0.02, 0.01, 0.007, 0.005, 0.003, 0.002)
+
+
+def vinculo_run(model: MoorDynFile, motion: Motion, t_end: float, dt: float) -> MooringRun:
+    """A timed run of vinculo on one case: steps of ``dt``, the state stored every
+    :data:`OUTPUT_INTERVAL` as MoorDyn's is.
+
+    Arguments:
+        model: the case.
+        motion: the fairlead motion.
+        t_end: the simulated time (s).
+        dt: the step (s).
+
+    Returns:
+        The run (its ``cpu_time`` is that of the time integration).
+    """
+    from vinculo.mooring.analysis import _output_grid, run
+
+    return run(model, motion, t_end, dt=dt, plots=False,
+               t_eval=_output_grid(t_end, OUTPUT_INTERVAL))
 
 
 def bench_vinculo(model: MoorDynFile, motion: Motion, t_end: float, target: float,
@@ -294,11 +326,9 @@ def bench_vinculo(model: MoorDynFile, motion: Motion, t_end: float, target: floa
     Returns:
         ``(row, end-segment tensions on the grid at the chosen step)``.
     """
-    from vinculo.mooring.analysis import run
-
     def tensions(dt: float, repeats: int = 1) -> tuple[np.ndarray, float]:
-        result = run(model, motion, t_end, dt=dt)
-        cpu = min([result.cpu_time] + [run(model, motion, t_end, dt=dt).cpu_time
+        result = vinculo_run(model, motion, t_end, dt)
+        cpu = min([result.cpu_time] + [vinculo_run(model, motion, t_end, dt).cpu_time
                                        for _ in range(repeats - 1)])
         return _on(result.times, result.segment_tensions, grid), cpu
 
@@ -369,12 +399,10 @@ def scaling(name: str, segments: Sequence[int], dt: float,
     Returns:
         ``(segments, real-time factor)`` pairs.
     """
-    from vinculo.mooring.analysis import run
-
     rows = []
     for n in segments:
         model = CASES[name](n)
-        result = run(model, motion_for(model), t_end, dt=dt)
+        result = vinculo_run(model, motion_for(model), t_end, dt)
         rows.append((n, result.cpu_time / t_end))
     return rows
 
@@ -449,7 +477,6 @@ def per_step(name: str, segments: int, dt: float, t_end: float) -> tuple[float, 
     Returns:
         ``(MoorDyn's step (s), MoorDyn's CPU time a step (s), vinculo's CPU time a step (s))``.
     """
-    from vinculo.mooring.analysis import run
     from vinculo.mooring.peer import moordyn_initial_state, run_moordyn
 
     model = CASES[name](segments)
@@ -458,10 +485,10 @@ def per_step(name: str, segments: int, dt: float, t_end: float) -> tuple[float, 
     with tempfile.TemporaryDirectory(prefix="vinculo-bench-") as folder:
         state = moordyn_initial_state(model, motion, Path(folder) / "initial.state",
                                       time_step=step)
-        moordyn = min(run_moordyn(model, motion, t_end, dt_output=0.1, time_step=step,
+        moordyn = min(run_moordyn(model, motion, t_end, dt_output=OUTPUT_INTERVAL, time_step=step,
                                   coupling_step=None, initial_state=state).cpu_time
                       for _ in range(REPEATS))
-    runs = [run(model, motion, t_end, dt=dt, plots=False) for _ in range(REPEATS)]
+    runs = [vinculo_run(model, motion, t_end, dt) for _ in range(REPEATS)]
     vinculo = min(r.cpu_time / r.solution.steps_taken for r in runs)
     return step, moordyn / round(t_end / step), vinculo
 
