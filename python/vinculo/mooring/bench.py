@@ -24,7 +24,8 @@ For each case and number of segments, both codes run the same MoorDyn file:
 
 Each row reports the step, the CPU time of the time integration (``time.process_time``, the
 initial equilibrium excluded; the least of :data:`REPEATS` runs; both codes storing their state
-every :data:`OUTPUT_INTERVAL`), the real-time factor (CPU time
+every :data:`OUTPUT_INTERVAL`, vinculo at every step where its step does not divide that
+interval), the real-time factor (CPU time
 over simulated time), the error against the code's own reference, and the difference in end
 tension between the two codes after the first period of the motion (:data:`DIFFERENCE_FROM`).
 The end tensions compared are those of each line's first and last segments: the force on an
@@ -293,7 +294,10 @@ STEPS = (0.5, 0.3, 0.2, 0.15, 0.1, 0.07, 0.05, 0.03, 0.02, 0.01, 0.007, 0.005, 0
 
 def vinculo_run(model: MoorDynFile, motion: Motion, t_end: float, dt: float) -> MooringRun:
     """A timed run of vinculo on one case: steps of ``dt``, the state stored every
-    :data:`OUTPUT_INTERVAL` as MoorDyn's is.
+    :data:`OUTPUT_INTERVAL` as MoorDyn's is where that is a whole number of steps, else at every
+    step (a state between step ends would be interpolated, and a segment's tension from
+    interpolated positions is less accurate than the tensions at the steps' ends interpolated
+    onto the comparison grid).
 
     Arguments:
         model: the case.
@@ -306,8 +310,9 @@ def vinculo_run(model: MoorDynFile, motion: Motion, t_end: float, dt: float) -> 
     """
     from vinculo.mooring.analysis import _output_grid, run
 
-    return run(model, motion, t_end, dt=dt, plots=False,
-               t_eval=_output_grid(t_end, OUTPUT_INTERVAL))
+    steps = round(OUTPUT_INTERVAL / dt)
+    every = steps * dt if steps >= 1 and math.isclose(steps * dt, OUTPUT_INTERVAL) else dt
+    return run(model, motion, t_end, dt=dt, plots=False, t_eval=_output_grid(t_end, every))
 
 
 def bench_vinculo(model: MoorDynFile, motion: Motion, t_end: float, target: float,
