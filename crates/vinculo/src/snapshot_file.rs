@@ -1,6 +1,6 @@
 //! Snapshot files: a [`Snapshot`] saved to and loaded from a small binary file.
 //!
-//! # Format (version 8)
+//! # Format (version 9)
 //!
 //! Little-endian throughout; every float is stored as its IEEE-754 bits, so a loaded snapshot
 //! is bit for bit the saved one.
@@ -8,11 +8,12 @@
 //! | field | type |
 //! |---|---|
 //! | magic `VNCLSNAP` | 8 bytes |
-//! | version (8) | u32 |
+//! | version (9) | u32 |
 //! | model fingerprint ([`crate::run::fingerprint`]), particles n, constraint equations m | 3 x u64 |
 //! | time | f64 |
 //! | positions, velocities, accelerations, their rates over the last step (the predictor's, `run.rs`) | 4 x (n x 3 f64) |
 //! | the size of the step the accelerations' rates were measured over (0: none) | f64 |
+//! | the accelerations' rates over the step before, the size of that step (0: none), and whether the predictor extrapolates with them (1) or with the last ones (0) | n x 3 f64, f64, u8 |
 //! | multipliers, their rates over the last step (the predictor's, `run.rs`) | 2 x (m f64) |
 //! | the time rule's state: 4 arrays of 3-vectors, each a u64 length then length x 3 f64 | |
 //! | step controller tag: 0 (fixed steps) or 1 (error control), then its state (below) | u8 |
@@ -36,7 +37,9 @@
 //! | PI controller: order k, last error norm, last attempt rejected (0 or 1), hold | f64, f64, u8, f64 |
 //! | next step size h, error norm of the last judged step | 2 x f64 |
 //!
-//! Version 7 is version 8 without the accelerations' rates (read as zero: the first step after
+//! Version 8 is version 9 without the rates over the step before (read as none: the predictor
+//! extrapolates with the last rates until it has both). Version 7 is version 8 without the
+//! accelerations' rates (read as zero: the first step after
 //! restoring it predicts at constant acceleration). Version 6 is version 7 without the
 //! residual evaluations (read as zero). Version 5 is version
 //! 6 without the multipliers' rates (read as zero: the first step after
@@ -59,7 +62,7 @@ use crate::run::{Carried, Controller, FixedSteps, Fnv, HeldMatrix, Snapshot};
 use crate::step_control::{AdaptiveOptions, ErrorWeights, PiController};
 
 const MAGIC: &[u8; 8] = b"VNCLSNAP";
-const VERSION: u32 = 8;
+const VERSION: u32 = 9;
 /// The oldest format version still read.
 const OLDEST: u32 = 1;
 
@@ -281,6 +284,9 @@ impl Snapshot {
         w.vecs(&c.acc);
         w.vecs(&c.acc_rate);
         w.f64(c.acc_rate_step);
+        w.vecs(&c.acc_rate_before);
+        w.f64(c.acc_rate_before_step);
+        w.0.push(u8::from(c.alternating));
         for &x in c.lambda.iter().chain(&c.lambda_rate) {
             w.f64(x);
         }
@@ -342,7 +348,7 @@ impl Snapshot {
     ///
     /// # Errors
     /// [`Error::Snapshot`] when the file cannot be read, is not a snapshot file, is of a format
-    /// version this vinculo does not read (1 to 8 are; of 2 only fixed steps), or is truncated or corrupt (its
+    /// version this vinculo does not read (1 to 9 are; of 2 only fixed steps), or is truncated or corrupt (its
     /// checksum does not match).
     pub fn load(path: impl AsRef<Path>) -> Result<Snapshot> {
         let path = path.as_ref();
@@ -390,6 +396,11 @@ impl Snapshot {
             (r.vecs(n)?, r.f64()?)
         } else {
             (vec![[0.0; 3]; n], 0.0)
+        };
+        let (acc_rate_before, acc_rate_before_step, alternating) = if version >= 9 {
+            (r.vecs(n)?, r.f64()?, r.take(1)?[0] == 1)
+        } else {
+            (vec![[0.0; 3]; n], 0.0, false)
         };
         let rates = if version >= 6 { m } else { 0 };
         if (m + rates).saturating_mul(8) > body.len() - r.at {
@@ -484,6 +495,9 @@ impl Snapshot {
                 acc,
                 acc_rate,
                 acc_rate_step,
+                acc_rate_before,
+                acc_rate_before_step,
+                alternating,
                 lambda,
                 lambda_rate,
                 rule,

@@ -298,8 +298,8 @@ fn with_checksum(mut body: Vec<u8>) -> Vec<u8> {
 /// and without the held iteration matrix, none held) is still read, to the same snapshot
 /// (saved again, the version 6 file with zero rates and no matrix held), and so is one written
 /// as version 5 (without the rates and the run's own grid), 6 (without the residual
-/// evaluations) or 7 (without the accelerations' rates, read as zero: saved again, the
-/// version 8 file with zero rates).
+/// evaluations), 7 (without the accelerations' rates, read as zero: saved again, the
+/// version 9 file with zero rates) or 8 (without the rates over the step before, read as none).
 #[test]
 fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     let system = chain();
@@ -315,25 +315,28 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     run.step_to(0.05).clone().unwrap();
     run.snapshot().save(&path).unwrap();
     let good = std::fs::read(&path).unwrap();
-    assert_eq!(&good[8..12], &8u32.to_le_bytes());
+    assert_eq!(&good[8..12], &9u32.to_le_bytes());
     let n = system.particles().len();
-    // Version 8 keeps the accelerations' rates and their step after the accelerations; the
-    // files below are written from version 7's layout (without them) and read back as version
-    // 8 (zero rates, no step).
+    // Version 8 keeps the accelerations' rates and their step after the accelerations, version
+    // 9 then the rates over the step before, their step and the predictor's choice (a byte);
+    // the files below are written from version 7's layout (without them) and read back as
+    // version 9 (zero rates, no steps, the last rates chosen).
     let acc_rates_at = 8 + 4 + 24 + 8 + 3 * 24 * n;
-    let v7 = |v8: &[u8]| {
-        let mut b = [&v8[..acc_rates_at], &v8[acc_rates_at + 24 * n + 8..]].concat();
+    let before_at = acc_rates_at + 24 * n + 8;
+    let before_end = before_at + 24 * n + 8 + 1;
+    let v7 = |v9: &[u8]| {
+        let mut b = [&v9[..acc_rates_at], &v9[before_end..]].concat();
         b[8..12].copy_from_slice(&7u32.to_le_bytes());
         b
     };
-    let v8 = |v7: Vec<u8>| {
+    let v9 = |v7: Vec<u8>| {
         let mut b = [
             &v7[..acc_rates_at],
-            &vec![0u8; 24 * n + 8],
+            &vec![0u8; before_end - acc_rates_at],
             &v7[acc_rates_at..],
         ]
         .concat();
-        b[8..12].copy_from_slice(&8u32.to_le_bytes());
+        b[8..12].copy_from_slice(&9u32.to_le_bytes());
         with_checksum(b)
     };
     let refused = |bytes: &[u8], expected: &str| {
@@ -436,7 +439,7 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     let loaded = vinculo::Snapshot::load(&v1).unwrap();
     let again = dir.join("fixed-again.snap");
     loaded.save(&again).unwrap();
-    let without_matrix = v8([
+    let without_matrix = v9([
         &body[..rates_at],
         &zero_rates,
         &body[rates_end..counts_end - 8],
@@ -458,7 +461,7 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     let v5 = dir.join("fixed-v5.snap");
     std::fs::write(&v5, with_checksum(v5_body)).unwrap();
     vinculo::Snapshot::load(&v5).unwrap().save(&again).unwrap();
-    let zeroed = v8([
+    let zeroed = v9([
         &body[..rates_at],
         &zero_rates,
         &body[rates_end..counts_end - 8],
@@ -474,7 +477,7 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     std::fs::write(&v6, with_checksum(v6_body)).unwrap();
     let restored = vinculo::Snapshot::load(&v6).unwrap();
     restored.save(&again).unwrap();
-    let counted_zero = v8([&body[..counts_end - 8], &[0u8; 8][..], &body[counts_end..]].concat());
+    let counted_zero = v9([&body[..counts_end - 8], &[0u8; 8][..], &body[counts_end..]].concat());
     assert_eq!(std::fs::read(&again).unwrap(), counted_zero);
     // A version 7 file: without the accelerations' rates.
     let v7_path = dir.join("fixed-v7.snap");
@@ -483,7 +486,30 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
         .unwrap()
         .save(&again)
         .unwrap();
-    assert_eq!(std::fs::read(&again).unwrap(), v8(body.to_vec()));
+    assert_eq!(std::fs::read(&again).unwrap(), v9(body.to_vec()));
+    // A version 8 file: without the rates over the step before (the chain's run had them).
+    assert!(
+        v2_bytes[before_at..before_end - 1].iter().any(|&b| b != 0),
+        "the rates over the step before are kept"
+    );
+    let unsummed = &v2_bytes[..v2_bytes.len() - 8];
+    let mut v8_body = [&unsummed[..before_at], &unsummed[before_end..]].concat();
+    v8_body[8..12].copy_from_slice(&8u32.to_le_bytes());
+    let v8_path = dir.join("fixed-v8.snap");
+    std::fs::write(&v8_path, with_checksum(v8_body)).unwrap();
+    vinculo::Snapshot::load(&v8_path)
+        .unwrap()
+        .save(&again)
+        .unwrap();
+    let none_before = with_checksum(
+        [
+            &unsummed[..before_at],
+            &vec![0u8; before_end - before_at],
+            &unsummed[before_end..],
+        ]
+        .concat(),
+    );
+    assert_eq!(std::fs::read(&again).unwrap(), none_before);
     std::fs::remove_dir_all(&dir).ok();
 }
 
