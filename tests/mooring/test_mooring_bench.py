@@ -32,3 +32,13 @@ def test_wave_step_is_a_segment_over_the_axial_wave_speed():
     # hanging_line: 100 m in 20 segments, EA = 1e8 N, 20 kg/m: 5 m / sqrt(5e6 m^2/s^2).
     assert wave_step(CASES["hanging"](20)) == pytest.approx(5.0 / math.sqrt(1e8 / 20.0),
                                                             rel=1e-15)
+
+
+@pytest.mark.parametrize("value", ["fast", "0", "-0.01", "nan"])
+def test_a_bad_per_step_value_is_refused_with_its_name(value, capsys):
+    from vinculo.mooring.bench import main
+
+    with pytest.raises(SystemExit) as stop:
+        main(["--per-step", value, "--cases", "hanging"])
+    assert stop.value.code == 2
+    assert f"--per-step {value!r}" in capsys.readouterr().err

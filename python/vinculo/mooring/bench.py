@@ -35,7 +35,8 @@ drag and added mass of the half segment at a moving fairlead).
 Run it with ``python -m vinculo.mooring.bench [--segments 20,100] [--t-end 60]``; it writes
 ``bench.csv`` and ``bench.md`` (the README's table) into ``--output``. With ``--per-step DT``
 it measures instead the CPU time of one step of each code (:func:`per_step`: MoorDyn's
-explicit step against vinculo's implicit step of DT), and with ``--scaling DT`` vinculo's
+explicit step against vinculo's implicit step of DT, or of MoorDyn's own step with
+``--per-step moordyn``), and with ``--scaling DT`` vinculo's
 real-time factor against the number of segments.
 """
 
@@ -292,26 +293,29 @@ REPEATS = 3
 STEPS = (0.5, 0.3, 0.2, 0.15, 0.1, 0.07, 0.05, 0.03, 0.02, 0.01, 0.007, 0.005, 0.003, 0.002)
 
 
-def vinculo_run(model: MoorDynFile, motion: Motion, t_end: float, dt: float) -> MooringRun:
-    """A timed run of vinculo on one case: steps of ``dt``, the state stored every
-    :data:`OUTPUT_INTERVAL` as MoorDyn's is where that is a whole number of steps, else at every
-    step (a state between step ends would be interpolated, and a segment's tension from
-    interpolated positions is less accurate than the tensions at the steps' ends interpolated
-    onto the comparison grid).
+def vinculo_run(model: MoorDynFile, motion: Motion, t_end: float, dt: float,
+                every: float | None = None) -> MooringRun:
+    """A timed run of vinculo on one case: steps of ``dt``, the state stored every ``every``.
 
     Arguments:
         model: the case.
         motion: the fairlead motion.
         t_end: the simulated time (s).
         dt: the step (s).
+        every: the output interval (s). Default: :data:`OUTPUT_INTERVAL`, as MoorDyn's, where
+            that is a whole number of steps, else every step (a state between step ends would
+            be interpolated, and a segment's tension from interpolated positions is less
+            accurate than the tensions at the steps' ends interpolated onto the comparison
+            grid).
 
     Returns:
         The run (its ``cpu_time`` is that of the time integration).
     """
     from vinculo.mooring.analysis import _output_grid, run
 
-    steps = round(OUTPUT_INTERVAL / dt)
-    every = steps * dt if steps >= 1 and math.isclose(steps * dt, OUTPUT_INTERVAL) else dt
+    if every is None:
+        steps = round(OUTPUT_INTERVAL / dt)
+        every = steps * dt if steps >= 1 and math.isclose(steps * dt, OUTPUT_INTERVAL) else dt
     return run(model, motion, t_end, dt=dt, plots=False, t_eval=_output_grid(t_end, every))
 
 
@@ -467,20 +471,24 @@ def write_rows(rows: Sequence[BenchRow], path: str | Path) -> Path:
     return path
 
 
-def per_step(name: str, segments: int, dt: float, t_end: float) -> tuple[float, float, float]:
+def per_step(name: str, segments: int, dt: float | None, t_end: float
+             ) -> tuple[float, float, float, float]:
     """The CPU time of one step of each code on one case: MoorDyn's at half its axial-wave step
     (:func:`wave_step`, within its stable range: an explicit step costs the same whatever its
     size), vinculo's at the step ``dt`` (its Newton iterations, and so its step's cost, depend
-    on the step); the least of :data:`REPEATS` runs each, from MoorDyn's initial state.
+    on the step), or at MoorDyn's step; both storing their state every
+    :data:`OUTPUT_INTERVAL`; the least of :data:`REPEATS` runs each, from MoorDyn's initial
+    state.
 
     Arguments:
         name: a key of :data:`CASES`.
         segments: the number of segments.
-        dt: vinculo's step (s).
+        dt: vinculo's step (s; None: MoorDyn's).
         t_end: the simulated time (s).
 
     Returns:
-        ``(MoorDyn's step (s), MoorDyn's CPU time a step (s), vinculo's CPU time a step (s))``.
+        ``(MoorDyn's step (s), MoorDyn's CPU time a step (s), vinculo's step (s), vinculo's CPU
+        time a step (s))``.
     """
     from vinculo.mooring.peer import moordyn_initial_state, run_moordyn
 
@@ -493,9 +501,10 @@ def per_step(name: str, segments: int, dt: float, t_end: float) -> tuple[float, 
         moordyn = min(run_moordyn(model, motion, t_end, dt_output=OUTPUT_INTERVAL, time_step=step,
                                   coupling_step=None, initial_state=state).cpu_time
                       for _ in range(REPEATS))
-    runs = [vinculo_run(model, motion, t_end, dt) for _ in range(REPEATS)]
+    dt = step if dt is None else dt
+    runs = [vinculo_run(model, motion, t_end, dt, every=OUTPUT_INTERVAL) for _ in range(REPEATS)]
     vinculo = min(r.cpu_time / r.solution.steps_taken for r in runs)
-    return step, moordyn / round(t_end / step), vinculo
+    return step, moordyn / round(t_end / step), dt, vinculo
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -519,11 +528,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--scaling", type=float, metavar="DT", default=None,
                         help="instead: vinculo's real-time factor against the number of segments "
                         "at the step DT (s), on each case")
-    parser.add_argument("--per-step", type=float, metavar="DT", default=None,
+    parser.add_argument("--per-step", metavar="DT", default=None,
                         help="instead: the CPU time of one step of each code on each case, "
-                        "vinculo's at the step DT (s)")
+                        "vinculo's at the step DT (s), or at MoorDyn's step with "
+                        "'--per-step moordyn'")
     parser.add_argument("--output", "-o", type=Path, default=Path("output") / "mooring-bench")
     args = parser.parse_args(argv)
+    per_step_dt = None
+    if args.per_step not in (None, "moordyn"):
+        try:
+            per_step_dt = float(args.per_step)
+        except ValueError:
+            parser.error(f"--per-step {args.per_step!r}: give a step in s or 'moordyn'")
+        if not (math.isfinite(per_step_dt) and per_step_dt > 0.0):
+            parser.error(f"--per-step {args.per_step!r}: give a step > 0 s or 'moordyn'")
     args.output.mkdir(parents=True, exist_ok=True)
     segment_list = [int(s) for s in args.segments.split(",") if s.strip()]
     if args.scaling is not None:
@@ -539,8 +557,8 @@ def main(argv: Sequence[str] | None = None) -> int:
               "| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
         for name in [c.strip() for c in args.cases.split(",") if c.strip()]:
             for n in segment_list:
-                step, moordyn, vinculo = per_step(name, n, args.per_step, args.t_end)
-                print(f"| {name} | {n} | {step:.3g} | {1e6 * moordyn:.1f} | {args.per_step:g} | "
+                step, moordyn, dt, vinculo = per_step(name, n, per_step_dt, args.t_end)
+                print(f"| {name} | {n} | {step:.3g} | {1e6 * moordyn:.1f} | {dt:.3g} | "
                       f"{1e6 * vinculo:.1f} | {vinculo / moordyn:.2f} |", flush=True)
         return 0
     rows: list[BenchRow] = []
