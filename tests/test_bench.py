@@ -78,6 +78,14 @@ def test_hanging_chain_stays_at_rest_and_scaling_reports_memory():
     assert figures["peak_mb"] > 0 and figures["seconds"] > 0
 
 
+@pytest.mark.parametrize("sizes", ["1000,x", "0", ""])
+def test_the_scaling_command_refuses_bad_sizes_naming_them(sizes, capsys):
+    with pytest.raises(SystemExit) as stop:
+        scaling.main(["swinging", "--sizes", sizes])
+    assert stop.value.code == 2
+    assert f"--sizes {sizes!r}" in capsys.readouterr().err
+
+
 def test_agreement_tolerance_is_a_share_of_the_schemes_own_error():
     # The tolerance of the side-by-side table is AGREEMENT_SHARE (1/100) of the distance between
     # vinculo's answers at dt and dt/2 (the scheme's own error: 3/4 of it at dt for a second-order

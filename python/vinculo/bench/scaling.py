@@ -1,6 +1,7 @@
 """vinculo alone: seconds per step and peak memory of hanging chains of 10^3 to 10^6 particles.
 
-Each size runs in its own process (``python -m vinculo.bench.scaling N``) so that the peak
+``python -m vinculo.bench.scaling [hanging|swinging] [--sizes 1000,10000]`` prints the table.
+Each size runs in its own process (the same command with ``--one N``) so that the peak
 resident memory (``ru_maxrss``) is that of one model: building it, the run (only the first and
 last states stored) and the returned Solution. The cost of a step is measured apart from the
 one-time set-up of a run (checks, consistent initial accelerations, the solver's analysis): a run
@@ -11,6 +12,7 @@ longer run.
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import resource
@@ -54,7 +56,8 @@ def _measure(n: int, shape: str) -> dict[str, float | str]:
     results = []
     steps = steps_for(n)
     for count in (1, 1 + steps):
-        args = [sys.executable, "-m", "vinculo.bench.scaling", str(n), shape, str(count)]
+        args = [sys.executable, "-m", "vinculo.bench.scaling", shape, "--one", str(n),
+                "--steps", str(count)]
         done = subprocess.run(args, capture_output=True, text=True, check=False)
         if done.returncode != 0:
             raise RuntimeError(" ".join(done.stderr.strip().splitlines()[-1:]))
@@ -98,11 +101,39 @@ def run(sizes: tuple[int, ...] = SIZES, hanging: bool = True, out=print) -> floa
     return p
 
 
-if __name__ == "__main__":
-    # No argument: the table of hanging chains; "swinging": of swinging ones; N [swinging
-    # [steps]]: one size, in this process (the table's subprocesses).
-    if len(sys.argv) > 1 and sys.argv[1] != "swinging":
-        count = int(sys.argv[3]) if len(sys.argv) > 3 else 1 + steps_for(int(sys.argv[1]))
-        print(json.dumps(one(int(sys.argv[1]), sys.argv[2:3] != ["swinging"], count)))
+def main(argv: list[str] | None = None) -> int:
+    """The command line (``python -m vinculo.bench.scaling``).
+
+    Arguments:
+        argv: the arguments (default: ``sys.argv[1:]``).
+
+    Returns:
+        The exit code (0).
+    """
+    parser = argparse.ArgumentParser(prog="python -m vinculo.bench.scaling",
+                                     description=__doc__.split("\n\n")[0])
+    parser.add_argument("shape", nargs="?", default="hanging", choices=("hanging", "swinging"),
+                        help="chains hanging at rest (default) or released swinging")
+    parser.add_argument("--sizes", default=",".join(str(n) for n in SIZES),
+                        help="comma-separated numbers of particles (default %(default)s)")
+    # One size in this process, the table's subprocesses: its figures as JSON.
+    parser.add_argument("--one", type=int, metavar="N", help=argparse.SUPPRESS)
+    parser.add_argument("--steps", type=int, metavar="K", help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    try:
+        sizes = tuple(int(x) for x in args.sizes.split(",") if x.strip())
+    except ValueError:
+        parser.error(f"--sizes {args.sizes!r}: give comma-separated whole numbers")
+    if not sizes or min(sizes) < 1:
+        parser.error(f"--sizes {args.sizes!r}: give numbers of particles >= 1")
+    hanging = args.shape == "hanging"
+    if args.one is not None:
+        count = args.steps if args.steps is not None else 1 + steps_for(args.one)
+        print(json.dumps(one(args.one, hanging, count)))
     else:
-        run(hanging=sys.argv[1:2] != ["swinging"])
+        run(sizes, hanging=hanging)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
