@@ -289,12 +289,18 @@ pub fn scaled_violation_among(
     q: &[Vec3],
     t: f64,
 ) -> (f64, usize) {
+    worst_among(system, rigid, |c| c.scale() * c.residual(q, t))
+}
+
+/// The largest `value` over the constraints `rigid` and the index of its constraint.
+fn worst_among(
+    system: &System,
+    rigid: &[usize],
+    value: impl Fn(&crate::constraints::Constraint) -> f64,
+) -> (f64, usize) {
     let constraints = system.constraints();
-    let (value, k) = worst(rigid.iter().map(|&c| {
-        let c = &constraints[c];
-        c.scale() * c.residual(q, t)
-    }));
-    (value, rigid.get(k).copied().unwrap_or(0))
+    let (largest, k) = worst(rigid.iter().map(|&c| value(&constraints[c])));
+    (largest, rigid.get(k).copied().unwrap_or(0))
 }
 
 /// Largest scaled velocity-constraint residual max_k |s_k (Phi_q v + Phi_t)| and its index
@@ -311,12 +317,7 @@ pub fn scaled_velocity_violation_among(
     v: &[Vec3],
     t: f64,
 ) -> (f64, usize) {
-    let constraints = system.constraints();
-    let (value, k) = worst(rigid.iter().map(|&c| {
-        let c = &constraints[c];
-        c.scale() * velocity_residual(c, q, v, t)
-    }));
-    (value, rigid.get(k).copied().unwrap_or(0))
+    worst_among(system, rigid, |c| c.scale() * velocity_residual(c, q, v, t))
 }
 
 /// Moves the system's initial positions and velocities onto Phi = 0 and G v + Phi_t = 0 at time t

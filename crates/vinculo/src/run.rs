@@ -1491,7 +1491,7 @@ impl Simulation<'_> {
         let slack = negative_tension(system, &new.lambda, t_new, self.tension_floor);
         let sol = &mut self.sol;
         let rigid = &self.rigid[..];
-        if let Some(outputs) = self.options.output_times.as_deref() {
+        let end_stored = if let Some(outputs) = self.options.output_times.as_deref() {
             let whole = StepEnds {
                 t: c.t,
                 h: t_new - c.t,
@@ -1557,23 +1557,13 @@ impl Simulation<'_> {
                 c.next_output += 1;
             }
             // A run that stops here shows the state where it stopped.
-            if slack.is_some() && sol.times.last() != Some(&t_new) {
-                store(
-                    sol,
-                    (system, rigid),
-                    t_new,
-                    (&new.q, &new.v, &new.lambda),
-                    stats,
-                );
-            }
-        } else if c.step % self.options.save_every == 0 || ends_run || slack.is_some() {
-            store(
-                sol,
-                (system, rigid),
-                t_new,
-                (&new.q, &new.v, &new.lambda),
-                stats,
-            );
+            slack.is_some() && sol.times.last() != Some(&t_new)
+        } else {
+            c.step % self.options.save_every == 0 || ends_run || slack.is_some()
+        };
+        if end_stored {
+            let state = (&new.q[..], &new.v[..], &new.lambda[..]);
+            store(sol, (system, rigid), t_new, state, stats);
         }
         std::mem::swap(&mut c.q, &mut new.q);
         std::mem::swap(&mut c.v, &mut new.v);
