@@ -134,13 +134,13 @@ impl BlockSlots {
         match &self.run {
             Some(run) if entries.start >= run.entries.start && entries.start < run.entries.end => {
                 let offset = entries.start - run.entries.start;
-                let block = (offset / run.per_block) as i64;
-                for ((o, &s), &d) in out.iter_mut().zip(&run.first).zip(&run.step) {
-                    *o = if s == ABSENT {
-                        0.0
-                    } else {
-                        values[(s as i64 + block * d) as usize]
-                    };
+                let block = (offset / run.per_block) as u32;
+                // A fill entry's slot stays ABSENT, past the end of `values` (every slot is
+                // below ABSENT): one bounds test reads a slot or gives the fill's zero.
+                let (first, step) = (&run.first[..out.len()], &run.wrapping_step[..out.len()]);
+                for ((o, &s), &d) in out.iter_mut().zip(first).zip(step) {
+                    let slot = s.wrapping_add(block.wrapping_mul(d)) as usize;
+                    *o = values.get(slot).copied().unwrap_or(0.0);
                 }
             }
             Some(run) if entries.start >= run.entries.end => {
@@ -168,10 +168,11 @@ impl Run {
     }
 }
 
-/// Gathers `values` at `slots` into `out` (absent entries are zero).
+/// Gathers `values` at `slots` into `out` (absent entries, whose slot ABSENT lies past the end
+/// of `values`, are zero).
 fn gather(out: &mut [f64], slots: &[u32], values: &[f64]) {
     for (o, &s) in out.iter_mut().zip(slots) {
-        *o = if s == ABSENT { 0.0 } else { values[s as usize] };
+        *o = values.get(s as usize).copied().unwrap_or(0.0);
     }
 }
 
