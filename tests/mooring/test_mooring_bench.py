@@ -42,3 +42,19 @@ def test_a_bad_per_step_value_is_refused_with_its_name(value, capsys):
         main(["--per-step", value, "--cases", "hanging"])
     assert stop.value.code == 2
     assert f"--per-step {value!r}" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("dt", "every"), [(0.005, 0.1), (0.02, 0.1), (0.07, 0.07), (0.03, 0.03)])
+def test_a_timed_run_stores_as_moordyn_does_where_its_steps_allow(dt, every):
+    # Both codes store their state every OUTPUT_INTERVAL (0.1 s, MoorDyn's output interval);
+    # vinculo where that is a whole number of its steps, else at every step (its tensions are
+    # then its steps' own, not interpolated between them).
+    from vinculo.mooring.bench import OUTPUT_INTERVAL, motion_for, vinculo_run
+
+    assert OUTPUT_INTERVAL == 0.1
+    model = CASES["hanging"](5)
+    result = vinculo_run(model, motion_for(model), 0.42, dt)
+    times = result.times
+    assert times[-1] == pytest.approx(0.42)
+    spacing = times[1:-1] - times[:-2]
+    assert spacing == pytest.approx(every, rel=1e-9)
