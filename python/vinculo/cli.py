@@ -10,7 +10,8 @@ Usage::
     vinculo buoy sweep --param NAME=VALUES [...] [--scheduler ADDRESS] [--output DIR]
     vinculo buoy calibrate --data FILE.csv [--fit NAMES] [--output DIR]
     vinculo mooring statics FILE [--output DIR]
-    vinculo mooring run FILE [--motion FILE.csv] --t-end T [--dt DT] [--output DIR]
+    vinculo mooring run FILE [--motion FILE.csv] --t-end T [--dt DT] [--output-every S]
+                        [--output DIR]
 
 ``demo`` runs the four demo models (pendulum, double pendulum, hanging chain, inclined plane),
 prints one line per model comparing the simulation with its reference value, and writes one PNG
@@ -37,6 +38,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import math
+import os
 import signal
 import sys
 import time
@@ -631,7 +633,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     Returns:
         The exit code: 0 on success, 1 if a simulation failed, 2 for a bad argument or input
-        file (an :class:`~vinculo.errors.InvalidInputError`), 130 after Ctrl-C.
+        file (an :class:`~vinculo.errors.InvalidInputError`), 130 after Ctrl-C, 141 when the
+        reader of its output closed it (a pipe into `head`).
 
     Raises:
         SystemExit: with code 2 on bad arguments (from argparse), or 0 after ``--help``.
@@ -654,6 +657,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"{parser.prog}: interrupted", file=sys.stderr, flush=True)
         return 130
+    except BrokenPipeError:
+        # The reader of the output went away (``vinculo ... | head``): the rest of the output
+        # goes nowhere, and the interpreter's last flush of stdout must not fail again.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
 
 
 if __name__ == "__main__":

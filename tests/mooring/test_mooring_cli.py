@@ -68,3 +68,30 @@ def test_a_bad_motion_file_is_named(tmp_path, capsys, header, rows, words):
     err = capsys.readouterr().err
     assert words in err
     assert "error:" in err
+
+
+@pytest.mark.parametrize("every", ["0.03", "0", "-0.1"])
+def test_an_output_interval_that_is_not_a_whole_number_of_steps_is_refused(every, tmp_path,
+                                                                           capsys):
+    with pytest.raises(SystemExit) as info:
+        cli.main(["mooring", "run", str(TAUT), "--t-end", "1", "--dt", "0.02",
+                  "--output-every", every, "--output", str(tmp_path / "out")])
+    assert info.value.code == 2
+    assert "--output-every" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()  # nothing written
+
+
+def test_a_reader_that_closes_the_output_ends_the_command_without_a_traceback(tmp_path):
+    # `vinculo mooring statics FILE | head -c 0`: the printing fails with a broken pipe, which
+    # ends the command with the shell's code for it (128 + SIGPIPE) and no traceback.
+    import subprocess
+    import sys
+
+    command = [sys.executable, "-m", "vinculo.cli", "mooring", "statics", str(TAUT),
+               "--output", str(tmp_path)]
+    with subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE) as child:
+        child.stdout.close()
+        err = child.stderr.read().decode()
+        code = child.wait()
+    assert code == 141, err
+    assert "Traceback" not in err

@@ -62,3 +62,19 @@ def test_run_api_returns_the_end_forces(tmp_path):
     # first stored end tensions are the static ones (1e-2: the first step's transient).
     np.testing.assert_allclose(result.end_tensions[0, 0],
                                [statics.ends[0].tension, statics.ends[1].tension], rtol=1e-2)
+
+
+def test_states_stored_every_few_steps_are_the_steps_own(tmp_path):
+    # output_every (MoorDyn's dtOut) stores every fifth step of 0.01 s: the same states, bit
+    # for bit, as the run that stores every step (the steps do not depend on what is stored),
+    # and a value that is not a whole number of steps is refused naming it.
+    import vinculo.mooring as mooring
+    from vinculo.errors import InvalidInputError
+
+    _motion, path = _motion_file(tmp_path)
+    every_step = mooring.run(HANGING, path, 1.0, dt=0.01, plots=False)
+    fifth = mooring.run(HANGING, path, 1.0, dt=0.01, output_every=0.05, plots=False)
+    np.testing.assert_allclose(fifth.times, np.arange(0.0, 1.0001, 0.05), atol=1e-12)
+    np.testing.assert_array_equal(fifth.end_forces, every_step.end_forces[::5])
+    with pytest.raises(InvalidInputError, match=r"output_every = 0\.015"):
+        mooring.run(HANGING, path, 1.0, dt=0.01, output_every=0.015, plots=False)

@@ -316,7 +316,10 @@ def vinculo_run(model: MoorDynFile, motion: Motion, t_end: float, dt: float,
     if every is None:
         steps = round(OUTPUT_INTERVAL / dt)
         every = steps * dt if steps >= 1 and math.isclose(steps * dt, OUTPUT_INTERVAL) else dt
-    return run(model, motion, t_end, dt=dt, plots=False, t_eval=_output_grid(t_end, every))
+    steps = round(every / dt)
+    grid = _output_grid(t_end, dt, steps) if math.isclose(steps * dt, every) else \
+        _output_grid(t_end, every)
+    return run(model, motion, t_end, dt=dt, plots=False, t_eval=grid)
 
 
 def bench_vinculo(model: MoorDynFile, motion: Motion, t_end: float, target: float,

@@ -3,8 +3,8 @@
 Usage::
 
     vinculo mooring statics FILE [--output DIR]
-    vinculo mooring run FILE [--motion FILE.csv] --t-end T [--dt DT] [--output DIR]
-                        [--no-plots] [--no-progress]
+    vinculo mooring run FILE [--motion FILE.csv] --t-end T [--dt DT] [--output-every S]
+                        [--output DIR] [--no-plots] [--no-progress]
 
 ``statics`` prints each line's end tensions and laid length and writes ``DIR/statics.csv``
 (columns ``line,end,point,x,y,z,fx,fy,fz,tension,laid_length``, two rows per line: end A, then
@@ -105,6 +105,9 @@ def add_mooring_parser(commands: Any) -> None:
     run.add_argument("--dt", metavar="DT", type=_positive_time, default=0.02,
                      help="the step size (s; default 0.02): the implicit scheme has no "
                      "stability limit, so the step follows the accuracy wanted")
+    run.add_argument("--output-every", metavar="S", type=_positive_time, default=None,
+                     help="the interval of the stored states (s): a whole number of steps, "
+                     "as MoorDyn's dtOut (default: every step)")
     run.add_argument("--output", "-o", metavar="DIR", type=Path, default=Path("output"),
                      help="folder of the results (created if missing; default: output)")
     run.add_argument("--no-plots", action="store_true", help="do not draw the plots")
@@ -146,11 +149,16 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
 
     model = read_moordyn(args.file)
     motion = Motion.from_csv(args.motion) if args.motion is not None else None
+    if args.output_every is not None:
+        steps = round(args.output_every / args.dt)
+        if steps < 1 or abs(steps * args.dt - args.output_every) > 1e-9 * args.output_every:
+            parser.error(f"--output-every {args.output_every:g}: give a whole number of steps "
+                         f"of --dt {args.dt:g} s")
     folder = _output(args.output, parser)
-    result = run(model, motion, args.t_end, dt=args.dt, output=folder,
-                 plots=not args.no_plots, progress=not args.no_progress)
+    result = run(model, motion, args.t_end, dt=args.dt, output_every=args.output_every,
+                 output=folder, plots=not args.no_plots, progress=not args.no_progress)
     tensions = result.end_tensions
-    print(f"{args.file}: t = 0 to {result.times[-1]:g} s in {result.solution.num_steps} steps "
+    print(f"{args.file}: t = 0 to {result.times[-1]:g} s in {result.solution.steps_taken} steps "
           f"of {args.dt:g} s, {result.cpu_time:.3g} s CPU", flush=True)
     for k, row in enumerate(model.lines):
         print(f"line {row.id}: end B tension {tensions[:, k, 1].min():.6g} to "
