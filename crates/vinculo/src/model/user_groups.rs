@@ -121,6 +121,13 @@ impl System {
     /// The first failure of a user function (of a group or a law) since the last reset, as a
     /// run error.
     pub fn user_failure(&self) -> Option<Error> {
+        // Most models have no user functions: the run loop asks after every step.
+        if self.user_forces.is_empty()
+            && self.user_constraints.is_empty()
+            && self.user_laws.is_empty()
+        {
+            return None;
+        }
         self.user_forces
             .iter()
             .find_map(|g| g.failure())
