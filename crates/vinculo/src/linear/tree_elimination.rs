@@ -883,6 +883,9 @@ impl TreeElimination {
         let (s, nb) = (self.start[b], self.start[b + 1] - self.start[b]);
         let k = self.coupled_at[b + 1] - self.coupled_at[b];
         let result = match (nb, k) {
+            (3, 0) => self.eliminate(b, 3, 0),
+            (4, 0) => self.eliminate(b, 4, 0),
+            (5, 0) => self.eliminate(b, 5, 0),
             (3, 1) => self.eliminate(b, 3, 1),
             (4, 1) => self.eliminate(b, 4, 1),
             (5, 1) => self.eliminate(b, 5, 1),
