@@ -91,18 +91,6 @@
 //! three solves a step), and from 426 to 421 us with full Newton (G_b costs each factorisation
 //! about what a solve saves).
 //!
-//! # One block
-//!
-//! A matrix that is one block (a single particle and its conditions: a pendulum's bob and its
-//! link) is inverted when it is factorised, column by column from its factors, and each solve
-//! is the product with that inverse: its n^2 products are independent, where the substitutions
-//! wait on each other through the block's row interchanges and both triangles. Measured on the
-//! benchmark pendulum (1 ms, 10^4 steps, three solves a step, 0.086 factorisations): 0.241 ->
-//! 0.226 to 0.233 us a step, the same residuals and factorisations a step, and the bob's end
-//! as far from full Newton's as before (4.1e-11 m); the solution differs from the
-//! substitutions' by round-off (the block's condition times the unit round-off; the sparse LU
-//! test below asks 1e-12).
-//!
 //! A line held at both ends is such a chain but at its ends: its blocks are a node and the link
 //! to its parent, but the node next to an anchor holds the link to the anchor too (a block of
 //! 5 among blocks of 4), and an end point moved by constraints on its coordinates is a block of
@@ -205,9 +193,6 @@ pub struct TreeElimination {
     /// Whether the local order is the global one (`unknowns[i] == i`, as for a single
     /// particle and its conditions): a one-block solve then works in the right-hand side itself.
     natural_order: bool,
-    /// The inverse of a matrix that is one block (row-major), formed with each factorisation:
-    /// its solve is then a product (module documentation); empty for more blocks.
-    single_inverse: Vec<f64>,
     /// Slots of D_b (row-major), of A_ub for the ancestors u of U_b in turn (3 x n_b each,
     /// row-major) and of [A_bu for u in U_b] (n_b x 3|U_b|, row-major); a uniform chain's
     /// are periodic (`block_slots.rs`).
@@ -748,7 +733,6 @@ impl TreeElimination {
             fill_index,
             coupling_at,
             natural_order: unknowns.iter().enumerate().all(|(i, &u)| u as usize == i),
-            single_inverse: Vec::new(),
             unknowns,
             diag_slots,
             low_slots,
@@ -875,29 +859,8 @@ impl TreeElimination {
             5 => self.make_explicit::<5>(),
             _ => {}
         }
-        if self.blocks() == 1 {
-            self.invert_single_block();
-        }
         self.factored = true;
         Ok(())
-    }
-
-    /// The inverse of a matrix of one block, column by column from its factors (module
-    /// documentation, "One block").
-    fn invert_single_block(&mut self) {
-        let n = self.unknowns.len();
-        let d = &self.store.diag()[self.diag_at[0]..self.diag_at[1]];
-        self.single_inverse.resize(n * n, 0.0);
-        let mut column = [0.0f64; MAX_BLOCK];
-        for c in 0..n {
-            let column = &mut column[..n];
-            column.fill(0.0);
-            column[c] = 1.0;
-            solve_block(d, &self.perm[..n], column);
-            for (r, &x) in column.iter().enumerate() {
-                self.single_inverse[r * n + c] = x;
-            }
-        }
     }
 
     /// Gathers the storage of block b and of its coupled ancestors, where not yet gathered.
@@ -1350,22 +1313,21 @@ impl LinearSolver for TreeElimination {
 }
 
 impl TreeElimination {
-    /// The solve of a matrix that is one block: z = D^-1 r with its inverse, in place.
+    /// The solve of a matrix that is one block: D z = r with its factors, in place.
     fn solve_single_block(&mut self, rhs: &mut [f64]) {
         let n = self.unknowns.len();
-        let mut r = [0.0f64; MAX_BLOCK];
-        let r = &mut r[..n];
+        let d = &self.store.diag()[self.diag_at[0]..self.diag_at[1]];
         if self.natural_order {
-            r.copy_from_slice(&rhs[..n]);
-        } else {
-            for (r, &u) in r.iter_mut().zip(&self.unknowns) {
-                *r = rhs[u as usize];
-            }
+            solve_block(d, &self.perm[..n], &mut rhs[..n]);
+            return;
         }
-        let inverse = &self.single_inverse[..n * n];
-        for (i, row) in inverse.chunks_exact(n).enumerate() {
-            let x = row.iter().zip(r.iter()).fold(0.0, |s, (a, r)| s + a * r);
-            rhs[self.unknowns[i] as usize] = x;
+        let z = &mut self.z[..n];
+        for (z, &u) in z.iter_mut().zip(&self.unknowns) {
+            *z = rhs[u as usize];
+        }
+        solve_block(d, &self.perm[..n], z);
+        for (z, &u) in z.iter().zip(&self.unknowns) {
+            rhs[u as usize] = *z;
         }
     }
 
@@ -1664,7 +1626,7 @@ mod tests {
     /// are those of the other two chains but their ends' (the block of 5 of the node next to a
     /// second anchor, the block of 6 of an end with its three coordinates prescribed, the
     /// root), the branched string's by the general sweeps; a pendulum's one block (its bob and
-    /// link, in the global order) by the product with its inverse. The chains' slots are periodic
+    /// link, in the global order) is solved in the right-hand side itself. The chains' slots are periodic
     /// over their uniform run (`block_slots.rs`): at most six blocks keep theirs one by one.
     #[test]
     fn tree_elimination_matches_sparse_lu() {
