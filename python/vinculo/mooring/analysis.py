@@ -303,10 +303,17 @@ def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_en
     return result
 
 
+def _whole_steps(every: float, dt: float) -> int | None:
+    """The number of steps ``dt`` in the interval ``every`` (s), None unless it is a whole
+    number (to 1e-9 of ``every``) of at least one."""
+    steps = round(every / dt) if math.isfinite(every) and every > 0.0 else 0
+    return steps if steps >= 1 and abs(steps * dt - every) <= 1e-9 * every else None
+
+
 def _output_steps(every: float, dt: float) -> int:
     """The steps ``dt`` in the output interval ``every`` (s), checked to be a whole number."""
-    steps = round(every / dt) if math.isfinite(every) and every > 0.0 else 0
-    if steps < 1 or abs(steps * dt - every) > 1e-9 * every:
+    steps = _whole_steps(every, dt)
+    if steps is None:
         raise InvalidInputError(
             f"output_every = {every!r}: give a whole number of steps of {dt:g} s (the states "
             "between step ends would be interpolated, and a segment's tension from "

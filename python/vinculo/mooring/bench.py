@@ -311,14 +311,13 @@ def vinculo_run(model: MoorDynFile, motion: Motion, t_end: float, dt: float,
     Returns:
         The run (its ``cpu_time`` is that of the time integration).
     """
-    from vinculo.mooring.analysis import _output_grid, run
+    from vinculo.mooring.analysis import _output_grid, _whole_steps, run
 
     if every is None:
-        steps = round(OUTPUT_INTERVAL / dt)
-        every = steps * dt if steps >= 1 and math.isclose(steps * dt, OUTPUT_INTERVAL) else dt
-    steps = round(every / dt)
-    grid = _output_grid(t_end, dt, steps) if math.isclose(steps * dt, every) else \
-        _output_grid(t_end, every)
+        grid = _output_grid(t_end, dt, _whole_steps(OUTPUT_INTERVAL, dt) or 1)
+    else:
+        steps = _whole_steps(every, dt)
+        grid = _output_grid(t_end, dt, steps) if steps else _output_grid(t_end, every)
     return run(model, motion, t_end, dt=dt, plots=False, t_eval=grid)
 
 

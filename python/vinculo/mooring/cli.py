@@ -143,17 +143,15 @@ def _statics(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
 
 def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     """Run the mooring with the motion and write its results."""
-    from vinculo.mooring.analysis import run
+    from vinculo.mooring.analysis import _whole_steps, run
     from vinculo.mooring.moordyn_file import read_moordyn
     from vinculo.mooring.motion import Motion
 
     model = read_moordyn(args.file)
     motion = Motion.from_csv(args.motion) if args.motion is not None else None
-    if args.output_every is not None:
-        steps = round(args.output_every / args.dt)
-        if steps < 1 or abs(steps * args.dt - args.output_every) > 1e-9 * args.output_every:
-            parser.error(f"--output-every {args.output_every:g}: give a whole number of steps "
-                         f"of --dt {args.dt:g} s")
+    if args.output_every is not None and _whole_steps(args.output_every, args.dt) is None:
+        parser.error(f"--output-every {args.output_every:g}: give a whole number of steps "
+                     f"of --dt {args.dt:g} s")
     folder = _output(args.output, parser)
     result = run(model, motion, args.t_end, dt=args.dt, output_every=args.output_every,
                  output=folder, plots=not args.no_plots, progress=not args.no_progress)
