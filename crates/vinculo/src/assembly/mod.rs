@@ -503,22 +503,40 @@ impl Layout {
         }
     }
 
-    /// Whether every scaled unknown ([`Layout::scaled_unknowns`]) of `q` and `lambda` is within
-    /// `distance` of `x`; stops at the first one that is not (in a model in motion, the first).
-    pub fn unknowns_within(
+    /// The largest distance of a scaled unknown ([`Layout::scaled_unknowns`]) of `q` and
+    /// `lambda` from `x` when none is farther than `cap`, else infinity: the scan stops at the
+    /// first one beyond `cap` (in a model in motion, the first) or not a number.
+    pub fn unknowns_distance(
         &self,
         (q, lambda): (&[crate::math::Vec3], &[f64]),
         (scales, sigma): (&[f64], f64),
         x: &[f64],
-        distance: f64,
-    ) -> bool {
+        cap: f64,
+    ) -> f64 {
         let m3 = 3 * self.free;
-        x.len() == m3 + lambda.len()
-            && q.iter()
-                .zip(&self.dof)
-                .all(|(qi, &d)| d == NONE || (0..3).all(|k| (qi[k] - x[d + k]).abs() <= distance))
-            && (lambda.iter().zip(scales).zip(&x[m3..]))
-                .all(|((l, s), xk)| (l * sigma / s - xk).abs() <= distance)
+        if x.len() != m3 + lambda.len() {
+            return f64::INFINITY;
+        }
+        let mut far = 0.0f64;
+        for (qi, &d) in q.iter().zip(&self.dof) {
+            if d != NONE {
+                for k in 0..3 {
+                    let e = (qi[k] - x[d + k]).abs();
+                    if e.is_nan() || e > cap {
+                        return f64::INFINITY;
+                    }
+                    far = far.max(e);
+                }
+            }
+        }
+        for ((l, s), xk) in lambda.iter().zip(scales).zip(&x[m3..]) {
+            let e = (l * sigma / s - xk).abs();
+            if e.is_nan() || e > cap {
+                return f64::INFINITY;
+            }
+            far = far.max(e);
+        }
+        far
     }
 
     /// Applies a Newton increment `dx` (in scaled unknowns) to the positions of the free

@@ -258,11 +258,11 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
         true
     }
 
-    fn is_within(&self, x: &[f64], distance: f64) -> bool {
+    fn distance_from(&self, x: &[f64], cap: f64) -> f64 {
         let b = &*self.buffers;
         let scaling = (self.scales, self.point.sigma);
         self.layout
-            .unknowns_within((&b.q, &b.lambda), scaling, x, distance)
+            .unknowns_distance((&b.q, &b.lambda), scaling, x, cap)
     }
 }
 
