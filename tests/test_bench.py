@@ -86,6 +86,13 @@ def test_the_scaling_command_refuses_bad_sizes_naming_them(sizes, capsys):
     assert f"--sizes {sizes!r}" in capsys.readouterr().err
 
 
+def test_the_scaling_command_refuses_a_repeat_below_one(capsys):
+    with pytest.raises(SystemExit) as stop:
+        scaling.main(["--sizes", "1000", "--repeat", "0"])
+    assert stop.value.code == 2
+    assert "--repeat 0" in capsys.readouterr().err
+
+
 def test_agreement_tolerance_is_a_share_of_the_schemes_own_error():
     # The tolerance of the side-by-side table is AGREEMENT_SHARE (1/100) of the distance between
     # vinculo's answers at dt and dt/2 (the scheme's own error: 3/4 of it at dt for a second-order

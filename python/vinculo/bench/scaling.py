@@ -1,11 +1,12 @@
 """vinculo alone: seconds per step and peak memory of hanging chains of 10^3 to 10^6 particles.
 
-``python -m vinculo.bench.scaling [hanging|swinging] [--sizes 1000,10000]`` prints the table.
-Each size runs in its own process (the same command with ``--one N``) so that the peak
-resident memory (``ru_maxrss``) is that of one model: building it, the run (only the first and
-last states stored) and the returned Solution. The cost of a step is measured apart from the
+``python -m vinculo.bench.scaling [hanging|swinging] [--sizes 1000,10000] [--repeat 3]`` prints
+the table. Each size runs in its own process (the same command with ``--one N``) so that the
+peak resident memory (``ru_maxrss``) is that of one model: building it, the run (only the first
+and last states stored) and the returned Solution. The cost of a step is measured apart from the
 one-time set-up of a run (checks, consistent initial accelerations, the solver's analysis): a run
-of one step and a run of ``1 + k`` steps are timed (each in its own process), and a step costs
+of one step and a run of ``1 + k`` steps are timed (each in its own process, the least time of
+``--repeat`` such processes: one run's time varies by about 10 % here), and a step costs
 ``(T(1 + k) - T(1)) / k``; the set-up is ``T(1)`` less one step. Peak memory is that of the
 longer run.
 """
@@ -51,26 +52,31 @@ def one(n: int, hanging: bool = True, count: int = 1) -> dict[str, float | str]:
     }
 
 
-def _measure(n: int, shape: str) -> dict[str, float | str]:
-    """One size in two subprocesses (1 and 1 + k steps): per-step cost, set-up, peak memory."""
+def _measure(n: int, shape: str, repeat: int = 1) -> dict[str, float | str]:
+    """One size in subprocesses of 1 and 1 + k steps, the quickest of ``repeat`` of each:
+    per-step cost, set-up, peak memory."""
     results = []
     steps = steps_for(n)
     for count in (1, 1 + steps):
         args = [sys.executable, "-m", "vinculo.bench.scaling", shape, "--one", str(n),
                 "--steps", str(count)]
-        done = subprocess.run(args, capture_output=True, text=True, check=False)
-        if done.returncode != 0:
-            raise RuntimeError(" ".join(done.stderr.strip().splitlines()[-1:]))
-        results.append(json.loads(done.stdout.strip().splitlines()[-1]))
+        runs = []
+        for _ in range(repeat):
+            done = subprocess.run(args, capture_output=True, text=True, check=False)
+            if done.returncode != 0:
+                raise RuntimeError(" ".join(done.stderr.strip().splitlines()[-1:]))
+            runs.append(json.loads(done.stdout.strip().splitlines()[-1]))
+        results.append(min(runs, key=lambda r: r["seconds"]))
     short, long = results
     per_step = (long["seconds"] - short["seconds"]) / steps
     return {**long, "steps": steps, "seconds_per_step": per_step,
             "setup": short["seconds"] - per_step}
 
 
-def run(sizes: tuple[int, ...] = SIZES, hanging: bool = True, out=print) -> float:
-    """Runs every size in a subprocess, prints a table and returns the fitted exponent p of
-    seconds per step ~ N^p."""
+def run(sizes: tuple[int, ...] = SIZES, hanging: bool = True, out=print,
+        repeat: int = 1) -> float:
+    """Runs every size in subprocesses (the quickest of ``repeat`` of each), prints a table and
+    returns the fitted exponent p of seconds per step ~ N^p."""
     shape = "hanging" if hanging else "swinging"
     out(
         f"vinculo scaling: {shape} chains, 0.1 m links, 0.1 kg, dt = 1e-3 "
@@ -83,7 +89,7 @@ def run(sizes: tuple[int, ...] = SIZES, hanging: bool = True, out=print) -> floa
     points = []
     for n in sizes:
         try:
-            r = _measure(n, shape)
+            r = _measure(n, shape, repeat)
         except RuntimeError as error:
             out(f"{n:>9} failed: {error}")
             continue
@@ -116,6 +122,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="chains hanging at rest (default) or released swinging")
     parser.add_argument("--sizes", default=",".join(str(n) for n in SIZES),
                         help="comma-separated numbers of particles (default %(default)s)")
+    parser.add_argument("--repeat", type=int, default=1, metavar="R",
+                        help="time each size's runs R times and keep the quickest "
+                             "(default %(default)s)")
     # One size in this process, the table's subprocesses: its figures as JSON.
     parser.add_argument("--one", type=int, metavar="N", help=argparse.SUPPRESS)
     parser.add_argument("--steps", type=int, metavar="K", help=argparse.SUPPRESS)
@@ -126,12 +135,14 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--sizes {args.sizes!r}: give comma-separated whole numbers")
     if not sizes or min(sizes) < 1:
         parser.error(f"--sizes {args.sizes!r}: give numbers of particles >= 1")
+    if args.repeat < 1:
+        parser.error(f"--repeat {args.repeat}: give a number of runs >= 1")
     hanging = args.shape == "hanging"
     if args.one is not None:
         count = args.steps if args.steps is not None else 1 + steps_for(args.one)
         print(json.dumps(one(args.one, hanging, count)))
     else:
-        run(sizes, hanging=hanging)
+        run(sizes, hanging=hanging, repeat=args.repeat)
     return 0
 
 
