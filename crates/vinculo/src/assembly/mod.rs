@@ -518,23 +518,21 @@ impl Layout {
             return f64::INFINITY;
         }
         let mut far = 0.0f64;
+        // Takes in one unknown's distance; false when it is beyond `cap` or not a number
+        // (`e <= cap` is false for NaN), which ends the scan.
+        let mut within = |e: f64| {
+            far = far.max(e);
+            e <= cap
+        };
         for (qi, &d) in q.iter().zip(&self.dof) {
-            if d != NONE {
-                for k in 0..3 {
-                    let e = (qi[k] - x[d + k]).abs();
-                    if e.is_nan() || e > cap {
-                        return f64::INFINITY;
-                    }
-                    far = far.max(e);
-                }
+            if d != NONE && !(0..3).all(|k| within((qi[k] - x[d + k]).abs())) {
+                return f64::INFINITY;
             }
         }
         for ((l, s), xk) in lambda.iter().zip(scales).zip(&x[m3..]) {
-            let e = (l * sigma / s - xk).abs();
-            if e.is_nan() || e > cap {
+            if !within((l * sigma / s - xk).abs()) {
                 return f64::INFINITY;
             }
-            far = far.max(e);
         }
         far
     }
