@@ -563,10 +563,7 @@ pub struct Simulation<'a> {
     /// The growth guard of index-3 generalised-alpha (`integrators/energy_guard.rs`).
     guard: Option<EnergyGuard>,
     /// The forces that can switch within a step (contact events, module documentation).
-    event_forces: Vec<usize>,
-    /// For each of `event_forces`: the particle and the height across which it switches (a
-    /// seabed contact's node and the seabed), for a quick look before its switch time.
-    event_heights: Vec<(usize, f64)>,
+    event_forces: Vec<EventForce>,
     /// A law that was not finite at the end of a failed attempt of the current step (a square
     /// root of a negative value): the cause to report if the step finally fails.
     law_trouble: Option<Error>,
@@ -728,9 +725,16 @@ impl<'a> Simulation<'a> {
             }
         }
         // The forces that can switch within a step (contact events, module documentation).
-        let event_forces: Vec<usize> = (system.forces().iter().enumerate())
+        let event_forces: Vec<EventForce> = (system.forces().iter().enumerate())
             .filter(|(_, f)| f.has_events())
-            .map(|(k, _)| k)
+            .map(|(force, f)| {
+                let (particle, height) = f.switch_height().expect("a force with events");
+                EventForce {
+                    force,
+                    particle,
+                    height,
+                }
+            })
             .collect();
         let controller = match options.step_control {
             StepControl::Fixed => {
@@ -825,14 +829,6 @@ impl<'a> Simulation<'a> {
             scratch,
             sol,
             guard,
-            event_heights: event_forces
-                .iter()
-                .map(|&f| {
-                    system.forces()[f]
-                        .switch_height()
-                        .expect("a force with events")
-                })
-                .collect(),
             event_forces,
             law_trouble: None,
             fingerprint: fingerprint(system),
@@ -1212,13 +1208,7 @@ impl Simulation<'_> {
             // seabed of 1,000 segments at 5 ms, 3.10 -> 2.91 s, the same error.
             if events && !fresh_retry {
                 let start = (&c.q[..], &c.v[..], &c.acc[..]);
-                let switch = first_event(
-                    system,
-                    (&self.event_forces[..], &self.event_heights[..]),
-                    start,
-                    &ws.state.q,
-                    h_try,
-                );
+                let switch = first_event(system, &self.event_forces, start, &ws.state.q, h_try);
                 if let (Some(at), Controller::Fixed(fixed)) =
                     (inside_step(switch, c.t, h_try), &mut c.controller)
                 {
@@ -1247,15 +1237,7 @@ impl Simulation<'_> {
                     self.law_trouble = None;
                     let start = (&c.q[..], &c.v[..], &c.acc[..]);
                     let switch = events
-                        .then(|| {
-                            first_event(
-                                system,
-                                (&self.event_forces[..], &self.event_heights[..]),
-                                start,
-                                &ws.state.q,
-                                h_try,
-                            )
-                        })
+                        .then(|| first_event(system, &self.event_forces, start, &ws.state.q, h_try))
                         .flatten();
                     let event = inside_step(switch, c.t, h_try);
                     // A step accepted across a jump (within EVENT_MARGIN of an end) or onto one
@@ -1319,13 +1301,8 @@ impl Simulation<'_> {
                         let mut predicted = vec![[0.0; 3]; c.q.len()];
                         let start = (&c.q[..], &c.v[..], &c.acc[..]);
                         extrapolate(start, h_try, &mut predicted);
-                        let found = first_event(
-                            system,
-                            (&self.event_forces[..], &self.event_heights[..]),
-                            start,
-                            &predicted,
-                            h_try,
-                        );
+                        let found =
+                            first_event(system, &self.event_forces, start, &predicted, h_try);
                         let switch = inside_step(found, c.t, h_try);
                         if let (Some((s, f)), Controller::Fixed(fixed)) =
                             (switch, &mut c.controller)
@@ -1645,12 +1622,22 @@ fn inside_step(found: Option<(f64, usize)>, t: f64, h: f64) -> Option<(f64, usiz
         .filter(|&(s, _)| unresolved_step(t, s).is_none())
 }
 
+/// A force that can switch within a step ([`crate::forces::Force::has_events`]): its index,
+/// and the particle and the height across which it switches (a seabed contact's node and the
+/// seabed, [`crate::forces::Force::switch_height`]), for a quick look before its switch time.
+#[derive(Debug, Clone, Copy)]
+struct EventForce {
+    force: usize,
+    particle: usize,
+    height: f64,
+}
+
 /// The earliest time after the start of a step of size `h` from `start` (positions,
 /// velocities, accelerations) to the positions `q1` at which one of the forces `event_forces` of
-/// `system` (those that can switch, [`crate::forces::Force::has_events`]) jumps, if any.
+/// `system` jumps, if any.
 fn first_event(
     system: &System,
-    (event_forces, heights): (&[usize], &[(usize, f64)]),
+    event_forces: &[EventForce],
     start: (&[Vec3], &[Vec3], &[Vec3]),
     q1: &[Vec3],
     h: f64,
@@ -1659,11 +1646,17 @@ fn first_event(
     let q0 = start.0;
     event_forces
         .iter()
-        .zip(heights)
         // A force whose particle stays on one side of its height does not switch (the test
         // [`crate::forces::Force::switch_time`] makes first), looked at here without it.
-        .filter(|&(_, &(i, z))| ((z - q0[i][2]) > 0.0) != ((z - q1[i][2]) > 0.0))
-        .filter_map(|(&f, _)| forces[f].switch_time(start, q1, h).map(|s| (s, f)))
+        .filter(|e| {
+            let (i, z) = (e.particle, e.height);
+            ((z - q0[i][2]) > 0.0) != ((z - q1[i][2]) > 0.0)
+        })
+        .filter_map(|e| {
+            forces[e.force]
+                .switch_time(start, q1, h)
+                .map(|s| (s, e.force))
+        })
         .reduce(|a, b| if b.0 < a.0 { b } else { a })
 }
 
