@@ -63,10 +63,19 @@ def test_last_step_is_shortened_to_reach_t_end():
     assert solution.step_sizes[-1] == pytest.approx(0.005, rel=1e-9)
 
 
-def test_arrays_are_read_only(chain_run):
+ARRAYS = (
+    "times positions velocities multipliers constraint_residual velocity_violation "
+    "newton_iterations step_sizes residual_norms increment_norms accepted_step_sizes"
+).split()
+
+
+@pytest.mark.parametrize("name", ARRAYS)
+def test_arrays_are_read_only(chain_run, name):
     _, solution = chain_run
+    array = getattr(solution, name)
+    assert not array.flags.writeable
     with pytest.raises(ValueError):
-        solution.positions[0, 0, 0] = 1.0
+        array[(0,) * array.ndim] = 1
 
 
 def test_energies_match_their_definitions(chain_run):

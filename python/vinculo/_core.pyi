@@ -942,9 +942,9 @@ class RunSettings:
 
 class RunResult:
     """A run as the compiled core returns it (``simulate``, ``Simulation.solution``): the stored
-    states and the statistics as typed read-only attributes (each array a fresh numpy copy), and
-    the error that stopped the run early as the exception that reports it. ``vinculo.Solution``
-    is built from it (``Solution.from_core``).
+    states and the statistics as typed read-only attributes (each array a fresh numpy copy,
+    read-only), and the error that stopped the run early as the exception that reports it.
+    ``vinculo.Solution`` is built from it (``Solution.from_core``).
 
     Row 0 is the initial state (0 iterations, step 0, multipliers from the consistent initial
     accelerations); row k > 0 holds the multipliers of the step that ends at ``times[k]``, which

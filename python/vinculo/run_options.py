@@ -100,14 +100,15 @@ class RunOptions:
             step's state. Default: the state after every accepted step (every
             ``save_every``-th).
         max_output_bytes: the largest memory the stored output may take, in bytes (default:
-            a third of the memory available when the run starts, ``MemAvailable`` of
-            ``/proc/meminfo``, since the arrays grow by doubling and are copied once when
-            returned; no limit where it cannot be read). A run whose output would be larger
-            (about ``(t_end - t_start) / dt / save_every`` states, or ``len(t_eval)``, of
-            56 + 48 n + 8 m bytes each for n particles and m constraint equations, and 8 bytes
-            per step) is refused before it starts with :class:`OutputTooLargeError`; an
-            error-controlled run, whose number of steps is known only as it goes, stops with
-            that error when its output reaches the limit (``solution`` keeps what it stored).
+            a third of the memory available, ``MemAvailable`` of ``/proc/meminfo``, since the
+            arrays grow by doubling and are copied once when returned; no limit where it cannot
+            be read; an output of at most 16 MiB is not checked against it). A run whose output
+            would be larger (about ``(t_end - t_start) / dt / save_every`` states, or
+            ``len(t_eval)``, of 56 + 48 n + 8 m bytes each for n particles and m constraint
+            equations, and 8 bytes per step) is refused before it starts with
+            :class:`OutputTooLargeError`; an error-controlled run, whose number of steps is known
+            only as it goes, stops with that error when its output reaches the limit
+            (``solution`` keeps what it stored).
         linear_solver: how the Newton iteration matrix is factorised. 'auto' (default): the
             block elimination along the particle graph's tree (linear cost: chains, branched
             strings, lines with bending stiffness, whose couplings join a particle and its
@@ -151,7 +152,7 @@ class RunOptions:
             TypeError: a keyword that is not an option (as for any unknown keyword argument); the
                 message lists the options.
         """
-        known = [field.name for field in fields(cls)]
+        known = _NAMES
         unknown = [name for name in options if name not in known]
         if unknown:
             raise TypeError(
@@ -223,8 +224,13 @@ class RunOptions:
                     value=self.t_eval,
                 )
             times = [float(x) for x in array]
-        options = {field.name: getattr(self, field.name) for field in fields(self)}
+        options = {name: getattr(self, name) for name in _NAMES}
         options.update(
             jacobian_reuse=self._jacobian_reuse(), adaptive=bool(self.adaptive), t_eval=times
         )
         return _core.RunSettings(t_end, dt, alpha, **options)
+
+
+#: The options' names, in their order (read once: ``dataclasses.fields`` takes microseconds a
+#: call, which every run would pay twice).
+_NAMES = tuple(field.name for field in fields(RunOptions))

@@ -131,19 +131,15 @@ class Solution:
         """Build a solution from the run returned by ``vinculo._core.simulate``.
 
         Arguments:
-            result: the core's ``RunResult`` (its arrays are fresh copies, made read-only here).
+            result: the core's ``RunResult`` (its arrays are fresh read-only copies).
             system: the system that was simulated.
 
         Returns:
             The solution; for a run that stopped early, :attr:`error` describes the exception of
             ``result.error``.
         """
-        arrays = {
-            name: _read_only(
-                getattr(result, name), np.int64 if name == "newton_iterations" else np.float64
-            )
-            for name in _ARRAY_FIELDS
-        }
+        # The core's arrays are fresh copies, read-only and of the dtypes of the fields.
+        arrays = {name: getattr(result, name) for name in _ARRAY_FIELDS}
         return cls(
             **arrays,
             error=_description(result.error),
@@ -154,7 +150,7 @@ class Solution:
             scheme=result.scheme,
             steps_taken=result.steps_taken,
             steps_rejected=result.steps_rejected,
-            accepted_step_sizes=_read_only(result.accepted_step_sizes, np.float64),
+            accepted_step_sizes=result.accepted_step_sizes,
             formulation=result.formulation,
         )
 

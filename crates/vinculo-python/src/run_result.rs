@@ -4,9 +4,19 @@
 
 use crate::errors::{exception, with_solution};
 use crate::user_physics::PendingError;
+use numpy::ndarray::Dimension;
 use numpy::ndarray::{Array1, Array2, Array3};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
+use numpy::{Element, IntoPyArray, PyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
+
+/// `array` (fresh, shared with nobody) made read-only: a run's stored arrays are its record,
+/// not to be edited in place (`vinculo.Solution` hands them out as they are).
+fn read_only<'py, T: Element, D: Dimension>(
+    array: Bound<'py, PyArray<T, D>>,
+) -> Bound<'py, PyArray<T, D>> {
+    let frozen = array.readwrite().make_nonwriteable();
+    (*frozen).clone()
+}
 
 /// The stored states of a run, its statistics, and the exception of the error that stopped it.
 #[pyclass(name = "RunResult", module = "vinculo._core", frozen)]
@@ -72,15 +82,17 @@ impl PyRunResult {
         py: Python<'py>,
         f: impl Fn(&vinculo::StepStats) -> T,
     ) -> Bound<'py, PyArray1<T>> {
-        Array1::from_iter(self.solution.stats.iter().map(f)).into_pyarray(py)
+        read_only(Array1::from_iter(self.solution.stats.iter().map(f)).into_pyarray(py))
     }
 
     /// A per-state array of (particles, 3) rows.
     fn states<'py>(&self, py: Python<'py>, flat: &[f64]) -> Bound<'py, PyArray3<f64>> {
         let shape = (self.solution.len(), self.solution.particles, 3);
-        Array3::from_shape_vec(shape, flat.to_vec())
-            .expect("the core stores 3 coordinates per particle and state")
-            .into_pyarray(py)
+        read_only(
+            Array3::from_shape_vec(shape, flat.to_vec())
+                .expect("the core stores 3 coordinates per particle and state")
+                .into_pyarray(py),
+        )
     }
 }
 
@@ -89,7 +101,7 @@ impl PyRunResult {
     /// Stored times, shape (s,), in s.
     #[getter]
     fn times<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_slice(py, &self.solution.times)
+        read_only(PyArray1::from_slice(py, &self.solution.times))
     }
 
     /// Positions, shape (s, n, 3), in m.
@@ -108,21 +120,23 @@ impl PyRunResult {
     #[getter]
     fn multipliers<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         let shape = (self.solution.len(), self.solution.constraints);
-        Array2::from_shape_vec(shape, self.solution.multipliers.clone())
-            .expect("the core stores one multiplier per constraint equation and state")
-            .into_pyarray(py)
+        read_only(
+            Array2::from_shape_vec(shape, self.solution.multipliers.clone())
+                .expect("the core stores one multiplier per constraint equation and state")
+                .into_pyarray(py),
+        )
     }
 
     /// max_k |s_k Phi_k| at each stored time, shape (s,), in m.
     #[getter]
     fn constraint_residual<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_slice(py, &self.solution.constraint_residual)
+        read_only(PyArray1::from_slice(py, &self.solution.constraint_residual))
     }
 
     /// max_k |s_k (Phi_q v + Phi_t)| at each stored time, shape (s,), in m/s.
     #[getter]
     fn velocity_violation<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_slice(py, &self.solution.velocity_violation)
+        read_only(PyArray1::from_slice(py, &self.solution.velocity_violation))
     }
 
     /// Newton iterations of each stored step, shape (s,).
@@ -152,7 +166,7 @@ impl PyRunResult {
     /// Size of every accepted step, stored or not, in s.
     #[getter]
     fn accepted_step_sizes<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_slice(py, &self.solution.accepted_step_sizes)
+        read_only(PyArray1::from_slice(py, &self.solution.accepted_step_sizes))
     }
 
     /// Steps attempted, including those rejected and retried.

@@ -559,7 +559,7 @@ pub struct Simulation<'a> {
     fingerprint: u64,
     run: u64,
     /// The largest stored output allowed (None: no limit known; `output_size.rs`).
-    output_limit: Option<OutputLimit>,
+    output_limit: OutputLimit,
     /// The growth guard of index-3 generalised-alpha (`integrators/energy_guard.rs`).
     guard: Option<EnergyGuard>,
     /// The forces that can switch within a step (contact events, module documentation).
@@ -597,11 +597,8 @@ impl<'a> Simulation<'a> {
             }
         }
         // A run whose stored output would not fit in memory is refused before it starts.
-        let output_limit = OutputLimit::of(options)?;
-        if let Some(e) = output_limit
-            .as_ref()
-            .and_then(|l| l.refused(system, options))
-        {
+        let mut output_limit = OutputLimit::of(options)?;
+        if let Some(e) = output_limit.refused(system, options) {
             return Err(e);
         }
         // User groups start the run with empty caches and counters.
@@ -1566,12 +1563,11 @@ impl Simulation<'_> {
         }
         // A run whose number of steps could not be told beforehand stops when its output
         // reaches the memory allowed, keeping what it stored.
-        if let Some(limit) = &self.output_limit {
-            let (states, steps) = (sol.len() as f64, sol.accepted_step_sizes.len() as f64);
-            if let Some(e) = limit.exceeded(system, &self.options, states, steps, Some(c.t)) {
-                sol.status = Err(e);
-                return Next::Stop;
-            }
+        let (states, steps) = (sol.len() as f64, sol.accepted_step_sizes.len() as f64);
+        let limit = &mut self.output_limit;
+        if let Some(e) = limit.exceeded(system, &self.options, states, steps, Some(c.t)) {
+            sol.status = Err(e);
+            return Next::Stop;
         }
         if !observer.step(c.t, self.options.t_end) {
             // The state where the run stopped is kept, stored or not by `save_every`.
