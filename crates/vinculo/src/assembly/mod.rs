@@ -548,17 +548,17 @@ impl Layout {
         scales: &[f64],
         sigma: f64,
     ) {
-        for (i, qi) in q.iter_mut().enumerate() {
-            let d = self.dof[i];
+        for (qi, &d) in q.iter_mut().zip(&self.dof) {
             if d != NONE {
+                let step: &[f64; 3] = dx[d..d + 3].try_into().expect("3 unknowns a particle");
                 for k in 0..3 {
-                    qi[k] -= dx[d + k];
+                    qi[k] -= step[k];
                 }
             }
         }
         let m3 = 3 * self.free;
-        for (c, l) in lambda.iter_mut().enumerate() {
-            *l -= dx[m3 + c] * scales[c] / sigma;
+        for ((l, &step), &s) in lambda.iter_mut().zip(&dx[m3..]).zip(scales) {
+            *l -= step * s / sigma;
         }
     }
 }

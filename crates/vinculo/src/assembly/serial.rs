@@ -17,6 +17,7 @@ impl Layout {
     /// s_k Phi_k(q_end, t_end) written (a compliant constraint's row is
     /// s_k (w Phi_k(q_end, t_end) + (1 - w) Phi_k(q_n, t_n) + c_k lambda_k) instead, see
     /// [`ResidualTerms::row`]).
+    #[inline(always)]
     pub fn residual(
         &self,
         system: &System,
