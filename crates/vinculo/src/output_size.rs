@@ -70,29 +70,35 @@ impl OutputLimit {
         }
     }
 
-    /// The limit (bytes) for an output of `bytes`, and where that figure comes from (None: the
-    /// output is not checked, or no limit is known).
-    fn limit_for(&mut self, bytes: f64) -> Option<(f64, String)> {
+    /// The limit (bytes) for an output of `bytes` (None: the output is not checked, or no limit
+    /// is known).
+    #[inline]
+    fn limit_for(&mut self, bytes: f64) -> Option<f64> {
         match self {
-            OutputLimit::Given(limit) => Some((*limit, "max_output_bytes".into())),
+            OutputLimit::Given(limit) => Some(*limit),
             OutputLimit::Memory(_) if bytes <= UNCHECKED_BYTES => None,
             OutputLimit::Memory(read) => {
                 let available = (*read.get_or_insert_with(memory_available))?;
-                Some((
-                    available / 3.0,
-                    format!(
-                        "a third of the {:.3} GB of memory available, MemAvailable of \
-                         /proc/meminfo; the arrays grow by doubling and are copied once when \
-                         returned",
-                        available / 1e9
-                    ),
-                ))
+                Some(available / 3.0)
             }
+        }
+    }
+
+    /// Where the limit comes from, for the error's message.
+    fn source(&self) -> String {
+        match self {
+            OutputLimit::Given(_) => "max_output_bytes".into(),
+            OutputLimit::Memory(read) => format!(
+                "a third of the {:.3} GB of memory available, MemAvailable of /proc/meminfo; the \
+                 arrays grow by doubling and are copied once when returned",
+                read.flatten().unwrap_or(f64::NAN) / 1e9
+            ),
         }
     }
 
     /// The error of an output of `states` stored states and `steps` step sizes that exceeds the
     /// limit (None: it fits); `t`: where the run stopped (None: before it started).
+    #[inline]
     pub(crate) fn exceeded(
         &mut self,
         system: &System,
@@ -103,15 +109,15 @@ impl OutputLimit {
     ) -> Option<Error> {
         let per_state = state_bytes(system.particles().len(), system.constraints().len());
         let bytes = states * per_state as f64 + steps * STEP_BYTES;
-        let (limit, limit_source) = self.limit_for(bytes)?;
-        (bytes > limit).then_some(Error::OutputTooLarge {
+        let limit = self.limit_for(bytes)?;
+        (bytes > limit).then(|| Error::OutputTooLarge {
             t,
             states,
             state_bytes: per_state,
             steps,
             bytes,
             limit,
-            limit_source,
+            limit_source: self.source(),
             save_every: o.save_every,
         })
     }
@@ -151,8 +157,8 @@ mod tests {
             panic!("not read: {limit:?}");
         };
         // Where /proc/meminfo can be read, the limit is a third of what it says.
-        assert_eq!(read.map(|(bytes, _)| bytes), available.map(|a| a / 3.0));
+        assert_eq!(read, available.map(|a| a / 3.0));
         let mut given = OutputLimit::Given(10.0);
-        assert_eq!(given.limit_for(1.0).map(|(bytes, _)| bytes), Some(10.0));
+        assert_eq!(given.limit_for(1.0), Some(10.0));
     }
 }

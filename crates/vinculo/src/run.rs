@@ -1678,12 +1678,17 @@ impl Observer for Silent {
 }
 
 /// The first tension-only constraint whose tension is below `floor` (N), as an error.
+#[inline]
 pub(crate) fn negative_tension(
     system: &System,
     lambda: &[f64],
     t: f64,
     floor: f64,
 ) -> Option<Error> {
+    // Asked after every step: a model without strings answers here, inlined in the run loop.
+    if system.tension_only().is_empty() {
+        return None;
+    }
     system.tension_only().iter().find_map(|&c| {
         let tension = system.tension(c, lambda[c])?;
         (tension < floor).then(|| Error::NegativeTension {

@@ -120,14 +120,21 @@ impl System {
 
     /// The first failure of a user function (of a group or a law) since the last reset, as a
     /// run error.
+    #[inline]
     pub fn user_failure(&self) -> Option<Error> {
-        // Most models have no user functions: the run loop asks after every step.
+        // Most models have no user functions: the run loop asks after every step, and the
+        // answer for them is this test, inlined there.
         if self.user_forces.is_empty()
             && self.user_constraints.is_empty()
             && self.user_laws.is_empty()
         {
             return None;
         }
+        self.user_group_failure()
+    }
+
+    /// [`System::user_failure`] of a model with user functions.
+    fn user_group_failure(&self) -> Option<Error> {
         self.user_forces
             .iter()
             .find_map(|g| g.failure())
