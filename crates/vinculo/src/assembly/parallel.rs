@@ -418,7 +418,7 @@ impl ParallelAssembly {
                 let mut i = 0;
                 for f in &forces[first..(first + MIN_TASK).min(forces.len())] {
                     f.with_force(at.q_eval, at.v_eval, at.t_eval, |fl| {
-                        out[i..i + fl.len()].copy_from_slice(fl);
+                        copy_rows(&mut out[i..i + fl.len()], fl);
                         i += fl.len();
                     });
                 }
@@ -432,7 +432,7 @@ impl ParallelAssembly {
                 for (c, r) in (first..).zip(rows.iter_mut()) {
                     let con = &constraints[c];
                     con.with_gradient(at.q_eval, at.t_eval, |grad| {
-                        out[i..i + grad.len()].copy_from_slice(grad);
+                        copy_rows(&mut out[i..i + grad.len()], grad);
                         i += grad.len();
                     });
                     *r = at.scales[c] * at.row(con, c, con.residual(at.q_end, at.t_end));
@@ -445,7 +445,8 @@ impl ParallelAssembly {
             .zip(this.free.par_iter())
             .with_min_len(MIN_TASK)
             .for_each(|(out, &i)| {
-                out.copy_from_slice(&row.rows(i));
+                let out: &mut [f64; 3] = out.try_into().expect("3 rows a particle");
+                *out = row.rows(i);
                 for &[_, e] in &this.force_incidence[this.force_start[i]..this.force_start[i + 1]] {
                     let fl = &this.forces[e as usize];
                     for k in 0..3 {
@@ -533,4 +534,15 @@ fn split_by_elements<'a>(
         values = rest;
     }
     pieces
+}
+
+/// Copies an element's local rows into `out` (of the same length) one 3-vector at a time: a
+/// `copy_from_slice` of a length known only at run time calls the C library's `memmove`: with
+/// it, those calls (and the one for each particle's three inertia rows) took 4.9 % of a step of
+/// the swinging chain of 10^6 particles (perf), 0.284 s a step against 0.271 s without.
+#[inline(always)]
+fn copy_rows(out: &mut [Vec3], rows: &[Vec3]) {
+    for (o, r) in out.iter_mut().zip(rows) {
+        *o = *r;
+    }
 }
