@@ -49,7 +49,7 @@ class RunOptions:
             that the floating-point times cannot resolve (fewer than 50 spacings of t) stops
             the run with a ``StepSizeTooSmallError`` instead. A model with seabed contact has
             four more: its fixed steps go to each touchdown and lift-off of a node and through
-            the transient it starts at dt / 16 (docs/theory/seabed-and-line-loads.md, contact
+            the transient it starts from dt / 16 (docs/theory/seabed-and-line-loads.md, contact
             events).
         initial_tolerance: largest initial violation accepted, relative to the model's scales:
             ``|s_k Phi_k| <= initial_tolerance * length_scale`` for positions and

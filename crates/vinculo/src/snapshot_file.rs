@@ -1,6 +1,6 @@
 //! Snapshot files: a [`Snapshot`] saved to and loaded from a small binary file.
 //!
-//! # Format (version 9)
+//! # Format (version 10)
 //!
 //! Little-endian throughout; every float is stored as its IEEE-754 bits, so a loaded snapshot
 //! is bit for bit the saved one.
@@ -8,7 +8,7 @@
 //! | field | type |
 //! |---|---|
 //! | magic `VNCLSNAP` | 8 bytes |
-//! | version (9) | u32 |
+//! | version (10) | u32 |
 //! | model fingerprint ([`crate::run::fingerprint`]), particles n, constraint equations m | 3 x u64 |
 //! | time | f64 |
 //! | positions, velocities, accelerations, their rates over the last step (the predictor's, `run.rs`) | 4 x (n x 3 f64) |
@@ -22,8 +22,9 @@
 //! | checksum: FNV-1a 64 of every byte before it | u64 |
 //!
 //! Fixed steps (tag 0): top u32, unit f64, units u64, level u32, t_grid f64, and the contact
-//! events' state (`run.rs`): the pending event's time (NaN: none) and the end of the short
-//! steps after the last event (-inf: none), 2 x f64; then the run's own grid: its origin f64,
+//! events' state (`run.rs`): the pending event's time (NaN: none), the end of the short
+//! steps after the last event (-inf: none) and that event's settling time (0: none), 3 x f64;
+//! then the run's own grid: its origin f64,
 //! whether the grid is it (u8), and the point of it the run is going back to, time (NaN:
 //! none) and units, f64 and u64.
 //!
@@ -37,7 +38,9 @@
 //! | PI controller: order k, last error norm, last attempt rejected (0 or 1), hold | f64, f64, u8, f64 |
 //! | next step size h, error norm of the last judged step | 2 x f64 |
 //!
-//! Version 8 is version 9 without the rates over the step before (read as none: the predictor
+//! Version 9 is version 10 without the last contact event's settling time (read as 0: the
+//! steps of a transient in progress stay at their shortest until it ends). Version 8 is version
+//! 9 without the rates over the step before (read as none: the predictor
 //! extrapolates with the last rates until it has both). Version 7 is version 8 without the
 //! accelerations' rates (read as zero: the first step after
 //! restoring it predicts at constant acceleration). Version 6 is version 7 without the
@@ -62,7 +65,7 @@ use crate::run::{Carried, Controller, FixedSteps, Fnv, HeldMatrix, Snapshot};
 use crate::step_control::{AdaptiveOptions, ErrorWeights, PiController};
 
 const MAGIC: &[u8; 8] = b"VNCLSNAP";
-const VERSION: u32 = 9;
+const VERSION: u32 = 10;
 /// The oldest format version still read.
 const OLDEST: u32 = 1;
 
@@ -304,6 +307,7 @@ impl Snapshot {
                 w.f64(fixed.t_grid);
                 w.f64(fixed.event_stop.unwrap_or(f64::NAN));
                 w.f64(fixed.settle_until);
+                w.f64(fixed.settle_time);
                 w.f64(fixed.origin);
                 w.0.push(fixed.home as u8);
                 let (at, units) = fixed.rejoin.unwrap_or((f64::NAN, 0));
@@ -425,6 +429,7 @@ impl Snapshot {
                 } else {
                     (None, f64::NEG_INFINITY)
                 };
+                let settle_time = if version >= 10 { r.f64()? } else { 0.0 };
                 let (origin, home, rejoin) = if version >= 6 {
                     let (origin, home) = (r.f64()?, r.take(1)?[0] == 1);
                     let (at, units) = (r.f64()?, r.u64()?);
@@ -440,6 +445,7 @@ impl Snapshot {
                     t_grid,
                     event_stop,
                     settle_until,
+                    settle_time,
                     origin,
                     home,
                     rejoin,

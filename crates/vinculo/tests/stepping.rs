@@ -299,7 +299,8 @@ fn with_checksum(mut body: Vec<u8>) -> Vec<u8> {
 /// (saved again, the version 6 file with zero rates and no matrix held), and so is one written
 /// as version 5 (without the rates and the run's own grid), 6 (without the residual
 /// evaluations), 7 (without the accelerations' rates, read as zero: saved again, the
-/// version 9 file with zero rates) or 8 (without the rates over the step before, read as none).
+/// version 10 file with zero rates), 8 (without the rates over the step before, read as none)
+/// or 9 (without the last contact event's settling time, read as none).
 #[test]
 fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     let system = chain();
@@ -315,7 +316,7 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     run.step_to(0.05).clone().unwrap();
     run.snapshot().save(&path).unwrap();
     let good = std::fs::read(&path).unwrap();
-    assert_eq!(&good[8..12], &9u32.to_le_bytes());
+    assert_eq!(&good[8..12], &10u32.to_le_bytes());
     let n = system.particles().len();
     // Version 8 keeps the accelerations' rates and their step after the accelerations, version
     // 9 then the rates over the step before, their step and the predictor's choice (a byte);
@@ -402,7 +403,32 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     fixed.step_to(0.05).clone().unwrap();
     let v2 = dir.join("fixed.snap");
     fixed.snapshot().save(&v2).unwrap();
-    let v2_bytes = std::fs::read(&v2).unwrap();
+    // Version 10 keeps the last contact event's settling time (0: none) after the fixed
+    // steps' two numbers of the contact events' state; the files below are written from
+    // version 9's layout (this file less it), and what is saved again is compared with version
+    // 9's bytes given it back (`v10`).
+    let v10_bytes = std::fs::read(&v2).unwrap();
+    let settle_at = tag_at + (before_end - acc_rates_at) + 1 + 32 + 16;
+    assert_eq!(v10_bytes[settle_at - 49], 0, "the step controller's tag");
+    assert_eq!(&v10_bytes[settle_at..settle_at + 8], &0f64.to_le_bytes());
+    let v10 = |v9: Vec<u8>| {
+        let mut b = [
+            &v9[..settle_at],
+            &[0u8; 8][..],
+            &v9[settle_at..v9.len() - 8],
+        ]
+        .concat();
+        b[8..12].copy_from_slice(&10u32.to_le_bytes());
+        with_checksum(b)
+    };
+    let mut v9_body = [
+        &v10_bytes[..settle_at],
+        &v10_bytes[settle_at + 8..v10_bytes.len() - 8],
+    ]
+    .concat();
+    v9_body[8..12].copy_from_slice(&9u32.to_le_bytes());
+    let v2_bytes = with_checksum(v9_body);
+    assert_eq!(v10(v2_bytes.clone()), v10_bytes);
     assert!(
         v2_bytes[acc_rates_at..acc_rates_at + 24 * n]
             .iter()
@@ -447,7 +473,7 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
         &[0u8][..],
     ]
     .concat());
-    assert_eq!(std::fs::read(&again).unwrap(), without_matrix);
+    assert_eq!(std::fs::read(&again).unwrap(), v10(without_matrix));
     // A version 5 file: without the rates, the run's own grid (read as the current one) and
     // the residual evaluations (read as zero).
     let mut v5_body = [
@@ -469,7 +495,7 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
         &body[counts_end..],
     ]
     .concat());
-    assert_eq!(std::fs::read(&again).unwrap(), zeroed);
+    assert_eq!(std::fs::read(&again).unwrap(), v10(zeroed));
     // A version 6 file: without the residual evaluations.
     let mut v6_body = [&body[..counts_end - 8], &body[counts_end..]].concat();
     v6_body[8..12].copy_from_slice(&6u32.to_le_bytes());
@@ -478,7 +504,7 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
     let restored = vinculo::Snapshot::load(&v6).unwrap();
     restored.save(&again).unwrap();
     let counted_zero = v9([&body[..counts_end - 8], &[0u8; 8][..], &body[counts_end..]].concat());
-    assert_eq!(std::fs::read(&again).unwrap(), counted_zero);
+    assert_eq!(std::fs::read(&again).unwrap(), v10(counted_zero));
     // A version 7 file: without the accelerations' rates.
     let v7_path = dir.join("fixed-v7.snap");
     std::fs::write(&v7_path, with_checksum(body.to_vec())).unwrap();
@@ -486,7 +512,7 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
         .unwrap()
         .save(&again)
         .unwrap();
-    assert_eq!(std::fs::read(&again).unwrap(), v9(body.to_vec()));
+    assert_eq!(std::fs::read(&again).unwrap(), v10(v9(body.to_vec())));
     // A version 8 file: without the rates over the step before (the chain's run had them).
     assert!(
         v2_bytes[before_at..before_end - 1].iter().any(|&b| b != 0),
@@ -509,7 +535,15 @@ fn damaged_adaptive_snapshot_files_are_refused_and_version_1_is_read() {
         ]
         .concat(),
     );
-    assert_eq!(std::fs::read(&again).unwrap(), none_before);
+    assert_eq!(std::fs::read(&again).unwrap(), v10(none_before));
+    // A version 9 file: without the settling time (none), read and saved again as this run's.
+    let v9_path = dir.join("fixed-v9.snap");
+    std::fs::write(&v9_path, &v2_bytes).unwrap();
+    vinculo::Snapshot::load(&v9_path)
+        .unwrap()
+        .save(&again)
+        .unwrap();
+    assert_eq!(std::fs::read(&again).unwrap(), v10_bytes);
     std::fs::remove_dir_all(&dir).ok();
 }
 
