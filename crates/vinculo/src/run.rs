@@ -99,14 +99,15 @@
 //! a ringing; unless dt / 2^[`EVENT_HALVINGS`] is longer already): the transient
 //! decays as e^(-s/tau) while a step's error on it grows as the square of the step, so that
 //! each doubling adds 4 e^-2 = 0.54 of the error of the one before. Measured (`python -m
-//! vinculo.mooring.bench`'s chain on the seabed, 20 s, errors against each build's own run at
-//! 0.5 ms): against steps held at dt / 16 through the whole transient, the same errors (20
-//! segments at 10 ms: 3.79e-3 against 3.77e-3; 100 at 5 ms: 7.1e-4 against 7.0e-4; 1,000 at
-//! 5 ms: 8.6e-4 against 7.2e-4) at 8 %, 6 % and 26 % less CPU time, and the particle of
+//! vinculo.mooring.bench --cases chain`, 20 s, errors against each build's own run at 0.5 ms):
+//! against steps held at dt / 16 through the whole transient, the same errors (20 segments at
+//! 10 ms: 3.79e-3 against 3.77e-3; 100 at 5 ms: 7.1e-4 against 7.0e-4; 1,000 at 5 ms: 8.6e-4
+//! against 7.2e-4) at 8 %, 7 % and 25 % less CPU time, and the particle of
 //! `tests/test_contact_events.py` ends as close to its closed form (1.21e-4, 2.97e-5, 7.40e-6 m
 //! at dt = 0.04, 0.02, 0.01, unchanged); doubling every tau instead (3.0e-4 m at dt = 0.04), or
 //! holding dt / 4 throughout (2.1e-3 m), loses it, and so does stepping at dt once the steps
-//! have doubled up to it (1,000 segments: 1.1e-3). A step that straddles the jump resolves it only to first order in its size; stepping to it and
+//! have doubled up to it (1,000 segments: 1.1e-3). A step that straddles the jump resolves it
+//! only to first order in its size; stepping to it and
 //! through its transient keeps the run second order (the error of the particle dropped onto the
 //! seabed of `tests/test_contact_events.py` shrinks fourfold when dt halves, against a closed
 //! form). A step that ends at an event, or whose event is within a millionth of the step from
@@ -610,7 +611,7 @@ pub struct Simulation<'a> {
     sol: Solution,
     fingerprint: u64,
     run: u64,
-    /// The largest stored output allowed (None: no limit known; `output_size.rs`).
+    /// The largest stored output allowed (`output_size.rs`).
     output_limit: OutputLimit,
     /// The growth guard of index-3 generalised-alpha (`integrators/energy_guard.rs`).
     guard: Option<EnergyGuard>,
@@ -1842,5 +1843,45 @@ mod tests {
             );
             assert!(new[1] < 0.1 * old[1], "{scheme:?}: {new:?} {old:?}");
         }
+    }
+
+    /// The longest step allowed `t` after a contact event that settles in `tau`, for a nominal
+    /// step `dt` (the grid holds `EVENT_HALVINGS` levels below it, as a run with contacts'):
+    /// the level `after_event` leaves from a step at dt.
+    fn transient_step(dt: f64, tau: f64, t: f64) -> f64 {
+        let mut fixed = FixedSteps::new(dt, EVENT_HALVINGS as usize, 0.0);
+        fixed.go_to_event(0.0, tau);
+        fixed.after_event(t);
+        fixed.nominal()
+    }
+
+    /// The steps of a contact event's transient (module documentation): dt / 16 for the first
+    /// two settling times, doubling every two, up to dt / 2 for the rest of the ten; and no
+    /// doubling beyond two settling times where dt / 16 is already near them.
+    #[test]
+    fn the_steps_of_a_transient_double_every_two_settling_times_up_to_half_a_step() {
+        let (dt, tau) = (0.005, 0.0034);
+        let expected = [
+            (0.5, dt / 16.0),
+            (1.9, dt / 16.0),
+            (2.1, dt / 8.0),
+            (4.1, dt / 4.0),
+            (6.1, dt / 2.0),
+            (9.9, dt / 2.0),
+        ];
+        for (spans, h) in expected {
+            assert_eq!(transient_step(dt, tau, spans * tau), h, "{spans} tau");
+        }
+        // dt = 0.1 s: dt / 16 = 6.25 ms, within two settling times (6.8 ms); its double is not.
+        for spans in [0.5, 2.1, 4.1, 6.1, 9.9] {
+            assert_eq!(
+                transient_step(0.1, tau, spans * tau),
+                0.1 / 16.0,
+                "{spans} tau"
+            );
+        }
+        // dt = 0.04 s and tau = 5 ms (the dropped particle): 2.5, 5 and 10 ms, then no further.
+        let steps = [0.5, 2.1, 4.1, 6.1].map(|spans| transient_step(0.04, 0.005, spans * 0.005));
+        assert_eq!(steps, [0.0025, 0.005, 0.01, 0.01]);
     }
 }
