@@ -1,7 +1,8 @@
 //! Parallel assembly (forced on with `parallel_from: 0`) gives the same trajectory as the serial
 //! loops: on a swinging chain with the trapezoidal rule and full Newton, the same chain with
 //! generalised-alpha and modified Newton, and a ring (a constraint graph with a loop, solved by
-//! the sparse LU), and a chain stiffened by bending forces on every three consecutive particles
+//! the sparse LU), a chain with every other particle held in a plane (fixed coordinates among the
+//! distances), and a chain stiffened by bending forces on every three consecutive particles
 //! (elements of three particles, whose Jacobian blocks couple second neighbours). The residuals are the same bit for bit and the Jacobians agree to round-off,
 //! so the Newton iterates agree far below the Newton tolerance.
 
@@ -67,6 +68,26 @@ fn stiff_chain(n: usize) -> System {
     s
 }
 
+/// A chain as [`chain`]'s with every other particle held in the plane y = 0 by a fixed
+/// coordinate, under a gravity with a y component, which the fixed coordinates carry (non-zero
+/// multipliers): constraints of another kind than distances among them, whose gradients the
+/// parallel residual stores per element where a distance's are made again per particle.
+fn planar_chain(n: usize) -> System {
+    let mut s = System::new([0.0, -3.0, -9.81]);
+    let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
+    for i in 1..=n {
+        let p = s
+            .add_particle(0.1, [0.1 * i as f64, 0.0, 0.0], [0.0; 3], false)
+            .unwrap();
+        s.add_distance(prev, p, None).unwrap();
+        if i % 2 == 1 {
+            s.add_fixed_coordinate(p, 1, None).unwrap();
+        }
+        prev = p;
+    }
+    s
+}
+
 fn run(system: &System, options: &SimulationOptions, parallel: bool) -> Solution {
     let options = SimulationOptions {
         parallel_from: if parallel { 0 } else { usize::MAX },
@@ -114,6 +135,7 @@ fn parallel_assembly_gives_the_serial_trajectory() {
     };
     assert_same_trajectory(&chain(3_000), &modified, "tree elimination");
     assert_same_trajectory(&ring(2_500), &options, "sparse LU");
+    assert_same_trajectory(&planar_chain(3_000), &options, "tree elimination");
     // Bending couples second neighbours, a particle and its grandparent in the chain's tree:
     // the tree elimination takes them (with fill).
     assert_same_trajectory(&stiff_chain(3_000), &options, "tree elimination");
