@@ -22,9 +22,9 @@
 use rayon::prelude::*;
 
 use super::{Block, ElementOffsets, Entries, InertiaRows, Layout, Slot, NONE, NO_SLOT};
-use crate::constraints::{Constraint, Distance, Hessian};
+use crate::constraints::{Constraint, Hessian};
 use crate::forces::Jacobian;
-use crate::math::{sub, Mat3, Vec3};
+use crate::math::{Mat3, Vec3};
 use crate::model::System;
 
 /// Elements handed to one rayon task at least (smaller tasks cost more to schedule than they
@@ -63,7 +63,7 @@ pub struct ParallelAssembly {
     forces: Vec<Vec3>,
     /// Gradient of every constraint at the evaluation point, per constraint and touched
     /// particle (the layout's `constraint_offsets`), but distances': the particle pass makes
-    /// those again from the two positions ([`distance_row`]), cheaper than storing 48 bytes
+    /// those again from the two positions (`Distance::gradient_row`), cheaper than storing 48 bytes
     /// a distance and reading them back (at 10^5 particles the parallel residual took 2.19 to
     /// 2.33 ms with them stored, 1.70 to 1.83 ms without, criterion's `assembly` group; the
     /// buffer's part for distances is then never touched: the 10^6 chain's peak 1,183 -> 1,137
@@ -437,7 +437,7 @@ impl ParallelAssembly {
                 for (c, r) in (first..).zip(rows.iter_mut()) {
                     let con = &constraints[c];
                     // A distance's gradient is made again in the particle pass, from the two
-                    // positions, rather than stored here and read back there (`distance_row`).
+                    // positions, rather than stored here and read back there (`Distance::gradient_row`).
                     if let Constraint::Distance(d) = con {
                         i += d.particles.len();
                     } else {
@@ -468,7 +468,7 @@ impl ParallelAssembly {
                     [this.constraint_start[i]..this.constraint_start[i + 1]];
                 for &[c, e] in incident {
                     let grad = match &constraints[c as usize] {
-                        Constraint::Distance(d) => &distance_row(d, at.q_eval, i),
+                        Constraint::Distance(d) => &d.gradient_row(at.q_eval, i),
                         _ => &this.gradients[e as usize],
                     };
                     let weight = sigma * at.lambda[c as usize];
@@ -548,16 +548,6 @@ fn split_by_elements<'a>(
         values = rest;
     }
     pieces
-}
-
-/// The gradient row of distance `d` for its particle `i` at `q`: the row that
-/// [`crate::constraints::Distance::gradient`] gives it, the same numbers.
-#[inline(always)]
-fn distance_row(d: &Distance, q: &[Vec3], i: usize) -> Vec3 {
-    let [a, b] = d.particles;
-    let diff = sub(q[a], q[b]);
-    let s = if i == a { -2.0 } else { 2.0 };
-    [s * diff[0], s * diff[1], s * diff[2]]
 }
 
 /// Copies an element's local rows into `out` (of the same length) one 3-vector at a time: a

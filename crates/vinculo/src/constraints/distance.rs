@@ -41,6 +41,17 @@ impl Distance {
         ]
     }
 
+    /// The gradient row of the constraint's particle `i` at `q`, the same numbers as its row of
+    /// [`Distance::gradient`]: what the parallel residual makes again where a particle's rows
+    /// gather it (`assembly/parallel.rs`).
+    #[inline(always)]
+    pub(crate) fn gradient_row(&self, q: &[Vec3], i: usize) -> Vec3 {
+        let [a, b] = self.particles;
+        let d = sub(q[a], q[b]);
+        let s = if i == a { -2.0 } else { 2.0 };
+        [s * d[0], s * d[1], s * d[2]]
+    }
+
     #[inline]
     pub(crate) fn residual_and_gradient(&self, q: &[Vec3]) -> (f64, [Vec3; 2]) {
         let d = sub(q[self.particles[0]], q[self.particles[1]]);
@@ -83,6 +94,20 @@ impl Distance {
 mod tests {
     use super::super::{fd, Constraint};
     use super::*;
+
+    /// Each particle's row made alone is its row of the gradient, bit for bit (the parallel
+    /// residual's distances give the serial one's numbers).
+    #[test]
+    fn a_gradient_row_is_the_gradient_s_row() {
+        let d = Distance {
+            particles: [2, 0],
+            length: 0.7,
+        };
+        let q = [[0.1, 0.2, -0.3], [9.0, 9.0, 9.0], [0.5, -0.4, 0.25]];
+        let rows = d.gradient(&q, 0.0);
+        assert_eq!(d.gradient_row(&q, 2), rows[0]);
+        assert_eq!(d.gradient_row(&q, 0), rows[1]);
+    }
 
     #[test]
     fn derivatives_match_finite_differences() {
