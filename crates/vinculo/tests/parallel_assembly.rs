@@ -12,7 +12,12 @@ use vinculo::{simulate, SimulationOptions, Solution};
 
 /// A horizontal chain of `n` links (0.1 m, 0.1 kg) from a fixed anchor, released at rest.
 fn chain(n: usize) -> System {
-    let mut s = System::new([0.0, 0.0, -9.81]);
+    chain_under(n, [0.0, 0.0, -9.81])
+}
+
+/// The chain of [`chain`] under the gravity `g`.
+fn chain_under(n: usize, g: [f64; 3]) -> System {
+    let mut s = System::new(g);
     let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
     for i in 1..=n {
         let p = s
@@ -73,17 +78,10 @@ fn stiff_chain(n: usize) -> System {
 /// multipliers): constraints of another kind than distances among them, whose gradients the
 /// parallel residual stores per element where a distance's are made again per particle.
 fn planar_chain(n: usize) -> System {
-    let mut s = System::new([0.0, -3.0, -9.81]);
-    let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
-    for i in 1..=n {
-        let p = s
-            .add_particle(0.1, [0.1 * i as f64, 0.0, 0.0], [0.0; 3], false)
-            .unwrap();
-        s.add_distance(prev, p, None).unwrap();
-        if i % 2 == 1 {
-            s.add_fixed_coordinate(p, 1, None).unwrap();
-        }
-        prev = p;
+    let mut s = chain_under(n, [0.0, -3.0, -9.81]);
+    for index in (1..=n).step_by(2) {
+        let p = s.particle_id(index).unwrap();
+        s.add_fixed_coordinate(p, 1, None).unwrap();
     }
     s
 }
