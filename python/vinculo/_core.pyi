@@ -856,6 +856,23 @@ class System:
             InvalidInputError: a constraint that is not such a segment, or not one of this
                 system's.
         """
+    def set_axial_damping(self, constraint: ConstraintId, damping: float) -> None:
+        """Give an elastic segment internal axial damping: the tension
+        ``damping * u . (v_a - v_b)`` along it (``u`` the unit vector from b to a), stretched or
+        slack, as MoorDyn's BA / l (N s/m). The same force as a spring-damper of zero stiffness
+        between the segment's particles, computed with the segment's own geometry
+        (docs/theory/moorings.md). Mooring lines (``vinculo.mooring``) damp their segments
+        this way.
+
+        Arguments:
+            constraint: an elastic segment between two particles (``add_elastic_distance``).
+            damping: the damping coefficient (N s/m), finite and >= 0.
+
+        Raises:
+            InvalidInputError: a constraint that is not such a segment (between points of
+                bodies, add a spring-damper of zero stiffness), or a damping that is negative
+                or not finite.
+        """
     def set_tension_only(self, constraint: ConstraintId) -> None:
         """Declare a distance constraint a string: runs stop with NegativeTensionError when it
         would have to push.

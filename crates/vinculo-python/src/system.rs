@@ -965,6 +965,12 @@ impl PySystem {
         self.inner.set_slack(c).map_err(to_py)
     }
 
+    /// Gives an elastic segment internal axial damping (N s/m; see the stub).
+    fn set_axial_damping(&mut self, constraint: &Bound<'_, PyAny>, damping: f64) -> PyResult<()> {
+        let c = constraint_id(constraint, "System.add_elastic_distance")?;
+        self.inner.set_axial_damping(c, damping).map_err(to_py)
+    }
+
     /// Declares a distance constraint a string: a run stops with NegativeTensionError when it
     /// would have to push.
     fn set_tension_only(&mut self, constraint: &Bound<'_, PyAny>) -> PyResult<()> {

@@ -86,6 +86,25 @@ fn planar_chain(n: usize) -> System {
     s
 }
 
+/// A chain of elastic segments (EA = 2e3 N) with internal axial damping, released horizontally:
+/// the damping's tension goes with each segment's multiplier into the particle rows, from the
+/// constraint pass in the parallel residual.
+fn damped_chain(n: usize) -> System {
+    let mut s = System::new([0.0, 0.0, -9.81]);
+    let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
+    for i in 1..=n {
+        let p = s
+            .add_particle(0.1, [0.01 * i as f64, 0.0, 0.0], [0.0; 3], false)
+            .unwrap();
+        let c = s
+            .add_elastic_distance(prev, p, (vinculo::laws::Law::Constant(0.01), 1.0), 2e3)
+            .unwrap();
+        s.set_axial_damping(c, 3.0).unwrap();
+        prev = p;
+    }
+    s
+}
+
 fn run(system: &System, options: &SimulationOptions, parallel: bool) -> Solution {
     let options = SimulationOptions {
         parallel_from: if parallel { 0 } else { usize::MAX },
@@ -137,4 +156,5 @@ fn parallel_assembly_gives_the_serial_trajectory() {
     // Bending couples second neighbours, a particle and its grandparent in the chain's tree:
     // the tree elimination takes them (with fill).
     assert_same_trajectory(&stiff_chain(3_000), &options, "tree elimination");
+    assert_same_trajectory(&damped_chain(3_000), &options, "tree elimination");
 }

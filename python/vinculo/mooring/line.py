@@ -8,8 +8,9 @@ loads of the half segment next to them (weight, buoyancy, drag, seabed contact),
 nodes belong to the points they attach to; their inertia stays the particles' own. Axial damping
 ``BA`` (or, negative, MoorDyn's damping ratio ``-zeta`` of each segment's axial mode:
 ``BA = zeta (L / N) sqrt(EA w)``, MoorDyn's documentation) is a dashpot in parallel with each
-segment, bending stiffness ``EI`` acts on consecutive node triples, Morison loads and seabed
-contact act on every node with MoorDyn's conventions.
+segment, carried by the segment itself (``System.set_axial_damping``), bending stiffness
+``EI`` acts on consecutive node triples, Morison loads and seabed contact act on every node
+with MoorDyn's conventions.
 
 The interior nodes start on the closed-form elastic catenary of the line when it has one (a line
 hanging in a vertical plane, :func:`vinculo.mooring.catenary.solve_catenary`), else on a
@@ -388,8 +389,9 @@ def add_line(system: Any, end_a: int, end_b: int, line_type: LineType,
             system.set_slack(link)
     damping = _damping(line_type, segment)
     if damping > 0.0:
-        for k in range(segments):
-            system.add_spring_damper(handle[k], handle[k + 1], 0.0, damping, segment)
+        # The segments' internal damping (MoorDyn's BA / l), carried by the segments themselves.
+        for link in links:
+            system.set_axial_damping(link, damping)
     if line_type.ei > 0.0:
         for k in range(1, segments):
             system.add_bending(handle[k - 1], handle[k], handle[k + 1], line_type.ei, segment)

@@ -326,6 +326,21 @@ impl Layout {
             s
         };
         con.with_hessian_and_gradient((at.q_eval, at.t_eval), w, buffer, |hess, grad_eval| {
+            // A damped segment's damping force (`constraints/elastic_distance.rs`) has its
+            // derivatives in the same four blocks as the Hessian term.
+            let damped;
+            let hess = match con.damped_segment() {
+                Some(segment) => {
+                    let weights = (at.force_dq, at.force_dv);
+                    let mut blocks = segment.damping_blocks(at.q_eval, at.v_eval, weights);
+                    for (b, h) in blocks.iter_mut().zip(hess) {
+                        *b = crate::math::add_mat(*b, *h);
+                    }
+                    damped = blocks;
+                    &damped[..]
+                }
+                None => hess,
+            };
             if at.same_point() {
                 let grads = (grad_eval, grad_eval);
                 self.add_constraint_blocks_weighted(values, (c, hess), (s, row), grads);

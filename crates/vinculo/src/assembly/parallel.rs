@@ -69,6 +69,9 @@ pub struct ParallelAssembly {
     /// buffer's part for distances is then never touched: the 10^6 chain's peak 1,183 -> 1,137
     /// MB).
     gradients: Vec<Vec3>,
+    /// The damping tension of each damped segment at the current iterate (written and read for
+    /// those alone: the pages of a model without them are never touched).
+    damping: Vec<f64>,
 }
 
 /// Where and with which weights one step's residual is evaluated.
@@ -157,6 +160,22 @@ impl ResidualTerms<'_> {
                 held + segment.compliance(self.t_eval) * self.lambda[c]
             }
             None => phi,
+        }
+    }
+
+    /// sigma times the tension that constraint `c` (`con`)'s gradient `grad` at the forces'
+    /// point carries into the dynamics rows: its multiplier, plus a damped segment's damping
+    /// tension there (`constraints/elastic_distance.rs`).
+    #[inline(always)]
+    pub fn gradient_weight(
+        &self,
+        con: &crate::constraints::Constraint,
+        c: usize,
+        grad: &[Vec3],
+    ) -> f64 {
+        match con.damped_segment() {
+            None => self.sigma * self.lambda[c],
+            Some(s) => self.sigma * (self.lambda[c] + s.damping_tension(grad, self.v_eval)),
         }
     }
 
@@ -395,6 +414,7 @@ impl ParallelAssembly {
             constraint_colour_start,
             forces: vec![[0.0; 3]; layout.force_offsets.particle_entries()],
             gradients: vec![[0.0; 3]; layout.constraint_offsets.particle_entries()],
+            damping: vec![0.0; constraints.len()],
         }
     }
 
@@ -432,9 +452,10 @@ impl ParallelAssembly {
         split_by_elements(&mut self.gradients, &layout.constraint_offsets)
             .into_par_iter()
             .zip(constraint_rows.par_chunks_mut(MIN_TASK))
-            .for_each(|((first, out), rows)| {
+            .zip(self.damping.par_chunks_mut(MIN_TASK))
+            .for_each(|(((first, out), rows), damping)| {
                 let mut i = 0;
-                for (c, r) in (first..).zip(rows.iter_mut()) {
+                for ((c, r), td) in (first..).zip(rows.iter_mut()).zip(damping) {
                     let con = &constraints[c];
                     // A distance's gradient is made again in the particle pass, from the two
                     // positions, rather than stored here and read back there (`Distance::gradient_row`).
@@ -444,6 +465,9 @@ impl ParallelAssembly {
                         con.with_gradient(at.q_eval, at.t_eval, |grad| {
                             copy_rows(&mut out[i..i + grad.len()], grad);
                             i += grad.len();
+                            if let Some(s) = con.damped_segment() {
+                                *td = s.damping_tension(grad, at.v_eval);
+                            }
                         });
                     }
                     *r = at.scales[c] * at.row(con, c, con.residual(at.q_end, at.t_end));
@@ -467,11 +491,18 @@ impl ParallelAssembly {
                 let incident = &this.constraint_incidence
                     [this.constraint_start[i]..this.constraint_start[i + 1]];
                 for &[c, e] in incident {
-                    let grad = match &constraints[c as usize] {
+                    let con = &constraints[c as usize];
+                    let grad = match con {
                         Constraint::Distance(d) => &d.gradient_row(at.q_eval, i),
                         _ => &this.gradients[e as usize],
                     };
-                    let weight = sigma * at.lambda[c as usize];
+                    // As `ResidualTerms::gradient_weight`, with the damping tension of the
+                    // constraint pass.
+                    let lambda = at.lambda[c as usize];
+                    let weight = match con.damped_segment() {
+                        None => sigma * lambda,
+                        Some(_) => sigma * (lambda + this.damping[c as usize]),
+                    };
                     for k in 0..3 {
                         out[k] -= weight * grad[k];
                     }

@@ -43,15 +43,16 @@ impl Layout {
         let same_point = at.same_point();
         let m3 = 3 * self.free;
         for (c, con) in system.constraints().iter().enumerate() {
-            let weight = sigma * at.lambda[c];
             let parts = con.particles();
             let phi = if same_point {
                 con.with_residual_and_gradient(at.q_end, at.t_end, |phi, grad| {
+                    let weight = at.gradient_weight(con, c, grad);
                     self.subtract_rows(r, parts, weight, grad);
                     phi
                 })
             } else {
                 con.with_gradient(at.q_eval, at.t_eval, |grad| {
+                    let weight = at.gradient_weight(con, c, grad);
                     self.subtract_rows(r, parts, weight, grad)
                 });
                 con.residual(at.q_end, at.t_end)

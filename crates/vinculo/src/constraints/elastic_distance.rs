@@ -26,6 +26,21 @@
 //! stretched, `c T = 0` (T = 0, no force, no dependence on q) while shorter than L. The
 //! switch is where T = 0, so the tension is continuous; its derivative jumps there (the step
 //! that crosses it is first order locally, as MoorDyn's is).
+//!
+//! Internal axial damping (MoorDyn's BA, `damping` = BA / l in N s/m,
+//! [`crate::model::System::set_axial_damping`]): the segment also carries the tension
+//! T_d = c u.w, w = v_i - v_j (c times the rate of its length), a force -T_d u on i and +T_d u
+//! on j along the same line as the multiplier's, slack or not (MoorDyn applies it whether the
+//! segment is stretched or not). It is a force, evaluated where the forces are (q_e, v_e),
+//! placed with the multiplier's column: the dynamics rows get -(lambda + T_d) Phi_q^T, one
+//! gather of the two particles' rows for both. With P = I - u u^T and |d| = l:
+//!
+//! ```text
+//! d(f_i)/dq_i = -(c / l) (u (P w)^T + (u.w) P)      d(f_i)/dv_i = -c u u^T
+//! ```
+//!
+//! and the blocks (i, j), (j, i) the negatives, (j, j) the same (as a spring-damper of zero
+//! stiffness, `forces/spring_damper.rs`, whose numbers they are).
 
 use super::Hessian;
 use crate::laws::Law;
@@ -45,6 +60,8 @@ pub struct ElasticDistance {
     pub ea: f64,
     /// Whether the segment goes slack (tension 0) instead of pushing when shorter than L.
     pub slack: bool,
+    /// Internal axial damping c (N s/m; 0: none): the tension c u.(v_i - v_j) along the segment.
+    pub damping: f64,
 }
 
 /// The unit vector u, the length |d| and the projector I - u u^T over |d|.
@@ -117,6 +134,37 @@ impl ElasticDistance {
         1.0
     }
 
+    /// The damping's tension T_d = c u.(v_i - v_j) from the gradient [-u, u] at the positions
+    /// the forces use and the velocities there: -c (grad_i . v_i + grad_j . v_j).
+    #[inline(always)]
+    pub(crate) fn damping_tension(&self, grad: &[Vec3], v: &[Vec3]) -> f64 {
+        let [i, j] = self.particles;
+        -self.damping * (dot(grad[0], v[i]) + dot(grad[1], v[j]))
+    }
+
+    /// `wq` d(f)/dq + `wv` d(f)/dv of the damping force (module documentation): the blocks
+    /// (i, i), (i, j), (j, i), (j, j).
+    pub(crate) fn damping_blocks(&self, q: &[Vec3], v: &[Vec3], (wq, wv): (f64, f64)) -> [Mat3; 4] {
+        let [i, j] = self.particles;
+        let (u, l) = geometry(q, self.particles);
+        let w = sub(v[i], v[j]);
+        let uw = dot(u, w);
+        // P w = w - (u.w) u.
+        let pw = [w[0] - uw * u[0], w[1] - uw * u[1], w[2] - uw * u[2]];
+        let c = self.damping;
+        let mut same = [[0.0; 3]; 3];
+        for (r, row) in same.iter_mut().enumerate() {
+            for (k, x) in row.iter_mut().enumerate() {
+                let p = if r == k { 1.0 } else { 0.0 } - u[r] * u[k];
+                let dq = -(c / l) * (u[r] * pw[k] + uw * p);
+                let dv = -c * u[r] * u[k];
+                *x = wq * dq + wv * dv;
+            }
+        }
+        let other = scale_mat(-1.0, same);
+        [same, other, other, same]
+    }
+
     /// The compliance c(t) = L(t)/EA (m/N) of the constraint equation Phi + c T = 0; 0 when
     /// inextensible.
     #[inline]
@@ -133,6 +181,7 @@ impl ElasticDistance {
 mod tests {
     use super::super::{fd, Constraint};
     use super::*;
+    use crate::math::scale as scale_vec;
 
     /// Gradient, Hessian, Phi_t and gamma against finite differences, for a segment whose
     /// length is paid out by a winch (a polynomial law).
@@ -144,10 +193,83 @@ mod tests {
             share: 0.5,
             ea: 1e5,
             slack: false,
+            damping: 0.0,
         }));
         let q = [[0.1, 0.2, -0.3], [9.0, 9.0, 9.0], [0.5, -0.4, 0.25]];
         let v = [[0.3, -1.0, 0.2], [0.0; 3], [-0.6, 0.1, 0.9]];
         fd::check(&c, &q, &v, 0.3);
+    }
+
+    /// The damping force's derivatives against central differences of the force
+    /// f_i = -T_d u, f_j = +T_d u (T_d from the gradient and the velocities), on a segment that
+    /// stretches and turns, and against the spring-damper of zero stiffness that is the same
+    /// force (`forces/spring_damper.rs`).
+    #[test]
+    fn damping_blocks_match_finite_differences_and_the_spring_damper() {
+        use crate::forces::{Force, Jacobian, SpringDamper};
+        let e = ElasticDistance {
+            particles: [0, 2],
+            length: Law::Constant(0.7),
+            share: 1.0,
+            ea: 1e5,
+            slack: true,
+            damping: 3.5,
+        };
+        let force = |q: &[Vec3], v: &[Vec3]| -> [Vec3; 2] {
+            let grad = e.gradient(q, 0.0);
+            let td = e.damping_tension(&grad, v);
+            [scale_vec(td, grad[0]), scale_vec(-td, grad[0])]
+        };
+        let q = [[0.1, 0.2, -0.3], [9.0, 9.0, 9.0], [0.5, -0.4, 0.25]];
+        let v = [[0.3, -1.0, 0.2], [0.0; 3], [-0.6, 0.1, 0.9]];
+        let h = 1e-6;
+        for (which, weights) in [(0, (1.0, 0.0)), (1, (0.0, 1.0))] {
+            let blocks = e.damping_blocks(&q, &v, weights);
+            for (y, &py) in e.particles.iter().enumerate() {
+                for k in 0..3 {
+                    let (mut xp, mut xm) = if which == 0 {
+                        (q.to_vec(), q.to_vec())
+                    } else {
+                        (v.to_vec(), v.to_vec())
+                    };
+                    xp[py][k] += h;
+                    xm[py][k] -= h;
+                    let (fp, fm) = if which == 0 {
+                        (force(&xp, &v), force(&xm, &v))
+                    } else {
+                        (force(&q, &xp), force(&q, &xm))
+                    };
+                    for x in 0..2 {
+                        for r in 0..3 {
+                            let fd = (fp[x][r] - fm[x][r]) / (2.0 * h);
+                            let an = blocks[2 * x + y][r][k];
+                            assert!((fd - an).abs() < 1e-6 * (1.0 + fd.abs()), "{fd} vs {an}");
+                        }
+                    }
+                }
+            }
+        }
+        // The spring-damper of zero stiffness between the same particles: the same blocks.
+        let spring = Force::SpringDamper(SpringDamper {
+            particles: [0, 2],
+            stiffness: 0.0,
+            damping: 3.5,
+            rest_length: 0.7,
+        });
+        let (mut dq, mut dv) = (Jacobian::zeros(2), Jacobian::zeros(2));
+        spring.add_jacobian(&q, &v, 0.0, &mut dq, &mut dv);
+        let mine = e.damping_blocks(&q, &v, (0.3, -0.8));
+        for x in 0..2 {
+            for y in 0..2 {
+                for r in 0..3 {
+                    for k in 0..3 {
+                        let theirs = 0.3 * dq[x][y][r][k] - 0.8 * dv[x][y][r][k];
+                        let diff = (mine[2 * x + y][r][k] - theirs).abs();
+                        assert!(diff < 1e-12 * (1.0 + theirs.abs()), "{x}{y}{r}{k}");
+                    }
+                }
+            }
+        }
     }
 
     /// The compliance is L/EA, and zero for an inextensible segment.
@@ -159,6 +281,7 @@ mod tests {
             share: 0.5,
             ea: 4e6,
             slack: false,
+            damping: 0.0,
         };
         assert_eq!(e.compliance(0.0), 2.0 / 4e6);
         e.ea = f64::INFINITY;

@@ -268,6 +268,16 @@ impl Constraint {
         }
     }
 
+    /// The elastic segment, if the constraint is one with internal axial damping (its force
+    /// goes with the multiplier's, `elastic_distance.rs`).
+    #[inline(always)]
+    pub fn damped_segment(&self) -> Option<&ElasticDistance> {
+        match self {
+            Constraint::ElasticDistance(c) if c.damping != 0.0 => Some(c.as_ref()),
+            _ => None,
+        }
+    }
+
     /// True when the constraint's equation has a compliance (its row gets a diagonal entry).
     #[inline]
     pub fn is_compliant(&self) -> bool {

@@ -120,6 +120,15 @@ impl System {
             }
         };
         for (k, inner) in constraints.into_iter().enumerate() {
+            if inner.damped_segment().is_some() {
+                return Err(Error::InvalidParameter {
+                    name: format!("elements of {label}"),
+                    value: f64::NAN,
+                    expected: "axial damping acts on segments between particles: between \
+                               points of bodies, add a spring-damper of zero stiffness"
+                        .into(),
+                });
+            }
             let map = PointMap::for_points(points, inner.particles());
             let element = OnPoints {
                 inner,

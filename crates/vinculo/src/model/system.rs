@@ -242,6 +242,7 @@ impl System {
             share,
             ea,
             slack: false,
+            damping: 0.0,
         })))
     }
 
@@ -610,6 +611,40 @@ impl System {
                 value: c.0 as f64,
                 expected: "must be an elastic segment of finite EA (add_elastic_distance); an \
                            inextensible string is made tension-only with set_tension_only"
+                    .into(),
+            }),
+            None => Err(self.unknown_constraint(c)),
+        }
+    }
+
+    /// Gives elastic segment `c` an internal axial damping `damping` (N s/m; MoorDyn's BA / l):
+    /// the tension `damping` u.(v_a - v_b) along it, whether stretched or slack
+    /// (`constraints/elastic_distance.rs`). One element for the segment's elasticity and its
+    /// damping: the same force as a spring-damper of zero stiffness between its particles.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] when `c` is not an elastic segment between two particles (a
+    /// segment between points of bodies takes a spring-damper of zero stiffness), or when
+    /// `damping` is not finite and >= 0.
+    pub fn set_axial_damping(&mut self, c: ConstraintId, damping: f64) -> Result<()> {
+        if !(damping.is_finite() && damping >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: format!("axial damping of constraint #{}", c.0),
+                value: damping,
+                expected: "must be finite and >= 0 (N s/m)".into(),
+            });
+        }
+        match self.constraints.get_mut(c.0) {
+            Some(Constraint::ElasticDistance(e)) => {
+                e.damping = damping;
+                Ok(())
+            }
+            Some(other) => Err(Error::InvalidParameter {
+                name: format!("damped segment ({})", other.name(c.0)),
+                value: c.0 as f64,
+                expected: "must be an elastic segment between two particles \
+                           (add_elastic_distance); between points of bodies, add a \
+                           spring-damper of zero stiffness"
                     .into(),
             }),
             None => Err(self.unknown_constraint(c)),
