@@ -54,13 +54,20 @@ def test_a_segment_that_is_not_slack_pushes():
     assert np.abs(z[early] - (-0.5 - G * sol.times[early] ** 2 / 2)).max() > 0.01
 
 
-def test_only_elastic_segments_can_go_slack():
+def test_only_elastic_segments_go_slack_or_take_axial_damping():
     system = vinculo.System()
     a = system.add_particle(1.0, (0.0, 0.0, 0.0), fixed=True)
     b = system.add_particle(1.0, (1.0, 0.0, 0.0))
     rod = system.add_distance(a, b)
     with pytest.raises(InvalidInputError, match="elastic segment"):
         system.set_slack(rod)
+    with pytest.raises(InvalidInputError, match="elastic segment"):
+        system.set_axial_damping(rod, 1.0)
+    # The damping coefficient (N s/m) must be finite and >= 0.
+    segment = system.add_elastic_distance(a, b, length=1.0, ea=1e4)
+    for bad in (-1.0, math.nan, math.inf):
+        with pytest.raises(InvalidInputError, match="axial damping"):
+            system.set_axial_damping(segment, bad)
 
 
 def test_a_damped_slack_segment_still_damps_as_moordyn_does():
@@ -85,16 +92,3 @@ def test_a_damped_slack_segment_still_damps_as_moordyn_does():
     assert z[-1] > -1.0
     np.testing.assert_allclose(z, closed, rtol=0.0, atol=2e-8)
     assert abs(z[-1] - (z0 - G * t[-1] ** 2 / 2)) > 3e-2
-
-
-def test_axial_damping_needs_an_elastic_segment_and_a_finite_nonnegative_coefficient():
-    system = vinculo.System()
-    a = system.add_particle(1.0, (0.0, 0.0, 0.0), fixed=True)
-    b = system.add_particle(1.0, (1.0, 0.0, 0.0))
-    rod = system.add_distance(a, b)
-    with pytest.raises(InvalidInputError, match="elastic segment"):
-        system.set_axial_damping(rod, 1.0)
-    segment = system.add_elastic_distance(a, b, length=1.0, ea=1e4)
-    for bad in (-1.0, math.nan, math.inf):
-        with pytest.raises(InvalidInputError, match="axial damping"):
-            system.set_axial_damping(segment, bad)

@@ -15,8 +15,8 @@
 
 use vinculo::laws::Law;
 use vinculo::linear::SparseSolver;
-use vinculo::model::System;
-use vinculo::{simulate, SimulationOptions};
+use vinculo::model::{ConstraintId, ParticleId, System};
+use vinculo::{simulate, SimulationOptions, Solution};
 
 const G: f64 = 9.81;
 
@@ -135,19 +135,40 @@ fn stiff_segment_moves_as_the_exact_distance() {
     }
 }
 
-#[test]
-fn tree_elimination_equals_sparse_lu_on_an_elastic_chain() {
-    // A 40-link elastic chain released horizontally from a fixed anchor.
+/// A chain of `links` elastic segments (0.1 m, stiffness `ea`) between 0.1 kg particles,
+/// released horizontally from a fixed anchor; `each(system, segment, a, b)` is called on every
+/// segment (to damp it).
+fn horizontal_chain(
+    links: usize,
+    ea: f64,
+    mut each: impl FnMut(&mut System, ConstraintId, ParticleId, ParticleId),
+) -> System {
     let mut s = System::new([0.0, 0.0, -G]);
     let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
-    for i in 1..=40 {
+    for i in 1..=links {
         let p = s
             .add_particle(0.1, [0.1 * i as f64, 0.0, 0.0], [0.0; 3], false)
             .unwrap();
-        s.add_elastic_distance(prev, p, (Law::Constant(0.1), 1.0), 5e3)
+        let c = s
+            .add_elastic_distance(prev, p, (Law::Constant(0.1), 1.0), ea)
             .unwrap();
+        each(&mut s, c, prev, p);
         prev = p;
     }
+    s
+}
+
+/// The largest difference between the positions of two runs (m).
+fn largest_difference(a: &Solution, b: &Solution) -> f64 {
+    a.positions
+        .iter()
+        .zip(&b.positions)
+        .fold(0.0f64, |w, (x, y)| w.max((x - y).abs()))
+}
+
+#[test]
+fn tree_elimination_equals_sparse_lu_on_an_elastic_chain() {
+    let s = horizontal_chain(40, 5e3, |_, _, _, _| {});
     let run = |solver: SparseSolver| {
         let options = SimulationOptions {
             t_end: 0.5,
@@ -167,11 +188,7 @@ fn tree_elimination_equals_sparse_lu_on_an_elastic_chain() {
     );
     // Two direct solvers of one linear system: the motions agree to round-off amplified over
     // the steps.
-    let worst = tree
-        .positions
-        .iter()
-        .zip(&lu.positions)
-        .fold(0.0f64, |w, (a, b)| w.max((a - b).abs()));
+    let worst = largest_difference(&tree, &lu);
     assert!(worst < 1e-9, "largest difference {worst} m");
 }
 
@@ -234,9 +251,7 @@ fn damped_segment_follows_the_damped_oscillator() {
     let stretch = m * G / k;
     let period = 2.0 * std::f64::consts::PI / omega;
     let mut system = hanging(m, Law::Constant(l), ea);
-    system
-        .set_axial_damping(vinculo::model::ConstraintId(0), c)
-        .unwrap();
+    system.set_axial_damping(ConstraintId(0), c).unwrap();
     let options = SimulationOptions {
         t_end: 3.0 * period,
         dt: period / 2000.0,
@@ -268,23 +283,13 @@ fn damped_segments_move_as_segments_with_zero_stiffness_spring_dampers() {
     // both terms of the damping's Jacobian act. Reference: the same chain with each segment's
     // damping as a separate spring-damper of zero stiffness (`forces/spring_damper.rs`).
     let chain = |separate: bool| {
-        let mut s = System::new([0.0, 0.0, -G]);
-        let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
-        for i in 1..=20 {
-            let p = s
-                .add_particle(0.1, [0.1 * i as f64, 0.0, 0.0], [0.0; 3], false)
-                .unwrap();
-            let c = s
-                .add_elastic_distance(prev, p, (Law::Constant(0.1), 1.0), 2e3)
-                .unwrap();
+        horizontal_chain(20, 2e3, |s, c, a, b| {
             if separate {
-                s.add_spring_damper(prev, p, 0.0, 3.0, Some(0.1)).unwrap();
+                s.add_spring_damper(a, b, 0.0, 3.0, Some(0.1)).unwrap();
             } else {
                 s.set_axial_damping(c, 3.0).unwrap();
             }
-            prev = p;
-        }
-        s
+        })
     };
     let options = SimulationOptions {
         t_end: 0.5,
@@ -299,20 +304,14 @@ fn damped_segments_move_as_segments_with_zero_stiffness_spring_dampers() {
     // The same equations: the runs differ by round-off within Newton's tolerance (1e-10 m;
     // measured 3.9e-14 m), where the same chain without damping moves 8.0e-5 m away
     // (measured).
-    let worst = one
-        .positions
-        .iter()
-        .zip(&two.positions)
-        .fold(0.0f64, |w, (a, b)| w.max((a - b).abs()));
+    let worst = largest_difference(&one, &two);
     assert!(worst < 1e-10, "largest difference {worst} m");
 }
 
 #[test]
 fn axial_damping_is_refused_where_it_does_not_apply() {
     let mut s = hanging(1.0, Law::Constant(1.0), 1e4);
-    let err = s
-        .set_axial_damping(vinculo::model::ConstraintId(0), -1.0)
-        .unwrap_err();
+    let err = s.set_axial_damping(ConstraintId(0), -1.0).unwrap_err();
     assert!(err.to_string().contains("axial damping"), "{err}");
     let a = s.particle_id(0).unwrap();
     let b = s.particle_id(1).unwrap();
