@@ -170,15 +170,17 @@ pub(crate) fn check_options(system: &System, o: &SimulationOptions) -> Result<()
         check_output_times(o, times)?;
     }
     if o.formulation == crate::integrators::Formulation::Ggl {
-        if let Some(k) = system.constraints().iter().position(|c| c.is_compliant()) {
+        let segment =
+            |c: &crate::constraints::Constraint| c.is_compliant() || c.damped_segment().is_some();
+        if let Some(k) = system.constraints().iter().position(segment) {
             return Err(Error::InvalidParameter {
                 name: format!(
-                    "formulation 'ggl' with the compliant {}",
+                    "formulation 'ggl' with the compliant or damped {}",
                     system.constraints()[k].name(k)
                 ),
                 value: f64::NAN,
-                expected: "elastic segments (finite EA) run on the index-3 formulation: use \
-                           formulation 'index-3'"
+                expected: "elastic segments (finite EA, or axial damping) run on the index-3 \
+                           formulation: use formulation 'index-3'"
                     .into(),
             });
         }

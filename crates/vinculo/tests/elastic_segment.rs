@@ -233,6 +233,16 @@ fn ggl_formulation_refuses_compliant_segments_with_a_typed_error() {
     }
     let rigid = simulate(&hanging(1.0, Law::Constant(1.0), f64::INFINITY), &options).unwrap();
     assert!(rigid.status.is_ok(), "{:?}", rigid.status);
+    // Its damping force is assembled with the index-3 rows alone: a damped inextensible
+    // segment is refused too (not run without its damping).
+    let mut damped = hanging(1.0, Law::Constant(1.0), f64::INFINITY);
+    damped.set_axial_damping(ConstraintId(0), 2.0).unwrap();
+    match simulate(&damped, &options) {
+        Err(vinculo::Error::InvalidParameter { name, .. }) => {
+            assert!(name.contains("damped"), "{name}");
+        }
+        other => panic!("expected InvalidParameter, got {other:?}"),
+    }
 }
 
 #[test]
