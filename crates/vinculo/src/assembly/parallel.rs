@@ -492,16 +492,16 @@ impl ParallelAssembly {
                     [this.constraint_start[i]..this.constraint_start[i + 1]];
                 for &[c, e] in incident {
                     let con = &constraints[c as usize];
-                    let grad = match con {
-                        Constraint::Distance(d) => &d.gradient_row(at.q_eval, i),
-                        _ => &this.gradients[e as usize],
-                    };
-                    // As `ResidualTerms::gradient_weight`, with the damping tension of the
-                    // constraint pass.
                     let lambda = at.lambda[c as usize];
-                    let weight = match con.damped_segment() {
-                        None => sigma * lambda,
-                        Some(_) => sigma * (lambda + this.damping[c as usize]),
+                    // As `ResidualTerms::gradient_weight`, with the damping tension of the
+                    // constraint pass (distances have none).
+                    let (grad, weight) = match con {
+                        Constraint::Distance(d) => (&d.gradient_row(at.q_eval, i), sigma * lambda),
+                        _ if con.damped_segment().is_some() => (
+                            &this.gradients[e as usize],
+                            sigma * (lambda + this.damping[c as usize]),
+                        ),
+                        _ => (&this.gradients[e as usize], sigma * lambda),
                     };
                     for k in 0..3 {
                         out[k] -= weight * grad[k];

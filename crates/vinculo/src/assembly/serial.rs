@@ -43,16 +43,19 @@ impl Layout {
         let same_point = at.same_point();
         let m3 = 3 * self.free;
         for (c, con) in system.constraints().iter().enumerate() {
+            let weight = sigma * at.lambda[c];
             let parts = con.particles();
-            let phi = if same_point {
+            let phi = if con.damped_segment().is_some() {
+                // A damped segment's damping tension joins its multiplier's (out of the loop's
+                // common path, which stays small enough to be inlined).
+                self.damped_segment_rows(r, (c, con), at)
+            } else if same_point {
                 con.with_residual_and_gradient(at.q_end, at.t_end, |phi, grad| {
-                    let weight = at.gradient_weight(con, c, grad);
                     self.subtract_rows(r, parts, weight, grad);
                     phi
                 })
             } else {
                 con.with_gradient(at.q_eval, at.t_eval, |grad| {
-                    let weight = at.gradient_weight(con, c, grad);
                     self.subtract_rows(r, parts, weight, grad)
                 });
                 con.residual(at.q_end, at.t_end)
@@ -82,6 +85,24 @@ impl Layout {
         for (c, con) in system.constraints().iter().enumerate() {
             self.add_constraint_terms(values, (c, con, &mut hess), at);
         }
+    }
+
+    /// The dynamics rows of damped segment `c` (`con`): its gradient at the forces' point times
+    /// sigma (lambda + T_d) ([`ResidualTerms::gradient_weight`]) subtracted; returns Phi at the
+    /// step's end.
+    #[inline(never)]
+    fn damped_segment_rows(
+        &self,
+        r: &mut [f64],
+        (c, con): (usize, &crate::constraints::Constraint),
+        at: &ResidualTerms<'_>,
+    ) -> f64 {
+        let parts = con.particles();
+        con.with_gradient(at.q_eval, at.t_eval, |grad| {
+            let weight = at.gradient_weight(con, c, grad);
+            self.subtract_rows(r, parts, weight, grad)
+        });
+        con.residual(at.q_end, at.t_end)
     }
 
     /// Subtracts `weight f` from the dynamics rows of particle `p` (nothing for a fixed one).
