@@ -9,7 +9,7 @@ mod tree_elimination;
 
 pub use dense_lu::DenseLu;
 pub use sparse_lu::SparseLu;
-pub use tree_elimination::TreeElimination;
+pub use tree_elimination::{TreeElimination, TWO_SIDED_FROM};
 
 use crate::assembly::{Pattern, Storage};
 

@@ -99,6 +99,11 @@
 //! chain from one anchor) take the general sweeps, the uniform run between them the products
 //! above.
 //!
+//! # Long chains
+//!
+//! A chain of at least [`TWO_SIDED_FROM`] blocks is eliminated from both ends at once, each end
+//! on its own thread, towards a separator block in the middle (`two_sided.rs`).
+//!
 //! # Singular blocks
 //!
 //! The elimination pivots only inside a block, so a block may be singular or nearly so while the
@@ -117,6 +122,12 @@
 //! between siblings, a constraint on three particles, coupled multipliers, more than three
 //! conditions on a particle's block) it declines and the caller falls back to the general sparse
 //! LU.
+
+mod two_sided;
+
+use std::ops::Range;
+
+pub use two_sided::TWO_SIDED_FROM;
 
 use super::block_slots::{BlockSlots, ABSENT};
 use super::{LinearSolver, Singular, SparseLu, Stored};
@@ -154,15 +165,15 @@ const ROOT: u32 = u32::MAX;
 /// Block `$b`'s part of a sweep: `$fixed::<N, K>` for blocks of 3 to 5 unknowns coupled with one
 /// or two ancestors (sizes known at compile time), `$general` for the others.
 macro_rules! by_size {
-    ($self:ident, $b:expr, $fixed:ident, $general:ident) => {
+    ($self:ident, $z:expr, $b:expr, $fixed:ident, $general:ident) => {
         match $self.sizes($b) {
-            (3, 1) => $self.$fixed::<3, 1>($b),
-            (4, 1) => $self.$fixed::<4, 1>($b),
-            (5, 1) => $self.$fixed::<5, 1>($b),
-            (3, 2) => $self.$fixed::<3, 2>($b),
-            (4, 2) => $self.$fixed::<4, 2>($b),
-            (5, 2) => $self.$fixed::<5, 2>($b),
-            _ => $self.$general($b),
+            (3, 1) => $self.$fixed::<3, 1>($z, $b),
+            (4, 1) => $self.$fixed::<4, 1>($z, $b),
+            (5, 1) => $self.$fixed::<5, 1>($z, $b),
+            (3, 2) => $self.$fixed::<3, 2>($z, $b),
+            (4, 2) => $self.$fixed::<4, 2>($z, $b),
+            (5, 2) => $self.$fixed::<5, 2>($z, $b),
+            _ => $self.$general($z, $b),
         }
     };
 }
@@ -233,10 +244,14 @@ pub struct TreeElimination {
     /// Entries of the pattern (the storage entries with a slot), counted when the solver is
     /// made to factorise in place: the length of the fallback's value array.
     pattern_entries: usize,
+    /// The separator block of a long chain eliminated from both ends on two threads
+    /// (`two_sided.rs`), or 0.
+    separator: usize,
 }
 
 /// The blocks' storage, one array: the D_b (`diag`), then the A_ub or G_b (`low`), then the
 /// W_b (`w`), each in the layout of its slots.
+#[derive(Default)]
 struct BlockStore {
     values: Vec<f64>,
     /// Where `low` and `w` start.
@@ -272,6 +287,16 @@ impl BlockStore {
         let (low, w) = rest.split_at_mut(self.w_at - self.low_at);
         (diag, low, w)
     }
+}
+
+/// The storage an elimination writes, borrowed apart from the tree's structure: the three
+/// parts of [`BlockStore`] and the row interchanges, whole or from a block on
+/// (`two_sided.rs`).
+struct Factors<'a> {
+    diag: &'a mut [f64],
+    low: &'a mut [f64],
+    w: &'a mut [f64],
+    perm: &'a mut [u32],
 }
 
 /// Union-find root with path halving.
@@ -716,7 +741,7 @@ impl TreeElimination {
             coupling_at[b]
         });
         let up_slots = BlockSlots::new(up_slots, candidates, 3 * uniform, |b| coupling_at[b]);
-        Ok(TreeElimination {
+        let mut tree = TreeElimination {
             uniform,
             head,
             tail,
@@ -744,7 +769,10 @@ impl TreeElimination {
             in_place: false,
             failed: 0,
             pattern_entries: 0,
-        })
+            separator: 0,
+        };
+        tree.separator = tree.chain_separator(TWO_SIDED_FROM);
+        Ok(tree)
     }
 
     /// Number of blocks (free particles).
@@ -838,40 +866,68 @@ impl TreeElimination {
     fn eliminate_blocks(&mut self, values: Option<&[f64]>) -> Result<(), usize> {
         self.factored = false;
         self.on_fallback = false;
+        // The storage is borrowed apart from the structure while the blocks are eliminated
+        // (the two sides of a long chain are eliminated on two threads, `two_sided.rs`).
+        let mut store = std::mem::take(&mut self.store);
+        let mut perm = std::mem::take(&mut self.perm);
+        let mut gathered = std::mem::take(&mut self.gathered);
+        let (diag, low, w) = store.parts_mut();
+        let mut f = Factors {
+            diag,
+            low,
+            w,
+            perm: &mut perm,
+        };
+        let result = if self.separator > 0 {
+            self.eliminate_two_sided(&mut f, values)
+        } else {
+            self.eliminate_in_order(&mut f, &mut gathered, values)
+        };
+        self.store = store;
+        self.perm = perm;
+        self.gathered = gathered;
+        result?;
+        self.factored = true;
+        Ok(())
+    }
+
+    /// Eliminates the blocks in order, then makes the uniform run's couplings explicit.
+    fn eliminate_in_order(
+        &self,
+        f: &mut Factors,
+        gathered: &mut [bool],
+        values: Option<&[f64]>,
+    ) -> Result<(), usize> {
         if let Some(values) = values {
             // The matrix's entries are gathered block by block as the elimination reaches them
             // (an ancestor's storage when the first of its descendants updates it), so that each
             // block's numbers are used while they are in cache: on a 10^6-particle chain the
             // three separate passes over 40 values per block cost as much as the elimination.
-            self.gathered.fill(false);
+            gathered.fill(false);
             for b in 0..self.blocks() {
-                self.gather_for(b, values);
-                self.eliminate_sized(b)?;
+                self.gather_for(f, gathered, b, values);
+                self.eliminate_sized(f, b)?;
             }
         } else {
             for b in 0..self.blocks() {
-                self.eliminate_sized(b)?;
+                self.eliminate_sized(f, b)?;
             }
         }
-        match self.uniform {
-            3 => self.make_explicit::<3>(),
-            4 => self.make_explicit::<4>(),
-            5 => self.make_explicit::<5>(),
-            _ => {}
-        }
-        self.factored = true;
+        self.make_explicit(f, self.head..self.tail);
         Ok(())
     }
 
     /// Gathers the storage of block b and of its coupled ancestors, where not yet gathered.
-    fn gather_for(&mut self, b: usize, values: &[f64]) {
-        if !self.gathered[b] {
-            self.gather_block(b, values);
+    fn gather_for(&self, f: &mut Factors, gathered: &mut [bool], b: usize, values: &[f64]) {
+        if !gathered[b] {
+            self.gather_block(f, b, values);
+            gathered[b] = true;
         }
         for i in self.coupled_at[b]..self.coupled_at[b + 1] {
             let u = self.ancestors[i] as usize;
-            if !self.gathered[u] {
-                self.gather_block(u, values);
+            if !gathered[u] {
+                self.gather_block(f, u, values);
+                gathered[u] = true;
             }
         }
     }
@@ -879,20 +935,20 @@ impl TreeElimination {
     /// [`TreeElimination::eliminate`] for block b, with unrolled copies for blocks of 3 (a
     /// free particle), 4 (a particle and its link) and 5 coupled with no ancestor (a root), one
     /// (a chain) or two (a line with bending). Returns the local unknown of a negligible pivot.
-    fn eliminate_sized(&mut self, b: usize) -> Result<(), usize> {
+    fn eliminate_sized(&self, f: &mut Factors, b: usize) -> Result<(), usize> {
         let (s, nb) = (self.start[b], self.start[b + 1] - self.start[b]);
         let k = self.coupled_at[b + 1] - self.coupled_at[b];
         let result = match (nb, k) {
-            (3, 0) => self.eliminate(b, 3, 0),
-            (4, 0) => self.eliminate(b, 4, 0),
-            (5, 0) => self.eliminate(b, 5, 0),
-            (3, 1) => self.eliminate(b, 3, 1),
-            (4, 1) => self.eliminate(b, 4, 1),
-            (5, 1) => self.eliminate(b, 5, 1),
-            (3, 2) => self.eliminate(b, 3, 2),
-            (4, 2) => self.eliminate(b, 4, 2),
-            (5, 2) => self.eliminate(b, 5, 2),
-            _ => self.eliminate(b, nb, k),
+            (3, 0) => self.eliminate(f, b, 3, 0),
+            (4, 0) => self.eliminate(f, b, 4, 0),
+            (5, 0) => self.eliminate(f, b, 5, 0),
+            (3, 1) => self.eliminate(f, b, 3, 1),
+            (4, 1) => self.eliminate(f, b, 4, 1),
+            (5, 1) => self.eliminate(f, b, 5, 1),
+            (3, 2) => self.eliminate(f, b, 3, 2),
+            (4, 2) => self.eliminate(f, b, 4, 2),
+            (5, 2) => self.eliminate(f, b, 5, 2),
+            _ => self.eliminate(f, b, nb, k),
         };
         result.map_err(|k| s + k)
     }
@@ -952,14 +1008,12 @@ impl TreeElimination {
 
     /// Gathers the matrix entries of block b's storage: D_b, the A_ub and the A_bu (fill
     /// entries are zero).
-    fn gather_block(&mut self, b: usize, values: &[f64]) {
+    fn gather_block(&self, f: &mut Factors, b: usize, values: &[f64]) {
         let (da, db) = (self.diag_at[b], self.diag_at[b + 1]);
         let (ca, cb) = (self.coupling_at[b], self.coupling_at[b + 1]);
-        let (diag, low, w) = self.store.parts_mut();
-        self.diag_slots.gather(da..db, &mut diag[da..db], values);
-        self.low_slots.gather(ca..cb, &mut low[ca..cb], values);
-        self.up_slots.gather(ca..cb, &mut w[ca..cb], values);
-        self.gathered[b] = true;
+        self.diag_slots.gather(da..db, &mut f.diag[da..db], values);
+        self.low_slots.gather(ca..cb, &mut f.low[ca..cb], values);
+        self.up_slots.gather(ca..cb, &mut f.w[ca..cb], values);
     }
 
     /// Eliminates block b of `nb` unknowns coupled with `k` ancestors (their storage gathered;
@@ -968,13 +1022,13 @@ impl TreeElimination {
     /// A_u1u2 -= A_u1b W_b[:, u2] to the ancestors' storage. Returns the local column of a
     /// negligible pivot.
     #[inline(always)]
-    fn eliminate(&mut self, b: usize, nb: usize, k: usize) -> Result<(), usize> {
+    fn eliminate(&self, f: &mut Factors, b: usize, nb: usize, k: usize) -> Result<(), usize> {
         let s = self.start[b];
         let (da, db) = (self.diag_at[b], self.diag_at[b + 1]);
-        let (diag, low, w) = self.store.parts_mut();
+        let (diag, low, w) = (&mut *f.diag, &mut *f.low, &mut *f.w);
         let (own_diag, rest_diag) = diag.split_at_mut(db);
         let d = &mut own_diag[da..];
-        let perm = &mut self.perm[s..s + nb];
+        let perm = &mut f.perm[s..s + nb];
         lu_in_place(d, nb, perm)?;
         let set = &self.ancestors[self.coupled_at[b]..self.coupled_at[b + 1]];
         let set = &set[..k];
@@ -1242,18 +1296,22 @@ impl LinearSolver for TreeElimination {
             self.solve_single_block(rhs);
             return;
         }
-        for (z, &u) in self.z.iter_mut().zip(&self.unknowns) {
+        let mut z = std::mem::take(&mut self.z);
+        for (z, &u) in z.iter_mut().zip(&self.unknowns) {
             *z = rhs[u as usize];
         }
+        let n = self.blocks();
         match self.uniform {
-            3 => self.sweeps_explicit::<3>(),
-            4 => self.sweeps_explicit::<4>(),
-            5 => self.sweeps_explicit::<5>(),
-            _ => self.sweeps(),
+            _ if self.separator > 0 => self.sweeps_two_sided(&mut z),
+            3 => self.sweeps_explicit::<3>(&mut z, n),
+            4 => self.sweeps_explicit::<4>(&mut z, n),
+            5 => self.sweeps_explicit::<5>(&mut z, n),
+            _ => self.sweeps(&mut z),
         }
-        for (z, &u) in self.z.iter().zip(&self.unknowns) {
+        for (z, &u) in z.iter().zip(&self.unknowns) {
             rhs[u as usize] = *z;
         }
+        self.z = z;
     }
 
     fn name(&self) -> &'static str {
@@ -1333,13 +1391,21 @@ impl TreeElimination {
 
     /// The forward and backward sweeps of the solve on the work vector `z` (blocks of any size,
     /// any number of coupled ancestors).
-    fn sweeps(&mut self) {
+    fn sweeps(&self, z: &mut [f64]) {
         for b in 0..self.blocks() {
-            by_size!(self, b, forward_fixed, forward_general);
+            by_size!(self, z, b, forward_fixed, forward_general);
         }
         for b in (0..self.blocks()).rev() {
-            by_size!(self, b, backward_fixed, backward_general);
+            by_size!(self, z, b, backward_fixed, backward_general);
         }
+    }
+
+    /// Both sweeps of a uniform chain over the blocks before `end` (all of them, or one side
+    /// of a chain eliminated from both ends, `two_sided.rs`), whose parents' unknowns are
+    /// final before the backward sweep reaches them.
+    fn sweeps_explicit<const N: usize>(&self, z: &mut [f64], end: usize) {
+        self.forward_explicit::<N>(z, end);
+        self.backward_explicit::<N>(z, end);
     }
 
     /// Block b's number of unknowns and of coupled ancestors.
@@ -1352,10 +1418,10 @@ impl TreeElimination {
     /// [`TreeElimination::forward_general`] for a block of N unknowns coupled with K ancestors
     /// known at compile time (a line with bending: 4 and 2), the same operations unrolled.
     #[inline(always)]
-    fn forward_fixed<const N: usize, const K: usize>(&mut self, b: usize) {
+    fn forward_fixed<const N: usize, const K: usize>(&self, z: &mut [f64], b: usize) {
         let (s, e) = (self.start[b], self.start[b + 1]);
         let d = &self.store.diag()[self.diag_at[b]..self.diag_at[b + 1]];
-        let (head, tail) = self.z.split_at_mut(e);
+        let (head, tail) = z.split_at_mut(e);
         let zb = &mut head[s..];
         block_solve_fixed::<N>(d, &self.perm[s..e], zb);
         let zb: &[f64; N] = (&zb[..N]).try_into().expect("N unknowns");
@@ -1370,9 +1436,9 @@ impl TreeElimination {
     /// [`TreeElimination::backward_general`] for a block of N unknowns coupled with K ancestors
     /// known at compile time, the same operations unrolled.
     #[inline(always)]
-    fn backward_fixed<const N: usize, const K: usize>(&mut self, b: usize) {
+    fn backward_fixed<const N: usize, const K: usize>(&self, z: &mut [f64], b: usize) {
         let (s, e) = (self.start[b], self.start[b + 1]);
-        let (head, tail) = self.z.split_at_mut(e);
+        let (head, tail) = z.split_at_mut(e);
         let zb = &mut head[s..s + N];
         let ca = self.coupling_at[b];
         let w = &self.store.w()[ca..ca + 3 * K * N];
@@ -1389,10 +1455,10 @@ impl TreeElimination {
 
     /// Block b's part of the forward sweep: z_b = D_b^-1 r_b, then r_u -= A_ub z_b for u in U_b.
     #[inline]
-    fn forward_general(&mut self, b: usize) {
+    fn forward_general(&self, z: &mut [f64], b: usize) {
         let (s, e) = (self.start[b], self.start[b + 1]);
         let d = &self.store.diag()[self.diag_at[b]..self.diag_at[b + 1]];
-        let (head, tail) = self.z.split_at_mut(e);
+        let (head, tail) = z.split_at_mut(e);
         let zb = &mut head[s..];
         solve_block(d, &self.perm[s..e], zb);
         let nb = e - s;
@@ -1406,14 +1472,14 @@ impl TreeElimination {
 
     /// Block b's part of the backward sweep: x_b = z_b - sum over u in U_b of W_b[:, u] x_u.
     #[inline]
-    fn backward_general(&mut self, b: usize) {
+    fn backward_general(&self, z: &mut [f64], b: usize) {
         let set = &self.ancestors[self.coupled_at[b]..self.coupled_at[b + 1]];
         let k = set.len();
         if k == 0 {
             return;
         }
         let (s, e) = (self.start[b], self.start[b + 1]);
-        let (head, tail) = self.z.split_at_mut(e);
+        let (head, tail) = z.split_at_mut(e);
         let zb = &mut head[s..];
         let w = &self.store.w()[self.coupling_at[b]..self.coupling_at[b] + 3 * k * (e - s)];
         for (i, &u) in set.iter().enumerate() {
@@ -1426,15 +1492,28 @@ impl TreeElimination {
         }
     }
 
-    /// After the elimination of a uniform chain (module documentation): each block's A_Pb
-    /// becomes G_b = A_Pb D_b^-1, each of its rows solved from the factors transposed.
-    fn make_explicit<const N: usize>(&mut self) {
-        let (h, t) = (self.head, self.tail);
-        let (diag, low, _) = self.store.parts_mut();
-        let blocks = diag[self.diag_at[h]..self.diag_at[t]]
+    /// After the elimination of a uniform chain (module documentation): the A_Pb of each block
+    /// of `blocks` (a part of the uniform run) becomes G_b = A_Pb D_b^-1, each of its rows
+    /// solved from the factors transposed.
+    fn make_explicit(&self, f: &mut Factors, blocks: Range<usize>) {
+        match self.uniform {
+            3 => self.make_explicit_sized::<3>(f, blocks),
+            4 => self.make_explicit_sized::<4>(f, blocks),
+            5 => self.make_explicit_sized::<5>(f, blocks),
+            _ => {}
+        }
+    }
+
+    /// [`TreeElimination::make_explicit`] for blocks of N unknowns.
+    fn make_explicit_sized<const N: usize>(&self, f: &mut Factors, blocks: Range<usize>) {
+        let (h, t) = (blocks.start, blocks.end);
+        if h >= t {
+            return;
+        }
+        let blocks = f.diag[self.diag_at[h]..self.diag_at[t]]
             .chunks_exact(N * N)
-            .zip(self.perm[self.start[h]..self.start[t]].chunks_exact(N))
-            .zip(low[self.coupling_at[h]..self.coupling_at[t]].chunks_exact_mut(3 * N));
+            .zip(f.perm[self.start[h]..self.start[t]].chunks_exact(N))
+            .zip(f.low[self.coupling_at[h]..self.coupling_at[t]].chunks_exact_mut(3 * N));
         for ((d, perm), low) in blocks {
             for row in low.chunks_exact_mut(N) {
                 let row: &mut [f64; N] = row.try_into().expect("N entries");
@@ -1443,18 +1522,18 @@ impl TreeElimination {
         }
     }
 
-    /// The sweeps of a uniform chain after [`TreeElimination::make_explicit`] (module
-    /// documentation): the general sweeps for the blocks before `head` and from `tail` on,
-    /// products for the others, block head + k starting at N k past the head's unknowns, its LU
-    /// factors at N^2 k past the head's, its G_b and W_b at 3 N k past the head's.
-    fn sweeps_explicit<const N: usize>(&mut self) {
-        let (h, t) = (self.head, self.tail);
+    /// The forward sweep of a uniform chain after [`TreeElimination::make_explicit`] (module
+    /// documentation) over the blocks before `end`: the general sweep for the blocks before
+    /// `head` and from `tail` on, products for the others, block head + k starting at N k past
+    /// the head's unknowns, its LU factors at N^2 k past the head's, its G_b and W_b at 3 N k
+    /// past the head's.
+    fn forward_explicit<const N: usize>(&self, z: &mut [f64], end: usize) {
+        let (h, t) = (self.head.min(end), self.tail.min(end));
         for b in 0..h {
-            self.forward_general(b);
+            self.forward_general(z, b);
         }
-        let (z0, d0, c0) = (self.start[h], self.diag_at[h], self.coupling_at[h]);
+        let (z0, c0) = (self.start[h], self.coupling_at[h]);
         let start = &self.start;
-        let z = &mut self.z;
         // Forward, leaves first: r_P -= G_b r_b (block b's r is final: its children came first).
         // The update of a parent that comes next (a chain's) is carried in registers to it:
         // written to memory and read back at once as a block, it would wait for the stores.
@@ -1490,16 +1569,21 @@ impl TreeElimination {
                 }
             }
         }
-        for b in t..self.blocks() {
-            self.forward_general(b);
+        for b in t.max(self.tail)..end {
+            self.forward_general(z, b);
         }
-        // Backward, roots first: x_b = D_b^-1 r_b - W_b x_P (the solve with the factors does not
-        // wait for x_P).
-        for b in (t..self.blocks()).rev() {
-            self.backward_general(b);
+    }
+
+    /// The backward sweep matching [`TreeElimination::forward_explicit`] over the blocks before
+    /// `end` (their parents' unknowns already final): x_b = D_b^-1 r_b - W_b x_P (the solve
+    /// with the factors does not wait for x_P).
+    fn backward_explicit<const N: usize>(&self, z: &mut [f64], end: usize) {
+        let (h, t) = (self.head.min(end), self.tail.min(end));
+        for b in (t.max(self.tail)..end).rev() {
+            self.backward_general(z, b);
         }
+        let (z0, d0, c0) = (self.start[h], self.diag_at[h], self.coupling_at[h]);
         let start = &self.start;
-        let z = &mut self.z;
         let blocks = self.store.diag()[d0..]
             .chunks_exact(N * N)
             .zip(self.perm[z0..].chunks_exact(N))
@@ -1513,7 +1597,11 @@ impl TreeElimination {
                 // The parent's unknowns, past this block's end: by the run's layout when it is
                 // in the run (a chain's next block), from the table at the run's end.
                 let pb = pb as usize;
-                let at = if pb < t { z0 + N * (pb - h) } else { start[pb] };
+                let at = if pb < self.tail {
+                    z0 + N * (pb - h)
+                } else {
+                    start[pb]
+                };
                 let p = at - (z0 + N * k + N);
                 let xp = [after[p], after[p + 1], after[p + 2]];
                 for i in 0..N {
@@ -1522,7 +1610,7 @@ impl TreeElimination {
             }
         }
         for b in (0..h).rev() {
-            self.backward_general(b);
+            self.backward_general(z, b);
         }
     }
 }
@@ -1628,25 +1716,50 @@ mod tests {
     /// root), the branched string's by the general sweeps; a pendulum's one block (its bob and
     /// link, in the global order) is solved in the right-hand side itself. The chains' slots are periodic
     /// over their uniform run (`block_slots.rs`): at most six blocks keep theirs one by one.
+    /// The fixture's chain of `n` links with its far end tied to a second anchor (`held`), or
+    /// to a particle whose three coordinates are prescribed (the end of a line moved by its
+    /// fairlead).
+    fn chain_to(n: usize, held: bool) -> System {
+        let mut s = crate::integrators::fixtures::chain(n);
+        let last = s.particle_id(n).unwrap();
+        let x = [0.1 * n as f64 + 0.05, 0.0, 0.0];
+        let end = s.add_particle(1.0, x, [0.0; 3], held).unwrap();
+        s.add_distance(last, end, None).unwrap();
+        if !held {
+            for axis in 0..3 {
+                s.add_fixed_coordinate(end, axis, None).unwrap();
+            }
+        }
+        s
+    }
+
+    /// The solution of `b` with the matrix `v` is the sparse LU's to 1e-12 relative, and its
+    /// residual against the matrix below 1e-12 of the solution's size.
+    fn check_solution(layout: &Layout, v: &[f64], b: &[f64], x: &[f64], what: &str) {
+        let mut lu = SparseLu::new(&layout.pattern);
+        let y = solve(&mut lu, v, b);
+        let scale = y.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        for i in 0..b.len() {
+            assert!(
+                (x[i] - y[i]).abs() <= 1e-12 * scale,
+                "{what}, unknown {i}: tree {} vs sparse LU {}",
+                x[i],
+                y[i]
+            );
+        }
+        let mut r = b.to_vec();
+        for (row, col, k) in layout.pattern.entries() {
+            r[row] -= v[k] * x[col];
+        }
+        // Relative to the solution's size (x up to 550 on these random matrices).
+        let bound = 1e-12 * scale.max(1.0);
+        assert!(r.iter().all(|e| e.abs() < bound), "{what}: residual {r:?}");
+    }
+
     #[test]
     fn tree_elimination_matches_sparse_lu() {
         use crate::integrators::fixtures::chain;
-        let mut held = chain(30);
-        let last = held.particle_id(30).unwrap();
-        let anchor = held
-            .add_particle(1.0, [3.05, 0.0, 0.0], [0.0; 3], true)
-            .unwrap();
-        held.add_distance(last, anchor, None).unwrap();
-        let mut moved = chain(30);
-        let end = moved
-            .add_particle(1.0, [3.05, 0.0, 0.0], [0.0; 3], false)
-            .unwrap();
-        moved
-            .add_distance(moved.particle_id(30).unwrap(), end, None)
-            .unwrap();
-        for axis in 0..3 {
-            moved.add_fixed_coordinate(end, axis, None).unwrap();
-        }
+        let (held, moved) = (chain_to(30, true), chain_to(30, false));
         let cases = [
             (chain(1), 2, (4, 0, 1)),
             (chain(30), 5, (4, 0, 30)),
@@ -1667,31 +1780,66 @@ mod tests {
             } else {
                 assert_eq!(kept, entries);
             }
-            let mut lu = SparseLu::new(&layout.pattern);
             let n = layout.unknowns();
             let mut rng = Lcg(seed + 100);
             let b: Vec<f64> = (0..n).map(|_| rng.next()).collect();
             for round in 0..3 {
                 let v = values(&layout, seed + round);
                 let x = solve(&mut tree, &v, &b);
-                let y = solve(&mut lu, &v, &b);
-                let scale = y.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-                for i in 0..n {
-                    assert!(
-                        (x[i] - y[i]).abs() <= 1e-12 * scale,
-                        "unknown {i}: tree {} vs sparse LU {}",
-                        x[i],
-                        y[i]
-                    );
+                check_solution(&layout, &v, &b, &x, "one side");
+            }
+        }
+    }
+
+    /// A chain eliminated from both ends (`two_sided.rs`), with the separator anywhere along
+    /// its uniform run, solves as faer's general sparse LU does (to 1e-12 relative, and the
+    /// residual against the matrix): a chain from one anchor, one held by a second anchor, one
+    /// whose far end is moved by constraints (the root side then holds the blocks of 5 and 6 at
+    /// its end), from the matrix in the pattern's order and assembled in place, and three
+    /// factorisations in a row (the storage holds the last one's factors when the next is
+    /// assembled). The chains are far shorter than the default length for two threads: the
+    /// separator is set here.
+    #[test]
+    fn chains_eliminated_from_both_ends_match_sparse_lu() {
+        use crate::integrators::fixtures::chain;
+        // The seeds of the one-sided test's matrices (random matrices of a chain's pattern
+        // can be ill-conditioned: the one-sided elimination's residual is 6e-10 on another).
+        let cases = [
+            (chain(30), 5),
+            (chain_to(30, true), 3),
+            (chain_to(30, false), 9),
+        ];
+        for (system, seed) in &cases {
+            let layout = Layout::new(system, 0);
+            let n = layout.unknowns();
+            let mut rng = Lcg(seed + 100);
+            let b: Vec<f64> = (0..n).map(|_| rng.next()).collect();
+            for (separator, in_place) in [(2, false), (15, false), (27, false), (13, true)] {
+                let mut tree = TreeElimination::analyse(&layout.pattern, 3 * layout.free).unwrap();
+                assert_eq!(tree.separator, 0, "a short chain takes one side");
+                tree.separator = tree.chain_separator(0);
+                assert!(tree.separator > 0, "seed {seed}: a chain");
+                tree.separator = separator;
+                let map = in_place.then(|| tree.assemble_in_place());
+                for round in 0..3 {
+                    let v = values(&layout, seed + round);
+                    let x = match &map {
+                        None => solve(&mut tree, &v, &b),
+                        Some(map) => {
+                            let storage = tree.storage().unwrap();
+                            storage.fill(0.0);
+                            for (slot, &e) in map.iter().enumerate() {
+                                storage[e as usize] = v[slot];
+                            }
+                            assert_eq!(tree.factor_stored().unwrap(), Stored::Factorised);
+                            let mut x = b.clone();
+                            tree.solve_in_place(&mut x);
+                            x
+                        }
+                    };
+                    let what = format!("seed {seed}, separator {separator}, round {round}");
+                    check_solution(&layout, &v, &b, &x, &what);
                 }
-                let p = &layout.pattern;
-                let mut r = b.clone();
-                for (row, col, k) in p.entries() {
-                    r[row] -= v[k] * x[col];
-                }
-                // Relative to the solution's size (x up to 550 on these random matrices).
-                let bound = 1e-12 * scale.max(1.0);
-                assert!(r.iter().all(|e| e.abs() < bound), "residual {r:?}");
             }
         }
     }
