@@ -576,6 +576,86 @@ impl Layout {
             *l -= step * s / sigma;
         }
     }
+
+    /// [`Layout::apply_increment`] on rayon's thread pool (the same numbers), for large models.
+    pub fn apply_increment_parallel(
+        &self,
+        q: &mut [crate::math::Vec3],
+        lambda: &mut [f64],
+        dx: &[f64],
+        scales: &[f64],
+        sigma: f64,
+    ) {
+        use rayon::prelude::*;
+        let m3 = 3 * self.free;
+        let (positions, multipliers) = dx.split_at(m3);
+        rayon::join(
+            || {
+                q.par_iter_mut()
+                    .zip(self.dof.par_iter())
+                    .with_min_len(MIN_TASK)
+                    .for_each(|(qi, &d)| {
+                        if d != NONE {
+                            for k in 0..3 {
+                                qi[k] -= positions[d + k];
+                            }
+                        }
+                    })
+            },
+            || {
+                lambda
+                    .par_iter_mut()
+                    .zip(multipliers.par_iter().zip(scales.par_iter()))
+                    .with_min_len(MIN_TASK)
+                    .for_each(|(l, (&step, &s))| *l -= step * s / sigma)
+            },
+        );
+    }
+
+    /// [`Layout::unknowns_distance`] on rayon's thread pool, for large models: the same
+    /// distance, from a scan of every unknown (infinity when one is beyond `cap` or not a
+    /// number).
+    pub fn unknowns_distance_parallel(
+        &self,
+        (q, lambda): (&[crate::math::Vec3], &[f64]),
+        (scales, sigma): (&[f64], f64),
+        x: &[f64],
+        cap: f64,
+    ) -> f64 {
+        use rayon::prelude::*;
+        let m3 = 3 * self.free;
+        if x.len() != m3 + lambda.len() {
+            return f64::INFINITY;
+        }
+        // NaN counts as infinitely far (f64::max would drop it).
+        let far = |e: f64| if e.is_nan() { f64::INFINITY } else { e };
+        let (positions, multipliers) = rayon::join(
+            || {
+                q.par_iter()
+                    .zip(self.dof.par_iter())
+                    .with_min_len(MIN_TASK)
+                    .map(|(qi, &d)| match d {
+                        NONE => 0.0,
+                        d => (0..3).fold(0.0f64, |m, k| m.max(far((qi[k] - x[d + k]).abs()))),
+                    })
+                    .reduce(|| 0.0, f64::max)
+            },
+            || {
+                lambda
+                    .par_iter()
+                    .zip(scales.par_iter().zip(x[m3..].par_iter()))
+                    .with_min_len(MIN_TASK)
+                    .map(|(l, (s, xk))| far((l * sigma / s - xk).abs()))
+                    .reduce(|| 0.0, f64::max)
+            },
+        );
+        let largest = positions.max(multipliers);
+        if largest <= cap {
+            largest
+        } else {
+            f64::INFINITY
+        }
+    }
 }
 
 /// The first unknown of each particle, 3 per free particle in order (NONE for fixed ones), and

@@ -99,6 +99,8 @@
 //! ([`NewtonProblem::stops_on_increment`]: the index-3 steps, and the GGL steps, whose velocities
 //! are unknowns of their own).
 
+use rayon::prelude::*;
+
 use crate::linear::{assemble_and_factor, LinearSolver, Singular};
 
 /// Options of the Newton loop.
@@ -311,9 +313,31 @@ pub enum NewtonFailure {
     Singular(Singular),
 }
 
-/// The infinity norm of `x`, NaN if any entry is NaN. Four independent running maxima and a
-/// NaN flag, with no early exit, so that the compiler turns the pass into vector instructions.
+/// Entries from which [`inf_norm`] runs on rayon's pool (a model of about 250,000 particles
+/// and their links; a pass over 8 MB or more, where waking the pool costs far less).
+const PARALLEL_NORM_FROM: usize = 1 << 20;
+
+/// The infinity norm of `x`, NaN if any entry is NaN: chunks on rayon's pool for long vectors
+/// (the same number: the largest entry does not depend on the order).
 fn inf_norm(x: &[f64]) -> f64 {
+    if x.len() < PARALLEL_NORM_FROM {
+        return inf_norm_serial(x);
+    }
+    x.par_chunks(1 << 16).map(inf_norm_serial).reduce(
+        || 0.0,
+        |a, b| {
+            if a.is_nan() || b.is_nan() {
+                f64::NAN
+            } else {
+                a.max(b)
+            }
+        },
+    )
+}
+
+/// [`inf_norm`] on this thread. Four independent running maxima and a NaN flag, with no early
+/// exit, so that the compiler turns the pass into vector instructions.
+fn inf_norm_serial(x: &[f64]) -> f64 {
     if x.len() < 8 {
         // A small system (a pendulum's four unknowns): one running maximum, without the
         // setting up and combining of the four lanes.
@@ -859,5 +883,22 @@ mod tests {
         assert!(full_error <= 1e-15, "{full_error}");
         assert!(error <= REUSED_ERROR_SHARE * tolerance, "{error}");
         assert!(modified_error <= tolerance, "{modified_error}");
+    }
+
+    /// The norm of a vector long enough for rayon's pool is the largest magnitude, found
+    /// wherever it lies (the first entry, one in the middle, the last, a chunk's remainder),
+    /// and NaN when any entry is NaN, as on one thread.
+    #[test]
+    fn the_norm_of_a_long_vector_is_its_largest_magnitude_or_nan() {
+        let n = PARALLEL_NORM_FROM + 5;
+        let base: Vec<f64> = (0..n).map(|i| ((i * 7919) % 1000) as f64 * 1e-3).collect();
+        for at in [0, n / 2 + 3, n - 1, n - 3] {
+            let mut x = base.clone();
+            x[at] = -2.5;
+            assert_eq!(inf_norm(&x), 2.5, "largest at {at}");
+            assert_eq!(inf_norm(&x), inf_norm_serial(&x));
+            x[(at + n / 3) % n] = f64::NAN;
+            assert!(inf_norm(&x).is_nan(), "NaN with the largest at {at}");
+        }
     }
 }

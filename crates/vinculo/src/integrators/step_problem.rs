@@ -83,6 +83,15 @@ impl<'a, R: Index3Rule> StepProblem<'a, R> {
     /// Updates v_{n+1} (and the evaluation point, where the rule has one of its own) from the
     /// iterate q.
     pub fn kinematics(&mut self) {
+        if self.parallel.is_some() {
+            self.kinematics_parallel();
+        } else {
+            self.kinematics_serial();
+        }
+    }
+
+    /// [`StepProblem::kinematics`] on this thread.
+    fn kinematics_serial(&mut self) {
         let rule = &self.rule;
         let b = &mut *self.buffers;
         for i in 0..b.q.len() {
@@ -131,11 +140,7 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
     }
 
     fn residual(&mut self, r: &mut [f64]) {
-        if self.parallel.is_some() {
-            self.kinematics_parallel();
-        } else {
-            self.kinematics();
-        }
+        self.kinematics();
         let b = &*self.buffers;
         let (q_eval, v_eval) = Self::eval_point(b);
         let (rule, point) = (&self.rule, self.point);
@@ -220,8 +225,14 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
 
     fn update(&mut self, dx: &[f64]) {
         let b = &mut *self.buffers;
-        self.layout
-            .apply_increment(&mut b.q, &mut b.lambda, dx, self.scales, self.point.sigma);
+        let (scales, sigma) = (self.scales, self.point.sigma);
+        if self.parallel.is_some() {
+            self.layout
+                .apply_increment_parallel(&mut b.q, &mut b.lambda, dx, scales, sigma);
+        } else {
+            self.layout
+                .apply_increment(&mut b.q, &mut b.lambda, dx, scales, sigma);
+        }
     }
 
     /// `ROUND_OFF_ULPS eps max_i sum_j |J_ij| |x_j|` over the scaled unknowns: positions (m) and
@@ -261,8 +272,13 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
     fn distance_from(&self, x: &[f64], cap: f64) -> f64 {
         let b = &*self.buffers;
         let scaling = (self.scales, self.point.sigma);
-        self.layout
-            .unknowns_distance((&b.q, &b.lambda), scaling, x, cap)
+        if self.parallel.is_some() {
+            self.layout
+                .unknowns_distance_parallel((&b.q, &b.lambda), scaling, x, cap)
+        } else {
+            self.layout
+                .unknowns_distance((&b.q, &b.lambda), scaling, x, cap)
+        }
     }
 }
 

@@ -247,6 +247,8 @@ pub struct TreeElimination {
     /// The separator block of a long chain eliminated from both ends on two threads
     /// (`two_sided.rs`), or 0.
     separator: usize,
+    /// With a separator, the local unknown of each global one (`unknowns` inverted).
+    local_of: Vec<u32>,
 }
 
 /// The blocks' storage, one array: the D_b (`diag`), then the A_ub or G_b (`low`), then the
@@ -770,8 +772,9 @@ impl TreeElimination {
             failed: 0,
             pattern_entries: 0,
             separator: 0,
+            local_of: Vec::new(),
         };
-        tree.separator = tree.chain_separator(TWO_SIDED_FROM);
+        tree.two_sided_from(TWO_SIDED_FROM);
         Ok(tree)
     }
 
@@ -1296,13 +1299,16 @@ impl LinearSolver for TreeElimination {
             self.solve_single_block(rhs);
             return;
         }
+        if self.separator > 0 {
+            self.solve_two_sided(rhs);
+            return;
+        }
         let mut z = std::mem::take(&mut self.z);
         for (z, &u) in z.iter_mut().zip(&self.unknowns) {
             *z = rhs[u as usize];
         }
         let n = self.blocks();
         match self.uniform {
-            _ if self.separator > 0 => self.sweeps_two_sided(&mut z),
             3 => self.sweeps_explicit::<3>(&mut z, n),
             4 => self.sweeps_explicit::<4>(&mut z, n),
             5 => self.sweeps_explicit::<5>(&mut z, n),
@@ -1817,8 +1823,7 @@ mod tests {
             for (separator, in_place) in [(2, false), (15, false), (27, false), (13, true)] {
                 let mut tree = TreeElimination::analyse(&layout.pattern, 3 * layout.free).unwrap();
                 assert_eq!(tree.separator, 0, "a short chain takes one side");
-                tree.separator = tree.chain_separator(0);
-                assert!(tree.separator > 0, "seed {seed}: a chain");
+                assert!(tree.two_sided_from(0), "seed {seed}: a chain");
                 tree.separator = separator;
                 let map = in_place.then(|| tree.assemble_in_place());
                 for round in 0..3 {

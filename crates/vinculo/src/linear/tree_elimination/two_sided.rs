@@ -49,6 +49,8 @@
 
 use std::ops::Range;
 
+use rayon::prelude::*;
+
 use super::{lu_in_place, lu_solve, solve_block, Factors, TreeElimination, MAX_BLOCK};
 
 /// Fewest blocks of a chain for its two ends to be eliminated on two threads. Measured on
@@ -80,7 +82,40 @@ impl TreeElimination {
     pub fn two_sided_from(&mut self, from: usize) -> bool {
         self.separator = self.chain_separator(from);
         self.factored = false;
+        // Where each unknown lies in the blocks' order: the solve's result goes back to the
+        // right-hand side's order on two threads.
+        self.local_of = Vec::new();
+        if self.separator > 0 {
+            self.local_of = vec![0; self.unknowns.len()];
+            for (i, &u) in self.unknowns.iter().enumerate() {
+                self.local_of[u as usize] = i as u32;
+            }
+        }
         self.separator > 0
+    }
+
+    /// Solves in place after [`TreeElimination::eliminate_two_sided`]: the right-hand side
+    /// gathered into the blocks' order, the sweeps, and the result put back, each on rayon's
+    /// pool.
+    pub(super) fn solve_two_sided(&mut self, rhs: &mut [f64]) {
+        const CHUNK: usize = 1 << 15;
+        let mut z = std::mem::take(&mut self.z);
+        z.par_chunks_mut(CHUNK)
+            .zip(self.unknowns.par_chunks(CHUNK))
+            .for_each(|(z, unknowns)| {
+                for (z, &u) in z.iter_mut().zip(unknowns) {
+                    *z = rhs[u as usize];
+                }
+            });
+        self.sweeps_two_sided(&mut z);
+        rhs.par_chunks_mut(CHUNK)
+            .zip(self.local_of.par_chunks(CHUNK))
+            .for_each(|(rhs, local)| {
+                for (r, &i) in rhs.iter_mut().zip(local) {
+                    *r = z[i as usize];
+                }
+            });
+        self.z = z;
     }
 
     /// The separator of a chain of blocks eliminated from both ends, or 0: the chain must be
@@ -239,7 +274,7 @@ impl TreeElimination {
     /// The solve's sweeps on the work vector `z` after [`TreeElimination::eliminate_two_sided`]:
     /// each side's forward sweep on its own thread, the separator, then each side's backward
     /// sweep on its own thread.
-    pub(super) fn sweeps_two_sided(&self, z: &mut [f64]) {
+    fn sweeps_two_sided(&self, z: &mut [f64]) {
         match self.uniform {
             3 => self.sweeps_two_sided_sized::<3>(z),
             4 => self.sweeps_two_sided_sized::<4>(z),
