@@ -93,8 +93,11 @@ impl Default for SimulationOptions {
 /// particles a hanging chain's step took 10-27 % less time, a swinging chain's between 18 %
 /// less and 5 % more; at 300,000 the same to 8 % less; at 100,000 and fewer the same or more.
 /// The assembly alone (`benches/kernels.rs`, `assembly`) is 20-27 % faster from 100,000 on, but
-/// it is a quarter to a half of a step and the rest (the linear solve above all) is serial,
+/// it was a quarter to a half of a step and the rest (the linear solve above all) serial,
 /// while the residual's per-element buffers and the threads' wake-ups cost a share of the gain.
+/// Where the assembly is parallel, so are the Newton loop's passes over the unknowns; a chain
+/// of [`crate::linear::TWO_SIDED_FROM`] particles or more is also solved from both ends on two
+/// threads, whatever this option says (`RAYON_NUM_THREADS=1` keeps a run on one thread).
 pub const PARALLEL_FROM: usize = 300_000;
 
 /// Receives progress and may stop a run.
