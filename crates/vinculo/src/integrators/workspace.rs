@@ -405,7 +405,8 @@ pub(crate) mod tests {
     /// A run snapshotted with its factors held in place, saved and loaded, and restored into
     /// a new simulation steps on as the run that went straight on, bit for bit: a swinging
     /// chain under modified Newton, which keeps its factors across steps (26 factorisations in
-    /// 200 steps), so that a restored run that factorised afresh would take other iterates.
+    /// 200 steps), so that a restored run that factorised afresh would take other iterates;
+    /// eliminated from one end and from both (whose root side keeps its blocks' inverses).
     #[test]
     fn a_snapshot_in_place_holds_the_factors() {
         let system = chain(30);
@@ -415,6 +416,15 @@ pub(crate) mod tests {
             ..Default::default()
         };
         options.newton.jacobian_reuse = crate::integrators::JacobianReuse::Always;
+        for two_sided in [None, Some(0)] {
+            TWO_SIDED.with(|t| t.set(two_sided));
+            snapshot_holds_the_factors(&system, &options);
+            TWO_SIDED.with(|t| t.set(None));
+        }
+    }
+
+    fn snapshot_holds_the_factors(system: &System, options: &SimulationOptions) {
+        let system = system.clone();
         released(Some(true), || {
             let mut straight = Simulation::new(&system, &options).unwrap();
             straight.step_to(0.1);
