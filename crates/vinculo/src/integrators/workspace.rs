@@ -424,9 +424,8 @@ pub(crate) mod tests {
     }
 
     fn snapshot_holds_the_factors(system: &System, options: &SimulationOptions) {
-        let system = system.clone();
         released(Some(true), || {
-            let mut straight = Simulation::new(&system, &options).unwrap();
+            let mut straight = Simulation::new(system, options).unwrap();
             straight.step_to(0.1);
             let snapshot = straight.snapshot();
             let held = snapshot.matrix.as_ref().expect("a matrix is held");
@@ -438,7 +437,7 @@ pub(crate) mod tests {
             let loaded = Snapshot::load(&path).unwrap();
             std::fs::remove_file(&path).unwrap();
             for restored in [&snapshot, &loaded] {
-                let mut again = Simulation::new(&system, &options).unwrap();
+                let mut again = Simulation::new(system, options).unwrap();
                 again.step_to(0.05);
                 again.try_restore(restored).unwrap();
                 again.step_to(options.t_end);
