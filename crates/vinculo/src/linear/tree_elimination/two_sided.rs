@@ -51,7 +51,7 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
-use super::{lu_in_place, lu_solve, solve_block, Factors, TreeElimination, MAX_BLOCK};
+use super::{invert_in_place, lu_in_place, solve_block, Factors, TreeElimination, MAX_BLOCK};
 
 /// Fewest blocks of a chain for its two ends to be eliminated on two threads. Measured on
 /// swinging chains (a step, the two-sided elimination against one side, alternated runs): 10 %
@@ -242,14 +242,9 @@ impl TreeElimination {
         let d = &mut own[..nb * nb];
         let perm = &mut side.perm[self.start[b] - s0..][..nb];
         lu_in_place(d, nb, perm).map_err(|j| self.start[b] + j)?;
-        // D_b^-1, kept in D_b's place (module documentation): from its factors, column by
-        // column of the identity.
-        let mut x = [0.0; MAX_BLOCK * MAX_BLOCK];
-        for r in 0..nb {
-            x[nb * r + r] = 1.0;
-        }
-        lu_solve(d, nb, perm, &mut x, nb);
-        d.copy_from_slice(&x[..nb * nb]);
+        // D_b^-1, kept in D_b's place (module documentation).
+        invert_in_place(d, nb, perm);
+        let x = &*d;
         let at = self.coupling_at[c] - c0;
         let (l, u) = (&side.low[at..at + 3 * nc], &side.w[at..at + 3 * nc]);
         // F = E L (3 x n_c), then D_c -= U F.
