@@ -53,6 +53,24 @@ use rayon::prelude::*;
 
 use super::{invert_in_place, lu_in_place, solve_block, Factors, TreeElimination, MAX_BLOCK};
 
+/// `$self.$method(b, nb, nc, args..)` for block `$b` of the root side, of `nb` unknowns, and its
+/// child, of `nc`: constants for equal blocks of 3 to 5 (unrolled copies), else the sizes.
+macro_rules! toward_leaf {
+    ($self:ident . $method:ident ($b:expr $(, $arg:expr)*)) => {{
+        let b = $b;
+        let (nb, nc) = (
+            $self.start[b + 1] - $self.start[b],
+            $self.start[b] - $self.start[b - 1],
+        );
+        match (nb, nc) {
+            (3, 3) => $self.$method(b, 3, 3 $(, $arg)*),
+            (4, 4) => $self.$method(b, 4, 4 $(, $arg)*),
+            (5, 5) => $self.$method(b, 5, 5 $(, $arg)*),
+            _ => $self.$method(b, nb, nc $(, $arg)*),
+        }
+    }};
+}
+
 /// Fewest blocks of a chain for its two ends to be eliminated on two threads. Measured on
 /// swinging chains (a step, the two-sided elimination against one side, alternated runs): 10 %
 /// faster at 300,000 particles (0.074-0.079 against 0.085-0.087 s), the same at 100,000, 6 to
@@ -211,26 +229,17 @@ impl TreeElimination {
     /// updates D_c by -U E L (module documentation). Blocks of the uniform run take a copy
     /// unrolled for their size.
     fn eliminate_toward_leaf(&self, side: &mut RootSide, b: usize) -> Result<(), usize> {
-        let (nb, nc) = (
-            self.start[b + 1] - self.start[b],
-            self.start[b] - self.start[b - 1],
-        );
-        match (nb, nc) {
-            (3, 3) => self.eliminate_toward_leaf_sized(side, b, 3, 3),
-            (4, 4) => self.eliminate_toward_leaf_sized(side, b, 4, 4),
-            (5, 5) => self.eliminate_toward_leaf_sized(side, b, 5, 5),
-            _ => self.eliminate_toward_leaf_sized(side, b, nb, nc),
-        }
+        toward_leaf!(self.eliminate_toward_leaf_sized(b, side))
     }
 
     /// [`TreeElimination::eliminate_toward_leaf`] for blocks b of `nb` unknowns and c of `nc`.
     #[inline(always)]
     fn eliminate_toward_leaf_sized(
         &self,
-        side: &mut RootSide,
         b: usize,
         nb: usize,
         nc: usize,
+        side: &mut RootSide,
     ) -> Result<(), usize> {
         let (d0, c0, s0) = (
             self.diag_at[side.from],
@@ -306,16 +315,7 @@ impl TreeElimination {
     fn forward_toward_leaf(&self, z: &mut [f64], from: usize, blocks: Range<usize>) {
         let mut carry = [0.0; MAX_BLOCK];
         for b in blocks.clone().rev() {
-            let (nb, nc) = (
-                self.start[b + 1] - self.start[b],
-                self.start[b] - self.start[b - 1],
-            );
-            match (nb, nc) {
-                (3, 3) => self.forward_toward_leaf_sized(z, from, b, 3, 3, &mut carry),
-                (4, 4) => self.forward_toward_leaf_sized(z, from, b, 4, 4, &mut carry),
-                (5, 5) => self.forward_toward_leaf_sized(z, from, b, 5, 5, &mut carry),
-                _ => self.forward_toward_leaf_sized(z, from, b, nb, nc, &mut carry),
-            }
+            toward_leaf!(self.forward_toward_leaf_sized(b, z, from, &mut carry));
         }
         if !blocks.is_empty() {
             let c = blocks.start - 1;
@@ -332,11 +332,11 @@ impl TreeElimination {
     #[inline(always)]
     fn forward_toward_leaf_sized(
         &self,
-        z: &mut [f64],
-        from: usize,
         b: usize,
         nb: usize,
         nc: usize,
+        z: &mut [f64],
+        from: usize,
         carry: &mut [f64; MAX_BLOCK],
     ) {
         let s = self.start[b] - self.start[from];
@@ -375,16 +375,7 @@ impl TreeElimination {
         let xc = &z[self.start[c] - z0..self.start[c + 1] - z0];
         x[..xc.len()].copy_from_slice(xc);
         for b in blocks {
-            let (nb, nc) = (
-                self.start[b + 1] - self.start[b],
-                self.start[b] - self.start[b - 1],
-            );
-            match (nb, nc) {
-                (3, 3) => self.backward_toward_leaf_sized(z, from, b, 3, 3, &mut x),
-                (4, 4) => self.backward_toward_leaf_sized(z, from, b, 4, 4, &mut x),
-                (5, 5) => self.backward_toward_leaf_sized(z, from, b, 5, 5, &mut x),
-                _ => self.backward_toward_leaf_sized(z, from, b, nb, nc, &mut x),
-            }
+            toward_leaf!(self.backward_toward_leaf_sized(b, z, from, &mut x));
         }
     }
 
@@ -393,11 +384,11 @@ impl TreeElimination {
     #[inline(always)]
     fn backward_toward_leaf_sized(
         &self,
-        z: &mut [f64],
-        from: usize,
         b: usize,
         nb: usize,
         nc: usize,
+        z: &mut [f64],
+        from: usize,
         x: &mut [f64; MAX_BLOCK],
     ) {
         let at = self.coupling_at[b - 1];
