@@ -9,6 +9,14 @@ of one step and a run of ``1 + k`` steps are timed (each in its own process, the
 ``--repeat`` such processes: one run's time varies by about 10 % here), and a step costs
 ``(T(1 + k) - T(1)) / k``; the set-up is ``T(1)`` less one step. Peak memory is that of the
 longer run.
+
+The last column puts each step against the machine's memory floor: the time of one read of the
+iteration matrix's storage, ``MATRIX_BYTES_PER_PARTICLE`` bytes a particle of a chain (the tree
+elimination's blocks: a particle and its link, 4 x 4 diagonal entries and two 3 x 4 couplings),
+by numpy on as many threads as the process may use from 64 MB on (the step's own: its
+assembly and, on long chains, its elimination run on every core), the least of five reads, in
+the same process after the run. A factorisation and a solve each read that storage at least
+once; below about 10^5 particles it fits in the caches and the "floor" is theirs.
 """
 
 from __future__ import annotations
@@ -16,10 +24,12 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import resource
 import subprocess
 import sys
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -27,6 +37,31 @@ import vinculo
 from vinculo.bench.models import Chain, build_vinculo
 
 SIZES = (1_000, 10_000, 100_000, 1_000_000)
+
+#: Bytes of iteration-matrix storage a particle of a chain: a block of 4 unknowns (its three
+#: coordinates and the link to its parent) keeps 16 diagonal entries and two 3 x 4 couplings.
+MATRIX_BYTES_PER_PARTICLE = 8 * (16 + 12 + 12)
+
+
+def memory_floor(n_bytes: int, threads: int | None = None, reads: int = 5) -> float:
+    """The least time of ``reads`` reads of ``n_bytes`` of memory (a sum of float64 over it),
+    split over ``threads`` threads (default: the CPUs this process may use, one below 64 MB),
+    in seconds."""
+    if threads is None:
+        # One thread below 64 MB, where starting the others costs more than the read.
+        cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else 1
+        threads = cpus if n_bytes >= 1 << 26 else 1
+    data = np.ones(max(1, n_bytes // 8))
+    parts = np.array_split(data, threads)
+    best = math.inf
+    with ThreadPoolExecutor(max_workers=threads) as pool:
+        for _ in range(reads):
+            start = time.perf_counter()
+            total = sum(pool.map(np.sum, parts))
+            best = min(best, time.perf_counter() - start)
+    if total != data.size:  # every entry was read
+        raise RuntimeError(f"memory floor: read {total} of {data.size} entries")
+    return best
 
 
 def steps_for(n: int) -> int:
@@ -42,13 +77,16 @@ def one(n: int, hanging: bool = True, count: int = 1) -> dict[str, float | str]:
     solution = vinculo.simulate(system, t_end=model.t_end, dt=model.dt, save_every=count)
     seconds = time.perf_counter() - start
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    residuals, solver = solution.residual_evaluations / count, solution.linear_solver
+    del solution, system
     return {
+        "floor": memory_floor(n * MATRIX_BYTES_PER_PARTICLE),
         "n": n,
         "seconds": seconds,
         # A run total (only the first and last states are stored).
-        "residuals": solution.residual_evaluations / count,
+        "residuals": residuals,
         "peak_mb": peak_mb,
-        "solver": solution.linear_solver,
+        "solver": solver,
     }
 
 
@@ -84,7 +122,7 @@ def run(sizes: tuple[int, ...] = SIZES, hanging: bool = True, out=print,
     )
     out(
         f"{'N':>9} {'steps':>6} {'s/step':>11} {'us/particle':>12} {'set-up s':>9} "
-        f"{'res./step':>11} {'peak MB':>9}  solver"
+        f"{'res./step':>11} {'peak MB':>9} {'floor s':>10} {'floors':>7}  solver"
     )
     points = []
     for n in sizes:
@@ -96,7 +134,8 @@ def run(sizes: tuple[int, ...] = SIZES, hanging: bool = True, out=print,
         out(
             f"{n:>9} {r['steps']:>6} {r['seconds_per_step']:>11.4e} "
             f"{1e6 * r['seconds_per_step'] / n:>12.3f} {r['setup']:>9.3f} {r['residuals']:>11.2f} "
-            f"{r['peak_mb']:>9.0f}  {r['solver']}"
+            f"{r['peak_mb']:>9.0f} {r['floor']:>10.2e} {r['seconds_per_step'] / r['floor']:>7.1f}"
+            f"  {r['solver']}"
         )
         points.append((math.log(n), math.log(r["seconds_per_step"])))
     if len(points) < 2:
