@@ -81,7 +81,7 @@ impl<'a, R: Index3Rule> StepProblem<'a, R> {
     }
 
     /// Updates v_{n+1} (and the evaluation point, where the rule has one of its own) from the
-    /// iterate q.
+    /// iterate q: on rayon's pool where the assembly is parallel.
     pub fn kinematics(&mut self) {
         if self.parallel.is_some() {
             self.kinematics_parallel();
