@@ -1810,6 +1810,20 @@ mod tests {
         s
     }
 
+    /// A chain of `n` particles joined by spring-dampers alone, the first to a fixed anchor: a
+    /// chain of blocks of 3 (a particle, no multiplier) coupled by the forces' Jacobians.
+    fn spring_chain(n: usize) -> System {
+        let mut s = System::new([0.0, 0.0, -9.81]);
+        let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
+        for i in 1..=n {
+            let x = [0.1 * i as f64, 0.0, 0.0];
+            let p = s.add_particle(0.1, x, [0.0; 3], false).unwrap();
+            s.add_spring_damper(prev, p, 100.0, 0.5, None).unwrap();
+            prev = p;
+        }
+        s
+    }
+
     /// The solution of `b` with the matrix `v` is the sparse LU's to 1e-12 relative, and its
     /// residual against the matrix below 1e-12 of the solution's size.
     fn check_solution(layout: &Layout, v: &[f64], b: &[f64], x: &[f64], what: &str) {
@@ -1872,7 +1886,7 @@ mod tests {
     /// its uniform run, solves as faer's general sparse LU does (to 1e-12 relative, and the
     /// residual against the matrix): a chain from one anchor, one held by a second anchor, one
     /// whose far end is moved by constraints (the root side then holds the blocks of 5 and 6 at
-    /// its end), from the matrix in the pattern's order and assembled in place, and three
+    /// its end), a chain of springs (blocks of 3), from the matrix in the pattern's order and assembled in place, and three
     /// factorisations in a row (the storage holds the last one's factors when the next is
     /// assembled). The chains are far shorter than the default length for two threads: the
     /// separator is set here.
@@ -1885,6 +1899,7 @@ mod tests {
             (chain(30), 5),
             (chain_to(30, true), 3),
             (chain_to(30, false), 9),
+            (spring_chain(30), 5),
         ];
         for (system, seed) in &cases {
             let layout = Layout::new(system, 0);
