@@ -24,14 +24,14 @@ fn release_above() -> (usize, bool) {
     (RELEASE_PATTERN_ABOVE, true)
 }
 
-/// The length from which a chain's tree elimination takes both ends (tests set it for a
-/// thread, to run short chains as long ones).
-fn two_sided_from() -> usize {
+/// Another length from which a chain's tree elimination takes both ends than the analysis'
+/// [`crate::linear::TWO_SIDED_FROM`]: tests set one for a thread, to run short chains as long
+/// ones (None otherwise).
+fn two_sided_override() -> Option<usize> {
     #[cfg(test)]
-    if let Some(from) = tests::TWO_SIDED.with(|r| r.get()) {
-        return from;
-    }
-    crate::linear::TWO_SIDED_FROM
+    return tests::TWO_SIDED.with(|r| r.get());
+    #[cfg(not(test))]
+    None
 }
 
 /// Matrices, solver and buffers reused by every step of a run (no allocation per step).
@@ -132,7 +132,9 @@ impl StepWorkspace {
             SparseSolver::Auto => {
                 let mut layout = Layout::new(system, 0);
                 TreeElimination::analyse(&layout.pattern, 3 * layout.free).map(|mut tree| {
-                    tree.two_sided_from(two_sided_from());
+                    if let Some(from) = two_sided_override() {
+                        tree.two_sided_from(from);
+                    }
                     // Large trees are assembled into the elimination's own storage.
                     if in_place && layout.pattern.nnz() > above {
                         layout.pattern.release_structure();
@@ -350,11 +352,11 @@ pub(crate) mod tests {
     /// A chain whose tree elimination takes both ends at once (`two_sided.rs`, on two threads)
     /// runs as the one eliminated from one end, to round-off: a swinging chain of 60 links and
     /// a V chain whose singular blocks send factorisations to the sparse LU, the matrix
-    /// gathered or assembled in place, under full and modified Newton. The same iterations (residuals, factorisations,
-    /// fallbacks) and positions within 2e-11 m over 0.1 s: the solves differ by round-off,
-    /// and Newton accepts an iterate anywhere within its tolerance, 1e-10 of the length scale
-    /// (measured: 3.4e-12 m on the V under modified Newton, 0 to 1e-15 m otherwise); the chains'
-    /// time-step errors are about 1e-6 m.
+    /// gathered or assembled in place, under full and modified Newton. The same iterations
+    /// (residuals, factorisations, fallbacks) and positions within 2e-11 m over 0.1 s: the
+    /// solves differ by round-off, and Newton accepts an iterate anywhere within its
+    /// tolerance, 1e-10 of the length scale (measured: 3.4e-12 m on the V under modified
+    /// Newton, 0 to 1e-15 m otherwise); the chains' time-step errors are about 1e-6 m.
     #[test]
     fn chains_eliminated_from_both_ends_run_as_from_one() {
         use crate::integrators::JacobianReuse;

@@ -108,10 +108,11 @@
 //! pendulum against Exudyn (`vinculo.bench`'s model, generalised-alpha at 1 ms, 3.05 residuals,
 //! 2.05 solves and 0.09 factorisations a step): 0.243-0.263 -> 0.217-0.222 us a step
 //! (alternating builds, the least of nine runs each; callgrind: 4,935 -> 4,831 instructions a
-//! step, the inverse made by unrolled copies for blocks of 3 to 5). The elimination's pivot test is the LU's, as before. Blocks
-//! of a chain keep their factors: with inverses (made in [`TreeElimination::make_explicit`]) a
-//! step of a swinging chain of 1,000 particles took 243 against 211 us, and the solve of random
-//! matrices of a chain's pattern lost digits against the sparse LU's.
+//! step, the inverse made by unrolled copies for blocks of 3 to 5). The elimination's pivot
+//! test is the LU's, as before. Blocks of a chain keep their factors: with inverses (made in
+//! [`TreeElimination::make_explicit`]) a step of a swinging chain of 1,000 particles took 243
+//! against 211 us, and the solve of random matrices of a chain's pattern lost digits against
+//! the sparse LU's.
 //!
 //! # Long chains
 //!
@@ -935,13 +936,7 @@ impl TreeElimination {
             // One block (a pendulum's bob and its link): its inverse, which a solve multiplies
             // by (module documentation).
             let n = self.unknowns.len();
-            let (d, perm) = (&mut f.diag[..n * n], &f.perm[..n]);
-            match n {
-                3 => invert_in_place(d, 3, perm),
-                4 => invert_in_place(d, 4, perm),
-                5 => invert_in_place(d, 5, perm),
-                _ => invert_in_place(d, n, perm),
-            }
+            invert_block(&mut f.diag[..n * n], &f.perm[..n]);
         }
         Ok(())
     }
@@ -1233,6 +1228,17 @@ pub(super) fn invert_in_place(d: &mut [f64], n: usize, perm: &[u32]) {
     }
     lu_solve(d, n, perm, &mut x, n);
     d[..n * n].copy_from_slice(&x[..n * n]);
+}
+
+/// [`invert_in_place`] for a block of `perm.len()` unknowns: unrolled copies for blocks of 3
+/// to 5, as [`solve_block`].
+fn invert_block(d: &mut [f64], perm: &[u32]) {
+    match perm.len() {
+        3 => invert_in_place(d, 3, perm),
+        4 => invert_in_place(d, 4, perm),
+        5 => invert_in_place(d, 5, perm),
+        n => invert_in_place(d, n, perm),
+    }
 }
 
 /// z = D^-1 z in place, for a block whose storage holds D^-1 (`invert_in_place`): copies

@@ -253,14 +253,14 @@ impl TreeElimination {
         lu_in_place(d, nb, perm).map_err(|j| self.start[b] + j)?;
         // D_b^-1, kept in D_b's place (module documentation).
         invert_in_place(d, nb, perm);
-        let x = &*d;
+        let inverse = &*d;
         let at = self.coupling_at[c] - c0;
         let (l, u) = (&side.low[at..at + 3 * nc], &side.w[at..at + 3 * nc]);
         // F = E L (3 x n_c), then D_c -= U F.
         let mut f = [0.0; 3 * MAX_BLOCK];
         for r in 0..3 {
             // E's row r: the particle columns of D_b^-1's row r.
-            let e = &x[nb * r..nb * r + 3];
+            let e = &inverse[nb * r..nb * r + 3];
             for j in 0..nc {
                 f[r * nc + j] = e[0] * l[j] + e[1] * l[nc + j] + e[2] * l[2 * nc + j];
             }
