@@ -662,11 +662,13 @@ class System:
         friction_damping: float = 200.0,
         static_dynamic_scale: float = 1.0,
         damping_ramp: float = 0.0,
+        grid: SeabedGrid | None = None,
     ) -> ForceId:
-        """Contact of a line node with a flat seabed at ``z = -depth``, MoorDyn's model
-        (docs/theory/seabed-and-line-loads.md).
+        """Contact of a line node with the seabed, MoorDyn's model: the plane ``z = -depth``,
+        or the heights of ``grid`` (docs/theory/seabed-and-line-loads.md).
 
-        While the node penetrates (``p = -depth - z > 0``) the seabed pushes it up with
+        While the node penetrates (``p = z_b - z > 0``, ``z_b`` the seabed's height under
+        it) the seabed pushes it up (vertically, on a slope too) with
         ``N = d l (kbot p - cbot v_z)``, and friction opposes its sliding velocity ``w`` (or,
         with ``axial_friction``, each of its parts along and across the line):
         ``-mu friction_damping w`` for slow sliding, ``-mu |N| w / |w|`` (Coulomb) once
@@ -696,6 +698,8 @@ class System:
             damping_ramp: penetration (m, >= 0) over which the damping grows linearly from zero
                 to ``cbot``, which smooths the contact for Newton's iteration; 0: MoorDyn's law,
                 full damping from the first touch.
+            grid: a seabed of varying height (MoorDyn's 3D seafloor), shared by the nodes;
+                ``depth`` then places nothing. None: the plane z = -depth.
 
         Returns:
             The force's handle.
@@ -1029,6 +1033,28 @@ class RunResult:
         it, of the ``vinculo.errors`` class the core's error selects, with the partial
         ``vinculo.Solution`` as its ``solution`` attribute and, for a failed user function, the
         user's exception as its ``__cause__``."""
+
+class SeabedGrid:
+    """Heights of the seabed on a grid of x and y ticks (m), bilinear in each cell and held
+    at the edge's height beyond it (MoorDyn's 3D seafloor; build it with
+    :class:`vinculo.mooring.Seafloor`; docs/theory/seabed-and-line-loads.md)."""
+
+    def __init__(self, x: npt.NDArray[np.float64], y: npt.NDArray[np.float64],
+                 z: npt.NDArray[np.float64]) -> None:
+        """``x`` (nx) and ``y`` (ny) strictly increasing, finite ticks; ``z`` (nx, ny) heights.
+
+        Raises:
+            InvalidInputError: ticks not increasing or not finite, heights of another shape
+                or not finite.
+        """
+    def height_and_slope(self, x: float, y: float) -> tuple[float, float, float]:
+        """The height z_b at (x, y) and its slopes dz_b/dx, dz_b/dy."""
+    def heights_at(self, x: list[float], y: list[float]) -> list[float]:
+        """The heights at the points (x[k], y[k]).
+
+        Raises:
+            InvalidInputError: for lists of different lengths.
+        """
 
 class Water:
     """The core's water: a current, linear wave components and a free surface at z = eta

@@ -7,6 +7,7 @@ mod points;
 mod reentry;
 mod run;
 mod run_result;
+mod seabed;
 mod statics;
 mod stepping;
 mod system;
@@ -29,6 +30,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<run::PyRunSettings>()?;
     m.add_class::<run_result::PyRunResult>()?;
     m.add_class::<water::PyWater>()?;
+    m.add_class::<seabed::PySeabedGrid>()?;
     m.add_function(wrap_pyfunction!(run::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(run::time_simulate, m)?)?;
     m.add_function(wrap_pyfunction!(statics::solve_statics, m)?)?;

@@ -3,6 +3,7 @@
 use crate::errors::{invalid, to_py};
 use crate::laws::{scalar, vector};
 use crate::points::PyPoint;
+use crate::seabed::PySeabedGrid;
 use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
@@ -708,8 +709,9 @@ impl PySystem {
         Ok(PyForceId { index: id.0 })
     }
 
-    /// Seabed contact and friction of a line node (MoorDyn's kBot, cBot, friction model).
-    #[pyo3(signature = (node, *, depth, diameter, length, kbot=3.0e6, cbot=3.0e5, tangent=None, friction=0.0, axial_friction=None, friction_damping=200.0, static_dynamic_scale=1.0, damping_ramp=0.0))]
+    /// Seabed contact and friction of a line node (MoorDyn's kBot, cBot, friction model), on
+    /// the plane z = -depth or, with `grid`, on the heights of a `SeabedGrid`.
+    #[pyo3(signature = (node, *, depth, diameter, length, kbot=3.0e6, cbot=3.0e5, tangent=None, friction=0.0, axial_friction=None, friction_damping=200.0, static_dynamic_scale=1.0, damping_ramp=0.0, grid=None))]
     #[allow(clippy::too_many_arguments)]
     fn add_seabed_contact(
         &mut self,
@@ -725,11 +727,13 @@ impl PySystem {
         friction_damping: f64,
         static_dynamic_scale: f64,
         damping_ramp: f64,
+        grid: Option<Bound<'_, PySeabedGrid>>,
     ) -> PyResult<PyForceId> {
         let n = self.particle(node)?;
         let tangent = self.tangent(tangent)?;
         let spec = SeabedSpec {
             depth,
+            grid: grid.map(|g| std::sync::Arc::clone(&g.get().inner)),
             diameter,
             length,
             stiffness: kbot,

@@ -1699,7 +1699,8 @@ fn first_event(
         // [`crate::forces::Force::switch_time`] makes first), looked at here without it.
         .filter(|e| {
             let (i, z) = (e.particle, e.height);
-            ((z - q0[i][2]) > 0.0) != ((z - q1[i][2]) > 0.0)
+            // NaN: a seabed of varying height, which the force's own test looks at.
+            z.is_nan() || ((z - q0[i][2]) > 0.0) != ((z - q1[i][2]) > 0.0)
         })
         .filter_map(|e| {
             forces[e.force]

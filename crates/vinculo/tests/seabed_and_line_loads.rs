@@ -50,6 +50,7 @@ fn node(z: f64, v: [f64; 3], cd: f64, ca: f64) -> (System, ParticleId, (Particle
 fn seabed(friction: SeabedFriction) -> SeabedSpec {
     SeabedSpec {
         depth: DEPTH,
+        grid: None,
         diameter: D,
         length: L,
         stiffness: 3.0e6,

@@ -3,7 +3,10 @@
 - :mod:`vinculo.mooring.moordyn_file`: read a MoorDyn v2 input file into a
   :class:`MoorDynFile` (:func:`read_moordyn`) and write one back (:func:`write_moordyn`).
 - :mod:`vinculo.mooring.catenary`: the elastic catenary with a frictionless seabed in closed
-  form (:func:`solve_catenary`), the reference of the line statics.
+  form (:func:`solve_catenary`; on a sloping seabed :func:`solve_catenary_on_slope`), the
+  reference of the line statics.
+- :mod:`vinculo.mooring.seafloor`: a seabed of varying height, MoorDyn's 3D seafloor
+  (:class:`Seafloor`, :func:`read_seafloor`), which a file names by its SeafloorFile option.
 - :mod:`vinculo.mooring.motion`: the prescribed motion of the coupled (Vessel) points.
 - :mod:`vinculo.mooring.model`: the vinculo model of a file (:func:`build_model`).
 - :mod:`vinculo.mooring.analysis`: :func:`statics` (the static equilibrium: end tensions and
@@ -24,7 +27,13 @@ from typing import Any
 
 from vinculo.mooring.analysis import MooringRun, MooringStatics, run
 from vinculo.mooring.analysis import statics as _statics
-from vinculo.mooring.catenary import CatenarySolution, solve_catenary, weight_in_water
+from vinculo.mooring.catenary import (
+    CatenarySolution,
+    SlopeCatenarySolution,
+    solve_catenary,
+    solve_catenary_on_slope,
+    weight_in_water,
+)
 from vinculo.mooring.model import MooringModel, build_model
 from vinculo.mooring.moordyn_file import (
     FileLine,
@@ -37,6 +46,7 @@ from vinculo.mooring.moordyn_file import (
     write_moordyn,
 )
 from vinculo.mooring.motion import Motion
+from vinculo.mooring.seafloor import Seafloor, read_seafloor
 
 
 class _CallableModule(types.ModuleType):
@@ -75,12 +85,16 @@ __all__ = [
     "MooringRun",
     "MooringStatics",
     "Motion",
+    "Seafloor",
+    "SlopeCatenarySolution",
     "build_model",
     "format_moordyn",
     "parse_moordyn",
     "read_moordyn",
+    "read_seafloor",
     "run",
     "solve_catenary",
+    "solve_catenary_on_slope",
     "statics",
     "weight_in_water",
     "write_moordyn",

@@ -65,7 +65,7 @@ def _line_ends(built: Any, source: Any, positions: np.ndarray) -> list[LineEnd]:
     rows = []
     for k, (row, line) in enumerate(zip(built.file.lines, built.lines, strict=True)):
         force_a, force_b = line.end_forces(source)
-        laid = float(line.laid_length(positions, built.seabed_z))
+        laid = float(line.laid_length(positions, built.seabed_height))
         a, b = built.line_ends(k)
         for end, point, particle, force in (("A", row.attach_a, a, force_a),
                                             ("B", row.attach_b, b, force_b)):

@@ -36,7 +36,8 @@ import numpy as np
 
 from vinculo.errors import InvalidInputError
 
-__all__ = ["CatenarySolution", "solve_catenary", "weight_in_water"]
+__all__ = ["CatenarySolution", "SlopeCatenarySolution", "solve_catenary", "solve_catenary_on_slope",
+           "weight_in_water"]
 
 
 def weight_in_water(mass_per_length: float, diameter: float, density: float = 1025.0,
@@ -301,3 +302,146 @@ def solve_catenary(horizontal_span: float, vertical_span: float, length: float, 
     v_b = vertical_for(h)
     laid = _spans(h, v_b, length, w, ea, seabed_contact)[2]
     return CatenarySolution(x_target, z_target, length, w, ea, h, v_b, laid, seabed_contact)
+
+
+@dataclass(frozen=True)
+class SlopeCatenarySolution:
+    """The equilibrium of an elastic catenary whose anchor lies on a plane seabed sloping up
+    towards the fairlead, MoorDyn's vertical frictionless contact (:func:`solve_catenary_on_slope`).
+
+    Arguments:
+        length: ``L``, the unstretched length (m).
+        weight: ``w``, weight in water per unit unstretched length (N/m).
+        ea: ``EA``, the axial stiffness (N).
+        slope: ``tan(beta)``, the seabed's rise per horizontal metre towards the fairlead.
+        horizontal_tension: ``H``, the same all along the line (N).
+        suspended_length: ``L_S``, the unstretched length off the seabed (m).
+    """
+
+    length: float
+    weight: float
+    ea: float
+    slope: float
+    horizontal_tension: float
+    suspended_length: float
+
+    @property
+    def laid_length(self) -> float:
+        """``L_B = L - L_S``, the unstretched length on the seabed (m)."""
+        return self.length - self.suspended_length
+
+    @property
+    def anchor_vertical_tension(self) -> float:
+        """``V_A = H tan(beta)``: the laid line follows the slope (N, up)."""
+        return self.horizontal_tension * self.slope
+
+    @property
+    def anchor_tension(self) -> float:
+        """``T_A = H / cos(beta)``, the tension all along the laid line (N)."""
+        return math.hypot(self.horizontal_tension, self.anchor_vertical_tension)
+
+    @property
+    def fairlead_vertical_tension(self) -> float:
+        """``V_B = H tan(beta) + w L_S`` (N, up)."""
+        return self.anchor_vertical_tension + self.weight * self.suspended_length
+
+    @property
+    def fairlead_tension(self) -> float:
+        """``sqrt(H^2 + V_B^2)`` (N)."""
+        return math.hypot(self.horizontal_tension, self.fairlead_vertical_tension)
+
+    @property
+    def laid_length_stretched(self) -> float:
+        """The laid line's length along the slope, stretched by ``T_A`` (m)."""
+        return self.laid_length * (1.0 + self.anchor_tension / self.ea)
+
+
+def _slope_spans(h: float, suspended: float, length: float, w: float, ea: float,
+                 slope: float) -> tuple[float, float]:
+    """(X, Z) of a line on a slope with horizontal tension ``h`` and ``suspended`` unstretched
+    length off the seabed."""
+    laid = length - suspended
+    cos_b = 1.0 / math.sqrt(1.0 + slope * slope)
+    tension = h / cos_b
+    along = laid * (1.0 + tension / ea)
+    v0 = h * slope
+    v1 = v0 + w * suspended
+    x = along * cos_b + float(_span_x(h, w, v1, v0, suspended)) + h * suspended / ea
+    z = (along * slope * cos_b + float(_span_z(h, w, v1, v0, suspended))
+         + (v0 * suspended + w * suspended**2 / 2.0) / ea)
+    return x, z
+
+
+def solve_catenary_on_slope(horizontal_span: float, vertical_span: float, length: float,
+                            weight: float, ea: float = math.inf, *, slope: float,
+                            rtol: float = 1e-13) -> SlopeCatenarySolution:
+    """The elastic catenary from an anchor on a plane seabed that rises towards the fairlead
+    by ``slope`` (tan beta; negative: falls), MoorDyn's vertical frictionless contact.
+
+    With a vertical contact force and no friction no horizontal load acts on the line, so its
+    horizontal tension ``H`` is the same all along it; the part on the seabed lies straight up
+    the slope, so its vertical tension is ``H tan(beta)`` and the seabed carries its weight;
+    the suspended part leaves the seabed tangentially, a catenary from ``V_0 = H tan(beta)``
+    to ``V_B = V_0 + w L_S`` (docs/theory/catenary.md, "A sloping seabed"):
+
+    ``X = L_B (1 + T_A/EA) cos(beta) + H/w [asinh(V_B/H) - asinh(V_0/H)] + H L_S / EA``
+
+    ``Z = L_B (1 + T_A/EA) sin(beta) + H/w [sqrt(1 + (V_B/H)^2) - sqrt(1 + (V_0/H)^2)]
+    + (V_0 L_S + w L_S^2 / 2) / EA``
+
+    with ``T_A = H / cos(beta)`` and ``L_B = L - L_S``. For each ``H`` the height ``Z`` grows
+    with ``L_S``, which a bracketed search finds; ``H`` then by a second one on ``X``.
+
+    Arguments:
+        horizontal_span: ``X > 0`` from the anchor to the fairlead (m).
+        vertical_span: ``Z``, the fairlead's height above the anchor (m).
+        length: ``L > 0``, the unstretched length (m).
+        weight: ``w > 0``, the weight in water per unit length (N/m).
+        ea: ``EA > 0`` (N; ``math.inf``: inextensible).
+        slope: tan(beta), the seabed's rise per horizontal metre towards the fairlead.
+        rtol: relative tolerance of the root searches.
+
+    Returns:
+        The tensions and the laid length.
+
+    Raises:
+        InvalidInputError: for arguments out of their domain, or a line that does not lie on
+            the seabed at this configuration (it hangs from the anchor: :func:`solve_catenary`
+            with ``seabed_contact=False``) or lies slack.
+    """
+    for name, value, ok in (("horizontal_span", horizontal_span, horizontal_span > 0.0),
+                            ("length", length, length > 0.0), ("weight", weight, weight > 0.0),
+                            ("ea", ea, ea > 0.0), ("slope", slope, math.isfinite(slope)),
+                            ("vertical_span", vertical_span, math.isfinite(vertical_span))):
+        if not (ok and (math.isfinite(value) or name == "ea")):
+            raise InvalidInputError(
+                f"solve_catenary_on_slope: {name} = {value!r} is out of its domain",
+                name=name, value=value)
+    from scipy.optimize import brentq
+
+    w = float(weight)
+
+    def suspended_for(h: float) -> float:
+        def dz(s: float) -> float:
+            return _slope_spans(h, s, length, w, ea, slope)[1] - vertical_span
+
+        if dz(length) < 0.0:
+            raise InvalidInputError(
+                "solve_catenary_on_slope: the line hangs from its anchor above the seabed "
+                "here (no part of it lies on the slope); use solve_catenary with "
+                "seabed_contact=False", name="length", value=length)
+        if dz(0.0) >= 0.0:
+            return 0.0
+        return brentq(dz, 0.0, length, rtol=rtol, xtol=1e-300, maxiter=500)
+
+    def dx(h: float) -> float:
+        return _slope_spans(h, suspended_for(h), length, w, ea, slope)[0] - horizontal_span
+
+    h_low = w * length * 1e-9
+    if dx(h_low) > 0.0:
+        raise InvalidInputError(
+            "solve_catenary_on_slope: the line is longer than it needs to reach the fairlead "
+            "along the seabed: it lies slack; shorten it", name="length", value=length)
+    h_high = _bracket_up(dx, h_low, w * length)
+    h = brentq(dx, h_low, h_high, rtol=rtol, xtol=1e-300, maxiter=500)
+    return SlopeCatenarySolution(length, w, ea, slope, h, suspended_for(h))

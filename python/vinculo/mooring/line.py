@@ -32,6 +32,7 @@ Example:
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -99,6 +100,8 @@ class Seabed:
             whole sliding velocity, MoorDyn-C's law).
         friction_damping: the slope of the friction at small speeds (N s/m), MoorDyn's FricDamp.
         static_dynamic_scale: static over kinetic friction, MoorDyn's StatDynFricScale.
+        surface: the seabed's heights on a grid (:class:`vinculo.mooring.seafloor.Seafloor`,
+            MoorDyn's 3D seafloor); None: the plane z = -depth of the water.
     """
 
     kbot: float = 3.0e6
@@ -107,6 +110,22 @@ class Seabed:
     axial_friction: float | None = None
     friction_damping: float = 200.0
     static_dynamic_scale: float = 1.0
+    surface: Any = None
+
+    def height(self, water: Water, x: Any, y: Any) -> np.ndarray:
+        """The seabed's height under the points (x, y) (m): the surface's, or ``-depth``.
+
+        Arguments:
+            water: the water (its depth places a flat seabed).
+            x: x coordinates (m).
+            y: y coordinates (m).
+
+        Returns:
+            The heights, of the points' shape.
+        """
+        if self.surface is not None:
+            return self.surface.height(x, y)
+        return np.full(np.broadcast_shapes(np.shape(x), np.shape(y)), -water.depth)
 
 
 @dataclass
@@ -237,23 +256,25 @@ class Line:
                         on_b = on_b + loads.sum(axis=1)
         return on_a, on_b
 
-    def laid_length(self, positions: Any, seabed_z: float) -> float:
+    def laid_length(self, positions: Any, seabed: float | Callable[[Any, Any], Any]) -> float:
         """The length of line lying on the seabed (unstretched).
 
-        A node is on the seabed when it is lower than ``seabed_z`` plus a tenth of the line's
-        diameter (the nodes on it sink into the contact spring, those next to the touchdown
-        point rise above it); the laid length sums the segments whose two nodes are on it, plus
-        half a segment where the line lifts off between two nodes.
+        A node is on the seabed when it touches it, at or below the seabed under it (the nodes
+        on it sink into the contact spring, which carries their weight; those past the
+        touchdown point rise above it); the laid length sums the segments whose two nodes are
+        on it, plus half a segment where the line lifts off between two nodes.
 
         Arguments:
             positions: ``(particles, 3)`` positions (m).
-            seabed_z: the height of the seabed (m).
+            seabed: the height of a flat seabed (m), or a function of x and y giving the
+                heights of a 3D seafloor (:meth:`vinculo.mooring.model.MooringModel.seabed_height`).
 
         Returns:
             The laid length (m, unstretched).
         """
-        z = np.asarray(positions, dtype=float)[self.nodes, 2]
-        down = z <= seabed_z + 0.1 * self.line_type.diameter
+        q = np.asarray(positions, dtype=float)[self.nodes]
+        floor = seabed(q[:, 0], q[:, 1]) if callable(seabed) else seabed
+        down = q[:, 2] <= np.asarray(floor, dtype=float)
         segment = self.unstretched_length / len(self.segments)
         both = int(np.sum(down[:-1] & down[1:]))
         if both == 0:
@@ -279,16 +300,42 @@ def _initial_shape(a: np.ndarray, b: np.ndarray, line_type: LineType, length: fl
     """Positions of the N + 1 nodes: on the closed-form catenary when it exists, else on a
     parabola of arc length ``length`` sagging below the chord; the nodes on the seabed sunk by
     the contact's static penetration w / (kbot d) (their contact force then carries them)."""
+    if seabed is not None and seabed.surface is not None:
+        return _on_surface(a, b, line_type, length, segments, water, seabed)
     nodes = _guess(a, b, line_type, length, segments, water,
                    seabed is not None and min(a[2], b[2]) <= -water.depth + 1e-6)
     if seabed is not None and seabed.kbot > 0.0:
-        from vinculo.mooring.catenary import weight_in_water
-
-        w = weight_in_water(line_type.mass_per_length, line_type.diameter, water.density,
-                            water.gravity)
-        sink = max(w, 0.0) / (seabed.kbot * line_type.diameter)
+        sink = _sink(line_type, water, seabed)
         down = nodes[:, 2] <= -water.depth + 1e-9
         nodes[1:-1, 2] = np.where(down[1:-1], -water.depth - sink, nodes[1:-1, 2])
+    return nodes
+
+
+def _sink(line_type: LineType, water: Water, seabed: Seabed) -> float:
+    """The static penetration w / (kbot d) of a line lying on the seabed (m)."""
+    from vinculo.mooring.catenary import weight_in_water
+
+    if seabed.kbot <= 0.0:
+        return 0.0
+    w = weight_in_water(line_type.mass_per_length, line_type.diameter, water.density,
+                        water.gravity)
+    return max(w, 0.0) / (seabed.kbot * line_type.diameter)
+
+
+def _on_surface(a: np.ndarray, b: np.ndarray, line_type: LineType, length: float,
+                segments: int, water: Water, seabed: Seabed) -> np.ndarray:
+    """The nodes of :func:`_initial_shape` over a 3D seafloor: the catenary (or parabola) of a
+    flat seabed at the lower end's height, kept above the seafloor (the nodes it would bury
+    lie on it, sunk by the static penetration)."""
+    low = min(a[2], b[2])
+    under = seabed.height(water, np.array([a[0], b[0]]), np.array([a[1], b[1]]))
+    touching = bool(np.any(np.array([a[2], b[2]]) <= under + 1e-6))
+    flat = Water(depth=-low, density=water.density, gravity=water.gravity)
+    nodes = _guess(a, b, line_type, length, segments, flat, touching)
+    floor = seabed.height(water, nodes[:, 0], nodes[:, 1])
+    down = nodes[:, 2] <= floor + 1e-9
+    nodes[1:-1, 2] = np.where(down[1:-1], floor[1:-1] - _sink(line_type, water, seabed),
+                              nodes[1:-1, 2])
     return nodes
 
 
@@ -337,7 +384,8 @@ def add_line(system: Any, end_a: int, end_b: int, line_type: LineType,
         unstretched_length: its unstretched length (m), or a law of time (a winch: every
             segment keeps its share, 1 / segments, of the law's length).
         segments: the number of segments N (>= 1).
-        water: the water (depth, density, gravity; the seabed at z = -depth).
+        water: the water (depth, density, gravity; the seabed at z = -depth unless the
+            seabed has a surface of its own).
         seabed: the seabed contact (None: the line does not touch the seabed).
         name: a name for messages.
 
@@ -410,7 +458,8 @@ def add_line(system: Any, end_a: int, end_b: int, line_type: LineType,
                 node, depth=water.depth, diameter=line_type.diameter, length=piece,
                 kbot=seabed.kbot, cbot=seabed.cbot, tangent=tangent, friction=seabed.friction,
                 axial_friction=seabed.axial_friction, friction_damping=seabed.friction_damping,
-                static_dynamic_scale=seabed.static_dynamic_scale))
+                static_dynamic_scale=seabed.static_dynamic_scale,
+                grid=None if seabed.surface is None else seabed.surface.core))
         if end:
             system.add_force(node, tuple(float(c) for c in 0.5 * mass * gravity))
     load = line_type.mass_per_length * 0.5 * segment * gravity

@@ -22,6 +22,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from vinculo._core import ParticleId, System
 from vinculo.errors import InvalidInputError
 from vinculo.mooring.moordyn_file import (
@@ -53,7 +55,8 @@ def water(options: FileOptions) -> Any:
 
 
 def seabed(options: FileOptions) -> Any:
-    """The seabed of a file's OPTIONS (MoorDyn's kBot, cBot and friction settings).
+    """The seabed of a file's OPTIONS (MoorDyn's kBot, cBot and friction settings, and its 3D
+    seafloor when the file names one).
 
     Arguments:
         options: the options.
@@ -66,7 +69,8 @@ def seabed(options: FileOptions) -> Any:
     return Seabed(kbot=options.kbot, cbot=options.cbot, friction=options.friction,
                   axial_friction=options.axial_friction,
                   friction_damping=options.friction_damping,
-                  static_dynamic_scale=options.static_dynamic_scale)
+                  static_dynamic_scale=options.static_dynamic_scale,
+                  surface=options.seafloor)
 
 
 @dataclass
@@ -92,8 +96,25 @@ class MooringModel:
 
     @property
     def seabed_z(self) -> float:
-        """The height of the flat seabed, ``-depth`` (m)."""
+        """The height of the flat seabed, ``-depth`` (m; the water depth's level under a 3D
+        seafloor, whose heights :meth:`seabed_height` gives)."""
         return -self.file.options.depth
+
+    def seabed_height(self, x: Any, y: Any) -> np.ndarray:
+        """The seabed's height under the points (x, y) (m): the 3D seafloor's, or ``-depth``.
+
+        Arguments:
+            x: x coordinates (m).
+            y: y coordinates (m).
+
+        Returns:
+            The heights, of the points' shape.
+        """
+        floor = self.file.options.seafloor
+        if floor is not None:
+            return floor.height(x, y)
+        shape = np.broadcast_shapes(np.shape(x), np.shape(y))
+        return np.full(shape, self.seabed_z)
 
     def line_ends(self, k: int) -> tuple[int, int]:
         """The particle indices of the two ends of line ``k`` (0-based).

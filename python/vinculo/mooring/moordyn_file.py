@@ -12,8 +12,9 @@ NODE PROPERTIES; attachments Fixed, Coupled/Vessel and Free/Point/Connect), LINE
 (water depth, density, gravity, seabed contact and friction, time step and MoorDyn's own
 simulation settings) and OUTPUTS (kept for writing back). What is not supported yet raises a
 :class:`~vinculo.errors.MooringFileError` that names the file, the line and the field: rods,
-bodies, failures, external loads, control channels, wave and current kinematics, a bathymetry
-file, non-linear or viscoelastic stiffness, vortex-induced vibration, points attached to bodies.
+bodies, failures, external loads, control channels, wave and current kinematics, MoorDyn-F's
+bathymetry file as WtrDpth (MoorDyn-C's SeafloorFile is read: :mod:`vinculo.mooring.seafloor`),
+non-linear or viscoelastic stiffness, vortex-induced vibration, points attached to bodies.
 
 Units are SI throughout (m, kg, N, s), as in the file.
 """
@@ -26,8 +27,9 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from vinculo.errors import MooringFileError
+from vinculo.errors import InvalidInputError, MooringFileError
 from vinculo.mooring.line import LineType
+from vinculo.mooring.seafloor import Seafloor, read_seafloor
 
 __all__ = [
     "ATTACHMENTS",
@@ -167,6 +169,9 @@ class FileOptions:
             friction (s/m).
         static_dynamic_scale: StatDynFricScale (MoorDyn-F's MC): static over dynamic friction.
         time_step: dtM, MoorDyn's time step (s); None when the file gives none.
+        seafloor: the seabed's heights from the file named by SeafloorFile (MoorDyn's 3D
+            seafloor, :func:`vinculo.mooring.seafloor.read_seafloor`; None: the flat seabed at
+            z = -depth). Without WtrDpth, the depth is the grid's average depth, as MoorDyn's.
         settings: MoorDyn's simulation settings that do not change the model (writeLog,
             tScheme, CFL, dtOut, the initial-condition settings dtIC, TmaxIC, CdScaleIC,
             threshIC, ...), as (key, text) pairs in file order, kept for writing back.
@@ -183,6 +188,7 @@ class FileOptions:
     static_dynamic_scale: float = 1.0
     time_step: float | None = None
     settings: tuple[tuple[str, str], ...] = ()
+    seafloor: Seafloor | None = None
 
 
 @dataclass(frozen=True)
@@ -466,15 +472,31 @@ _UNSUPPORTED_OPTIONS = {
     "wavekin": "wave kinematics",
     "currents": "currents",
     "waterkin": "water kinematics",
-    "seafloorfile": "a bathymetry file",
     "dtwave": "wave kinematics",
     "unifycurrentgrid": None,
 }
 
 
+_OFF = ("0", "0.0", "", "-", '""', "none")
+
+
+def _seafloor(path: str, line: _Line, key: str, text: str) -> Seafloor:
+    """The seafloor file ``text`` of option ``key``: relative to the input file's folder, or
+    to the working directory (where MoorDyn looks)."""
+    given = Path(text.strip('"'))
+    candidates = [given] if given.is_absolute() else [Path(path).parent / given, given]
+    for candidate in candidates:
+        if candidate.is_file():
+            return read_seafloor(candidate)
+    looked = " and ".join(repr(str(c)) for c in dict.fromkeys(candidates))
+    raise _error(path, line.number, key,
+                 f"{text!r}: no such seafloor file (looked for {looked})", text)
+
+
 def _options(path: str, body: list[_Line]) -> FileOptions:
     values: dict[str, float] = {}
     settings: list[tuple[str, str]] = []
+    seafloor: Seafloor | None = None
     for line in body:
         fields = line.text.split()
         if not fields:
@@ -500,13 +522,15 @@ def _options(path: str, body: list[_Line]) -> FileOptions:
             values[name] = value
         elif lower in _SETTINGS:
             settings.append((key, text))
+        elif lower == "seafloorfile":
+            if text.lower() not in _OFF:
+                seafloor = _seafloor(path, line, key, text)
         elif lower in _UNSUPPORTED_OPTIONS:
             what = _UNSUPPORTED_OPTIONS[lower]
             if what is None:
                 settings.append((key, text))
                 continue
-            off = text in ("0", "0.0", "", "-", '""', "none") or (
-                lower == "dtwave")
+            off = text in _OFF or lower == "dtwave"
             if not off:
                 raise _error(path, line.number, key,
                              f"{text!r}: {what} are not supported yet (still water only); "
@@ -516,7 +540,9 @@ def _options(path: str, body: list[_Line]) -> FileOptions:
             known = sorted({*(_MODEL_OPTIONS), *(_SETTINGS)})
             raise _error(path, line.number, key,
                          f"unknown option {key!r}; known options: {', '.join(known)}", key)
-    return FileOptions(**values, settings=tuple(settings))
+    if seafloor is not None and "depth" not in values:
+        values["depth"] = seafloor.mean_depth
+    return FileOptions(**values, settings=tuple(settings), seafloor=seafloor)
 
 
 def parse_moordyn(text: str, path: str | Path = "<text>") -> MoorDynFile:
@@ -660,14 +686,20 @@ def _header(phrase: str) -> str:
 _ATTACHMENT_WORDS = {"fixed": "Fixed", "coupled": "Coupled", "free": "Free"}
 
 
-def format_moordyn(model: MoorDynFile) -> str:
+def format_moordyn(model: MoorDynFile, seafloor_path: str | Path | None = None) -> str:
     """The text of a MoorDyn v2 input file for ``model``.
 
     Arguments:
         model: the model to write.
+        seafloor_path: the seafloor file the text names in SeafloorFile (default: the one the
+            model's seafloor was read from, absolute).
 
     Returns:
         The file's text; :func:`parse_moordyn` reads it back to an equal model.
+
+    Raises:
+        InvalidInputError: for a model with a seafloor built in code and no ``seafloor_path``
+            (:func:`write_moordyn` writes the grid beside the file).
     """
     out = [_header("MoorDyn Input File")]
     out += (model.title or "MoorDyn v2 input file written by vinculo").splitlines()
@@ -717,6 +749,15 @@ def format_moordyn(model: MoorDynFile) -> str:
                              and value == getattr(defaults, attr)):
             continue
         option_lines.append((_g(value), key, description))
+    if o.seafloor is not None:
+        floor = seafloor_path if seafloor_path is not None else o.seafloor.path
+        if floor is None:
+            raise InvalidInputError(
+                "the model's seafloor was built in code and has no file: give seafloor_path "
+                "(write_moordyn writes the grid beside the file)", name="seafloor_path",
+                value=None)
+        option_lines.append((str(Path(floor).resolve()) if seafloor_path is None else str(floor),
+                             "SeafloorFile", "3D seafloor file path"))
     width_v = max((len(v) for v, _, _ in option_lines), default=1)
     width_k = max((len(k) for _, k, _ in option_lines), default=1)
     out += [f"{v.ljust(width_v)}  {k.ljust(width_k)}  {d}".rstrip() for v, k, d in option_lines]
@@ -741,8 +782,14 @@ def write_moordyn(model: MoorDynFile, path: str | Path) -> Path:
         MooringFileError: when the file cannot be written.
     """
     path = Path(path)
+    floor = model.options.seafloor
+    seafloor_path = None
+    if floor is not None and floor.path is None:
+        # A grid built in code: written beside the file, which names it by its file name
+        # (MoorDyn looks in the working directory, vinculo beside the file first).
+        seafloor_path = floor.write(path.with_name(path.stem + "_seafloor.txt")).name
     try:
-        path.write_text(format_moordyn(model), encoding="utf-8")
+        path.write_text(format_moordyn(model, seafloor_path), encoding="utf-8")
     except OSError as exc:
         raise MooringFileError(f"cannot write the MoorDyn file {str(path)!r}: {exc.strerror}",
                                file=str(path), line=None, field=None, value=None) from None

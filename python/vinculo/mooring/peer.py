@@ -154,7 +154,10 @@ def _model_and_file(source: str | Path | MoorDynFile, folder: Path,
     if time_step is not None:
         model = dataclasses.replace(
             model, options=dataclasses.replace(model.options, time_step=float(time_step)))
-    if isinstance(source, MoorDynFile) or time_step is not None:
+    if isinstance(source, MoorDynFile) or time_step is not None or (
+            model.options.seafloor is not None):
+        # Written again: a seafloor file is then named by its absolute path, which MoorDyn
+        # finds from any working directory.
         path = write_moordyn(model, folder / "mooring.txt")
     else:
         path = Path(shutil.copy(source, folder / "mooring.txt"))

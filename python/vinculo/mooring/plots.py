@@ -51,7 +51,13 @@ def plot_shapes(run: Any, path: str | Path, snapshots: int = 6) -> Path:
             shape = positions[i, nodes]
             ax.plot(_horizontal(shape, origin), shape[:, 2], "-", color=colour, lw=1.2,
                     label=f"t = {times[i]:.3g} s")
-        ax.axhline(run.model.seabed_z, color="saddlebrown", lw=1.0, label="seabed")
+        if run.model.file.options.seafloor is None:
+            ax.axhline(run.model.seabed_z, color="saddlebrown", lw=1.0, label="seabed")
+        else:
+            # The 3D seafloor under the line's first shape, along its horizontal path.
+            first = positions[picks[0], nodes]
+            ax.plot(_horizontal(first, origin), run.model.seabed_height(first[:, 0], first[:, 1]),
+                    color="saddlebrown", lw=1.0, label="seabed (under the first shape)")
         ax.set_ylabel("z (m)")
         ax.set_title(f"line {row.id}")
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")

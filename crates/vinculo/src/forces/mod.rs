@@ -31,6 +31,7 @@ mod line_node;
 mod morison;
 mod on_points;
 mod seabed;
+mod seabed_grid;
 mod spring_damper;
 pub mod user;
 
@@ -45,7 +46,8 @@ pub use line_node::LineNode;
 pub(crate) use line_node::{unit_chord, TangentCache};
 pub use morison::{Morison, MorisonSpec};
 pub use on_points::ForceOnPoints;
-pub use seabed::{SeabedContact, SeabedFriction};
+pub use seabed::{SeabedContact, SeabedFriction, SeabedSurface};
+pub use seabed_grid::SeabedGrid;
 pub use spring_damper::SpringDamper;
 pub use user::{ForceGroup, UserForce, UserForces};
 
@@ -230,11 +232,14 @@ impl Force {
     }
 
     /// The particle and the height across which the element switches (a seabed contact's node
-    /// and the seabed: [`Force::switch_time`] is None while the particle stays on one side),
-    /// None for every element whose force is continuous.
+    /// and the seabed: [`Force::switch_time`] is None while the particle stays on one side;
+    /// NaN for a seabed whose height varies, which only [`Force::switch_time`] can tell), None
+    /// for every element whose force is continuous.
     pub fn switch_height(&self) -> Option<(usize, f64)> {
         match self {
-            Force::SeabedContact(f) => Some((f.node.node(), f.seabed_z)),
+            Force::SeabedContact(f) => {
+                Some((f.node.node(), f.seabed.flat_height().unwrap_or(f64::NAN)))
+            }
             _ => None,
         }
     }

@@ -1,13 +1,21 @@
-//! Contact of a line node with a flat seabed at z = z_b (= -depth), with Coulomb friction
-//! regularised as MoorDyn does (`docs/theory/seabed-and-line-loads.md`).
+//! Contact of a line node with the seabed, with Coulomb friction regularised as MoorDyn does
+//! (`docs/theory/seabed-and-line-loads.md`). The seabed is a plane z = z_b (= -depth) or a
+//! surface z = z_b(x, y) given by heights on a grid ([`SeabedGrid`], MoorDyn's 3D seafloor).
 //!
 //! Normal force (MoorDyn: kBot, cBot per unit area; the contact area is the node's projected
 //! area A = d l, d the line's diameter and l the node's length, half a segment each side):
 //!
 //! ```text
-//! p = z_b - z                       penetration (contact while p > 0)
+//! p = z_b(x, y) - z                 penetration (contact while p > 0)
 //! N = A (kBot p - cBot v_z)         f_n = N e_z
 //! ```
+//!
+//! The force is vertical on a sloping seabed too, as MoorDyn's ("vertical-only"): the surface
+//! enters through the penetration alone, dp/dq = (dz_b/dx, dz_b/dy, -1), so that
+//! dN/dq = A kBot dp/dq (the damping ramp's share as well). On a slope the force is therefore
+//! not the gradient of the spring's energy A kBot p^2 / 2 (whose x and y parts it lacks); a
+//! line lying on a frictionless slope keeps its horizontal tension, the contact carrying its
+//! weight (`docs/theory/catenary.md`, the sloping seabed).
 //!
 //! As in MoorDyn the damping acts whenever the node penetrates, in either direction of v_z, so
 //! N may be negative (the seabed holds a node that leaves it fast); friction uses |N|.
@@ -32,12 +40,15 @@
 //! -A cBot v_z in v_z there, exactly as MoorDyn's; the Jacobian is the one of the branch the
 //! state is in (one-sided at the kinks). No regularisation beyond MoorDyn's own.
 //!
-//! Jacobian (contact, the node local 0): dN/dz = -A kBot, dN/dv_z = -A cBot; for each friction
+//! Jacobian (contact, the node local 0): dN/dq = A kBot dp/dq, dN/dv_z = -A cBot; for each friction
 //! part, linear branch df/dw = -mu c_v I, kinetic branch df/dw = -mu |N| (I - u u^T)/|w| with
 //! u = w/|w|, df/dN = -mu sgn(N) u; dw/dv and dw/dt follow from w = t t^T S v or (I - t t^T) S v,
 //! S = diag(1, 1, 0), and dt/dq from [`super::line_node`].
 
+use std::sync::Arc;
+
 use super::line_node::{axial_part_by_tangent, mul, LineNode, Tangent, TangentCache};
+use super::seabed_grid::SeabedGrid;
 use super::Jacobian;
 use crate::local::Rows;
 use crate::math::{add, add_mat, diag, dot, norm, outer, scale, scale_mat, sub, Mat3, Vec3};
@@ -72,13 +83,41 @@ impl SeabedFriction {
     };
 }
 
+/// The seabed's surface: a plane, or heights on a grid shared by every node's contact.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SeabedSurface {
+    /// The plane z = z_b (m; -depth).
+    Flat(f64),
+    /// z = z_b(x, y), bilinear between the heights of a grid.
+    Grid(Arc<SeabedGrid>),
+}
+
+impl SeabedSurface {
+    /// The height z_b under the point q and its slopes dz_b/dx, dz_b/dy.
+    #[inline]
+    pub fn height_and_slope(&self, q: Vec3) -> (f64, f64, f64) {
+        match self {
+            SeabedSurface::Flat(z) => (*z, 0.0, 0.0),
+            SeabedSurface::Grid(grid) => grid.height_and_slope(q[0], q[1]),
+        }
+    }
+
+    /// The height of a flat seabed (None for a grid).
+    pub fn flat_height(&self) -> Option<f64> {
+        match self {
+            SeabedSurface::Flat(z) => Some(*z),
+            SeabedSurface::Grid(_) => None,
+        }
+    }
+}
+
 /// Seabed contact and friction on one line node.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SeabedContact {
     /// The node and the particles of its tangent.
     pub node: LineNode,
-    /// Height of the seabed z_b (m; -depth).
-    pub seabed_z: f64,
+    /// The seabed's surface.
+    pub seabed: SeabedSurface,
     /// Contact area A = d l (m^2).
     pub area: f64,
     /// kBot (Pa/m).
@@ -109,21 +148,28 @@ impl SeabedContact {
         self.node.particles()
     }
 
-    /// Normal force N (N, along +z) with dN/dz and dN/dv_z; None out of contact.
-    fn normal(&self, q: Vec3, v: Vec3) -> Option<(f64, f64, f64)> {
-        let p = self.seabed_z - q[2];
+    /// Normal force N (N, along +z) with dN/dq and dN/dv_z; None out of contact.
+    #[inline]
+    fn normal(&self, q: Vec3, v: Vec3) -> Option<(f64, Vec3, f64)> {
+        let (zb, sx, sy) = self.seabed.height_and_slope(q);
+        let p = zb - q[2];
         if p <= 0.0 {
             return None;
         }
         let a = self.area;
-        let (ramp, dramp_dz) = if p < self.damping_ramp {
-            (p / self.damping_ramp, -1.0 / self.damping_ramp)
+        let (ramp, dramp_dp) = if p < self.damping_ramp {
+            (p / self.damping_ramp, 1.0 / self.damping_ramp)
         } else {
             (1.0, 0.0)
         };
         let n = a * (self.stiffness * p - self.damping * ramp * v[2]);
-        let dn_dz = -a * self.stiffness - a * self.damping * dramp_dz * v[2];
-        Some((n, dn_dz, -a * self.damping * ramp))
+        // dN/dp, times dp/dq = (dz_b/dx, dz_b/dy, -1).
+        let dn_dp = a * self.stiffness - a * self.damping * dramp_dp * v[2];
+        Some((
+            n,
+            [dn_dp * sx, dn_dp * sy, -dn_dp],
+            -a * self.damping * ramp,
+        ))
     }
 
     /// The friction parts (transverse, axial) at velocity v and tangent t.
@@ -229,7 +275,9 @@ impl SeabedContact {
     /// The time is the first root in (0, h] of the height's Taylor polynomial from the start,
     /// z(s) = z0 + v0 s + a0 s^2 / 2 - z_b (its error O(h^3) in z, so that a step to that time
     /// lands within O(h^3) of the seabed), or, when the polynomial does not cross in the step
-    /// although the step did, the chord's root h p0 / (p0 - p1).
+    /// although the step did, the chord's root h p0 / (p0 - p1). Under a sloping seabed z_b is
+    /// its tangent plane at the start, z_b0 + (dz_b/dx, dz_b/dy) . (x(s) - x0, y(s) - y0): the
+    /// root is exact on a plane, and within O(h^2) of the curvature's share elsewhere.
     pub(crate) fn switch_time(
         &self,
         q0: &[Vec3],
@@ -239,11 +287,19 @@ impl SeabedContact {
         h: f64,
     ) -> Option<f64> {
         let i = self.node.node();
-        let (p0, p1) = (self.seabed_z - q0[i][2], self.seabed_z - q1[i][2]);
+        let (zb0, sx, sy) = self.seabed.height_and_slope(q0[i]);
+        let zb1 = self.seabed.height_and_slope(q1[i]).0;
+        let (p0, p1) = (zb0 - q0[i][2], zb1 - q1[i][2]);
         if (p0 > 0.0) == (p1 > 0.0) {
             return None;
         }
-        let (c, b, a) = (q0[i][2] - self.seabed_z, v0[i][2], 0.5 * a0[i][2]);
+        // The height above the seabed's tangent plane at the start (exact on a plane).
+        let (v, acc) = (v0[i], a0[i]);
+        let (c, b, a) = (
+            q0[i][2] - zb0,
+            v[2] - sx * v[0] - sy * v[1],
+            0.5 * (acc[2] - sx * acc[0] - sy * acc[1]),
+        );
         let chord = h * p0 / (p0 - p1);
         Some(first_root(a, b, c, h).unwrap_or(chord))
     }
@@ -263,9 +319,11 @@ impl SeabedContact {
     }
 
     /// Energy of the seabed's spring, A kBot p^2 / 2 while the node penetrates (the damping
-    /// and the friction dissipate).
+    /// and the friction dissipate; on a sloping seabed the vertical force is not its gradient,
+    /// module documentation).
     pub(crate) fn potential(&self, q: &[Vec3]) -> f64 {
-        let p = (self.seabed_z - q[self.node.node()][2]).max(0.0);
+        let q = q[self.node.node()];
+        let p = (self.seabed.height_and_slope(q).0 - q[2]).max(0.0);
         0.5 * self.area * self.stiffness * p * p
     }
 
@@ -282,10 +340,12 @@ impl SeabedContact {
         dv: &mut Jacobian,
     ) {
         let i = self.node.node();
-        let Some((n, dn_dz, dn_dvz)) = self.normal(q[i], v[i]) else {
+        let Some((n, dn_dq, dn_dvz)) = self.normal(q[i], v[i]) else {
             return;
         };
-        dq[0][0][2][2] += dn_dz;
+        for (c, d) in dn_dq.iter().enumerate() {
+            dq[0][0][2][c] += d;
+        }
         dv[0][0][2][2] += dn_dvz;
         if !self.friction.acts() {
             return;
@@ -303,7 +363,9 @@ impl SeabedContact {
                 if n != 0.0 {
                     let df_dn = scale(1.0 / n, f);
                     for r in 0..3 {
-                        dq[0][0][r][2] += df_dn[r] * dn_dz;
+                        for (c, d) in dn_dq.iter().enumerate() {
+                            dq[0][0][r][c] += df_dn[r] * d;
+                        }
                         dv[0][0][r][2] += df_dn[r] * dn_dvz;
                     }
                 }
@@ -347,7 +409,7 @@ mod tests {
     fn contact(tangent: Option<[usize; 2]>, friction: SeabedFriction) -> SeabedContact {
         SeabedContact {
             node: LineNode::new(1, tangent),
-            seabed_z: -50.0,
+            seabed: SeabedSurface::Flat(-50.0),
             area: 0.08 * 1.7,
             stiffness: 3.0e6,
             damping: 3.0e5,
@@ -386,7 +448,7 @@ mod tests {
     #[test]
     fn switch_time_is_the_touchdown_of_the_taylor_polynomial() {
         let c = contact(None, SeabedFriction::NONE);
-        let zb = c.seabed_z;
+        let zb = c.seabed.flat_height().unwrap();
         // From 0.5 m above at rest, g = 9.81: touchdown at sqrt(2 0.5 / 9.81) = 0.3193 s.
         let q0 = vec![[0.0; 3], [0.0, 0.0, zb + 0.5], [0.0; 3]];
         let v0 = vec![[0.0; 3]; 3];
@@ -452,6 +514,77 @@ mod tests {
         above[1][2] = -49.9;
         let f = Force::SeabedContact(Box::new(contact(Some([0, 2]), friction(1.0))));
         fd::check(&f, &above, &v, 0.0);
+    }
+
+    /// The contact of `contact` under a seabed of varying height: a twisted (bilinear, not
+    /// planar) cell whose height under the node of `state`, (0.05, 0.1), is -49.999 (the node
+    /// 3 mm in), sloping in x and y there.
+    fn on_grid(tangent: Option<[usize; 2]>, friction: SeabedFriction) -> SeabedContact {
+        let mut c = contact(tangent, friction);
+        let z = [-50.8, -49.6, -50.1, -48.2];
+        // The bilinear height at the node's shares of the cell [-4, 4] x [-4, 4].
+        let (fx, fy) = (4.05 / 8.0, 4.1 / 8.0);
+        let at_node = (1.0 - fx) * (1.0 - fy) * z[0]
+            + (1.0 - fx) * fy * z[1]
+            + fx * (1.0 - fy) * z[2]
+            + fx * fy * z[3];
+        let shift = -49.999 - at_node;
+        let grid = SeabedGrid::new(
+            vec![-4.0, 4.0],
+            vec![-4.0, 4.0],
+            z.iter().map(|h| h + shift).collect(),
+        )
+        .unwrap();
+        c.seabed = SeabedSurface::Grid(Arc::new(grid));
+        c
+    }
+
+    /// Under a sloping seabed the penetration's slopes enter the Jacobian (the normal force's
+    /// row and, through |N|, the friction's): central differences agree on both friction
+    /// branches, with and without a tangent, in the damping ramp and out of contact.
+    #[test]
+    fn jacobian_on_a_sloping_seabed_matches_finite_differences() {
+        let (q, mut v) = state();
+        let c = on_grid(None, SeabedFriction::NONE);
+        let (_, dn_dq, _) = c.normal(q[1], [0.0; 3]).unwrap();
+        assert!(dn_dq[0].abs() > 1e3 && dn_dq[1].abs() > 1e3, "{dn_dq:?}");
+        for vel in [[1e-4, -2e-4, 1e-5], [6.1, -8.2, 0.01]] {
+            v[1] = vel;
+            for tangent in [Some([0, 2]), None] {
+                for mc in [1.0, 1.5] {
+                    let f = Force::SeabedContact(Box::new(on_grid(tangent, friction(mc))));
+                    fd::check(&f, &q, &v, 0.0);
+                }
+            }
+        }
+        v[1] = [0.2, 0.1, -0.3];
+        let mut c = on_grid(Some([0, 2]), friction(1.0));
+        c.damping_ramp = 0.005;
+        fd::check(&Force::SeabedContact(Box::new(c)), &q, &v, 0.0);
+        let mut above = q.clone();
+        above[1][2] = -49.9;
+        let f = Force::SeabedContact(Box::new(on_grid(Some([0, 2]), friction(1.0))));
+        fd::check(&f, &above, &v, 0.0);
+    }
+
+    /// On a planar slope z_b = -50 + 0.3 x, a node moving at 2 m/s along x and falling from
+    /// 0.5 m above it touches down at the root of 0.5 - 0.6 s - 4.905 s^2 (its height above
+    /// the slope): the event time is exact there.
+    #[test]
+    fn switch_time_under_a_slope_is_the_touchdown_on_the_plane() {
+        let mut c = contact(None, SeabedFriction::NONE);
+        let grid = SeabedGrid::new(vec![-100.0, 100.0], vec![0.0], vec![-80.0, -20.0]).unwrap();
+        c.seabed = SeabedSurface::Grid(Arc::new(grid));
+        let q0 = vec![[0.0; 3], [0.0, 0.0, -49.5], [0.0; 3]];
+        let v0 = vec![[0.0; 3], [2.0, 0.0, 0.0], [0.0; 3]];
+        let a0 = vec![[0.0, 0.0, -9.81]; 3];
+        let h = 0.4;
+        let q1 = vec![[0.0; 3], [2.0 * h, 0.0, -49.5 - 4.905 * h * h], [0.0; 3]];
+        let s = c.switch_time(&q0, &v0, &a0, &q1, h).unwrap();
+        let exact = (-0.6 + (0.36f64 + 4.0 * 4.905 * 0.5).sqrt()) / (2.0 * 4.905);
+        assert!((s - exact).abs() < 1e-14, "{s} vs {exact}");
+        // The flat seabed at the start's height (-50) would put it later, at sqrt(0.5 / 4.905).
+        assert!((0.5f64 / 4.905).sqrt() - s > 0.05);
     }
 
     /// At rest without friction the force is minus the gradient of the spring's energy.

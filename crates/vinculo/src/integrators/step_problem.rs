@@ -567,6 +567,7 @@ mod tests {
         // The seabed 0.55 m up: the anchor and the first and last free nodes touch it.
         let spec = SeabedSpec {
             depth: -0.55,
+            grid: None,
             diameter: 0.05,
             length: 0.9,
             stiffness: 3e6,

@@ -4,13 +4,19 @@
 use super::particle::{ForceId, ParticleId};
 use super::System;
 use crate::error::{finite, non_negative, positive, Error, Result};
-use crate::forces::{Force, LineHydro, LineNode, SeabedContact, SeabedFriction};
+use std::sync::Arc;
 
-/// A flat seabed and its contact law, MoorDyn's parameters, for [`System::add_seabed_contact`].
+use crate::forces::SeabedSurface;
+use crate::forces::{Force, LineHydro, LineNode, SeabedContact, SeabedFriction, SeabedGrid};
+
+/// A seabed and its contact law, MoorDyn's parameters, for [`System::add_seabed_contact`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct SeabedSpec {
-    /// Water depth (m): the seabed is the plane z = -depth.
+    /// Water depth (m): the seabed is the plane z = -depth, unless `grid` is given.
     pub depth: f64,
+    /// Heights of a seabed that varies (MoorDyn's 3D seafloor), shared by the nodes; None: the
+    /// plane z = -depth.
+    pub grid: Option<Arc<SeabedGrid>>,
     /// Volume-equivalent diameter d of the line (m, > 0).
     pub diameter: f64,
     /// Length l of line the node stands for (m, > 0; half a segment each side).
@@ -71,7 +77,8 @@ impl System {
         Ok(LineNode::new(i, tangent))
     }
 
-    /// Contact of line node `node` with a flat seabed at z = -depth, with MoorDyn's normal
+    /// Contact of line node `node` with the seabed (the plane z = -depth, or the heights of
+    /// `spec.grid`), with MoorDyn's normal
     /// stiffness and damping per unit area and its regularised Coulomb friction, separate along
     /// and across the line. `tangent` = (a, b): the line's direction at the node is the one
     /// from particle a to particle b (MoorDyn: the node's two neighbours, or the node and its
@@ -97,7 +104,10 @@ impl System {
             });
         }
         let element = SeabedContact {
-            seabed_z: -finite(field("water depth"), spec.depth)?,
+            seabed: match &spec.grid {
+                Some(grid) => SeabedSurface::Grid(Arc::clone(grid)),
+                None => SeabedSurface::Flat(-finite(field("water depth"), spec.depth)?),
+            },
             area: positive(field("diameter"), spec.diameter)?
                 * positive(field("node length"), spec.length)?,
             stiffness: non_negative(field("seabed stiffness kBot"), spec.stiffness)?,
