@@ -201,3 +201,58 @@ def test_moordyn_settles_on_the_slope_where_vinculos_statics_is(tmp_path):
     assert mean[0] == pytest.approx(ours[0], rel=1e-4)
     assert mean[2] == pytest.approx(ours[2], rel=1e-4)
     assert math.isclose(ours[1], 0.0, abs_tol=1e-6)
+
+
+BATHYMETRY = """----- MoorDyn Bathymetry Input File ----
+nGridX 4
+nGridY 2
+       -400.0 -200.0 0.0 100.0
+-50.0   80.0 70.0 60.0 55.0
+ 50.0   80.0 70.0 60.0 55.0
+"""
+
+
+def test_moordyn_f_bathymetry_as_water_depth_is_the_same_seabed(tmp_path):
+    # MoorDyn-F's layout of the grid of seafloors/slope.txt (depths positive down), given as
+    # WtrDpth: the same heights, and the same equilibrium.
+    (tmp_path / "bathymetry.dat").write_text(BATHYMETRY)
+    floor = read_seafloor(tmp_path / "bathymetry.dat")
+    assert floor == read_seafloor(FLOOR)
+    assert floor.layout == "F"
+    text = (DATA / "chain_on_slope.txt").read_text()
+    text = text.replace("75.0          WtrDpth", "bathymetry.dat  WtrDpth").replace(
+        "seafloors/slope.txt  SeafloorFile", "0  SeafloorFile")
+    path = tmp_path / "f.txt"
+    path.write_text(text)
+    model = read_moordyn(path)
+    assert model.options.seafloor == floor
+    assert model.options.depth == pytest.approx(66.25, rel=1e-15)
+    ours = statics(model).ends
+    reference = statics(read_moordyn(DATA / "chain_on_slope.txt")).ends
+    for a, b in zip(ours, reference, strict=True):
+        assert a.force == pytest.approx(b.force, rel=1e-12, abs=1e-9)
+    # Written back for MoorDyn-C: the grid in its layout beside the file.
+    (tmp_path / "out").mkdir()
+    again = read_moordyn(write_moordyn(model, tmp_path / "out" / "c.txt"))
+    assert again.options.seafloor == floor and again.options.seafloor.layout == "C"
+    # Two seafloors (WtrDpth and SeafloorFile) are one too many.
+    shutil.copytree(DATA / "seafloors", tmp_path / "seafloors")
+    both = text.replace("0  SeafloorFile", "seafloors/slope.txt  SeafloorFile")
+    with pytest.raises(MooringFileError, match="a second seafloor"):
+        parse_moordyn(both, path)
+
+
+@pytest.mark.parametrize(("text", "line", "field"), [
+    ("title\nnGridX 2\nnGrid 1\n0 1\n0 5 5\n", 3, "nGridY"),
+    ("title\nnGridX 2\nnGridY 1\n0 1 2\n0 5 5\n", 4, "x ticks"),
+    ("title\nnGridX 2\nnGridY 1\n0 1\n0 5\n", 5, "y depths"),
+    ("title\nnGridX 2\nnGridY 2\n0 1\n0 5 5\n", None, "nGridY"),
+    ("title\nnGridX 2\nnGridY 1\n1 0\n0 5 5\n", 4, "x ticks"),
+    ("title\nnGridX 2.5\nnGridY 1\n0 1\n0 5 5\n", 2, "nGridX"),
+])
+def test_a_malformed_bathymetry_file_names_the_line_and_field(tmp_path, text, line, field):
+    path = tmp_path / "bathymetry.dat"
+    path.write_text(text)
+    with pytest.raises(MooringFileError) as info:
+        read_seafloor(path)
+    assert (info.value.file, info.value.line, info.value.field) == (str(path), line, field)

@@ -12,9 +12,8 @@ NODE PROPERTIES; attachments Fixed, Coupled/Vessel and Free/Point/Connect), LINE
 (water depth, density, gravity, seabed contact and friction, time step and MoorDyn's own
 simulation settings) and OUTPUTS (kept for writing back). What is not supported yet raises a
 :class:`~vinculo.errors.MooringFileError` that names the file, the line and the field: rods,
-bodies, failures, external loads, control channels, wave and current kinematics, MoorDyn-F's
-bathymetry file as WtrDpth (MoorDyn-C's SeafloorFile is read: :mod:`vinculo.mooring.seafloor`),
-non-linear or viscoelastic stiffness, vortex-induced vibration, points attached to bodies.
+bodies, failures, external loads, control channels, wave and current kinematics, non-linear
+or viscoelastic stiffness, vortex-induced vibration, points attached to bodies.
 
 Units are SI throughout (m, kg, N, s), as in the file.
 """
@@ -169,9 +168,11 @@ class FileOptions:
             friction (s/m).
         static_dynamic_scale: StatDynFricScale (MoorDyn-F's MC): static over dynamic friction.
         time_step: dtM, MoorDyn's time step (s); None when the file gives none.
-        seafloor: the seabed's heights from the file named by SeafloorFile (MoorDyn's 3D
-            seafloor, :func:`vinculo.mooring.seafloor.read_seafloor`; None: the flat seabed at
-            z = -depth). Without WtrDpth, the depth is the grid's average depth, as MoorDyn's.
+        seafloor: the seabed's heights from the file named by SeafloorFile (MoorDyn-C's 3D
+            seafloor) or given as WtrDpth (MoorDyn-F's bathymetry file)
+            (:func:`vinculo.mooring.seafloor.read_seafloor`; None: the flat seabed at
+            z = -depth). Without a numeric WtrDpth, the depth is the grid's average depth, as
+            MoorDyn's.
         settings: MoorDyn's simulation settings that do not change the model (writeLog,
             tScheme, CFL, dtOut, the initial-condition settings dtIC, TmaxIC, CdScaleIC,
             threshIC, ...), as (key, text) pairs in file order, kept for writing back.
@@ -513,9 +514,13 @@ def _options(path: str, body: list[_Line]) -> FileOptions:
                 try:
                     float(text)
                 except ValueError:
-                    raise _error(path, line.number, key,
-                                 f"{text!r}: a bathymetry file as the water depth is not "
-                                 f"supported yet; give the depth in m", text) from None
+                    # MoorDyn-F's bathymetry file in place of the depth.
+                    if seafloor is not None:
+                        raise _error(path, line.number, key, f"{text!r}: a second seafloor "
+                                     f"(SeafloorFile gives one); give one of them",
+                                     text) from None
+                    seafloor = _seafloor(path, line, key, text)
+                    continue
             value = _number(path, line, key, text)
             _positive(path, line, key, value,
                       allow_zero=name not in ("depth", "density", "gravity", "time_step"))
@@ -524,6 +529,9 @@ def _options(path: str, body: list[_Line]) -> FileOptions:
             settings.append((key, text))
         elif lower == "seafloorfile":
             if text.lower() not in _OFF:
+                if seafloor is not None:
+                    raise _error(path, line.number, key, f"{text!r}: a second seafloor "
+                                 f"(WtrDpth gives one); give one of them", text)
                 seafloor = _seafloor(path, line, key, text)
         elif lower in _UNSUPPORTED_OPTIONS:
             what = _UNSUPPORTED_OPTIONS[lower]
@@ -698,7 +706,8 @@ def format_moordyn(model: MoorDynFile, seafloor_path: str | Path | None = None) 
         The file's text; :func:`parse_moordyn` reads it back to an equal model.
 
     Raises:
-        InvalidInputError: for a model with a seafloor built in code and no ``seafloor_path``
+        InvalidInputError: for a model with a seafloor built in code (or read from MoorDyn-F's
+            bathymetry file, which MoorDyn-C does not read) and no ``seafloor_path``
             (:func:`write_moordyn` writes the grid beside the file).
     """
     out = [_header("MoorDyn Input File")]
@@ -750,7 +759,8 @@ def format_moordyn(model: MoorDynFile, seafloor_path: str | Path | None = None) 
             continue
         option_lines.append((_g(value), key, description))
     if o.seafloor is not None:
-        floor = seafloor_path if seafloor_path is not None else o.seafloor.path
+        floor = seafloor_path if seafloor_path is not None else (
+            o.seafloor.path if o.seafloor.layout == "C" else None)
         if floor is None:
             raise InvalidInputError(
                 "the model's seafloor was built in code and has no file: give seafloor_path "
@@ -784,7 +794,7 @@ def write_moordyn(model: MoorDynFile, path: str | Path) -> Path:
     path = Path(path)
     floor = model.options.seafloor
     seafloor_path = None
-    if floor is not None and floor.path is None:
+    if floor is not None and (floor.path is None or floor.layout != "C"):
         # A grid built in code: written beside the file, which names it by its file name
         # (MoorDyn looks in the working directory, vinculo beside the file first).
         seafloor_path = floor.write(path.with_name(path.stem + "_seafloor.txt")).name

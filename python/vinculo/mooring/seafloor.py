@@ -5,9 +5,9 @@ x and y ticks and is bilinear in each cell; beyond the grid it keeps the height 
 edge. The line nodes' seabed contact is MoorDyn's: vertical, with the penetration
 z_b(x, y) - z (``docs/theory/seabed-and-line-loads.md``).
 
-MoorDyn's file format (MoorDyn-C 2.x): the first line holds the numbers of ticks ``nx ny``,
-the second the ``nx`` x ticks, the third the ``ny`` y ticks, then one line ``x y z`` for each
-grid point (any order), z the seabed's height there::
+MoorDyn-C's file format (its ``SeafloorFile`` option): the first line holds the numbers of
+ticks ``nx ny``, the second the ``nx`` x ticks, the third the ``ny`` y ticks, then one line
+``x y z`` for each grid point (any order), z the seabed's height there::
 
     3 2
     -100.0 0.0 100.0
@@ -15,9 +15,20 @@ grid point (any order), z the seabed's height there::
     -100.0 -50.0 -60.0
     ...
 
-:func:`read_seafloor` reads such a file (every grid point once; a line whose x or y is not a
-tick, a missing or repeated point, or a value that is not a number is an error naming the file,
-the line and the field); :meth:`Seafloor.write` writes one.
+MoorDyn-F's bathymetry file (given as its ``WtrDpth``): a title line, ``nGridX nx``,
+``nGridY ny``, a line of the ``nx`` x ticks, then ``ny`` lines each of a y tick and the
+``nx`` water depths along it (positive down: z = -depth)::
+
+    ----- MoorDyn Bathymetry Input File ----
+    nGridX 2
+    nGridY 2
+           -1500 900
+    -1200   1000 700
+     1200   1000 700
+
+:func:`read_seafloor` reads either (every grid point once; a line whose x or y is not a tick, a
+missing or repeated point, or a value that is not a number is an error naming the file, the
+line and the field); :meth:`Seafloor.write` writes MoorDyn-C's.
 """
 
 from __future__ import annotations
@@ -44,6 +55,8 @@ class Seafloor:
         y: the ``ny`` y ticks (m), strictly increasing.
         z: the ``(nx, ny)`` heights of the seabed at the grid points (m).
         path: the file it was read from (None when built in code).
+        layout: the file's layout, ``"C"`` (MoorDyn-C's SeafloorFile) or ``"F"`` (MoorDyn-F's
+            bathymetry file).
 
     Raises:
         InvalidInputError: for ticks that are not finite and strictly increasing, heights of
@@ -54,6 +67,7 @@ class Seafloor:
     y: np.ndarray
     z: np.ndarray
     path: Path | None = None
+    layout: str = "C"
     _core: Any = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -189,6 +203,10 @@ def read_seafloor(path: str | Path) -> Seafloor:
         raise MooringFileError(f"cannot read the seafloor file {name!r}: {exc.strerror}",
                                file=name, line=None, field=None, value=None) from None
     rows = [(k + 1, ln.split()) for k, ln in enumerate(text.splitlines()) if ln.strip()]
+    heading = next((k for k, (_, fields) in enumerate(rows[:3])
+                    if fields[0].lower() == "ngridx"), None)
+    if heading is not None:
+        return _read_bathymetry(path, rows[heading:])
     if len(rows) < 4:
         raise MooringFileError(
             f"{name}: a seafloor file holds 'nx ny', the x ticks, the y ticks and a line "
@@ -252,3 +270,51 @@ def read_seafloor(path: str | Path) -> Seafloor:
     except InvalidInputError as exc:  # pragma: no cover - the checks above come first
         raise MooringFileError(f"{name}: {exc}", file=name, line=None, field=None,
                                value=None) from None
+
+
+def _read_bathymetry(path: Path, rows: list[tuple[int, list[str]]]) -> Seafloor:
+    """MoorDyn-F's bathymetry file from its ``nGridX`` line on (module documentation)."""
+    name = str(path)
+    counts = []
+    for k, key in enumerate(("nGridX", "nGridY")):
+        if len(rows) <= k or rows[k][1][0].lower() != key.lower() or len(rows[k][1]) < 2:
+            number = rows[k][0] if len(rows) > k else None
+            raise MooringFileError(
+                f"{name}{f', line {number}' if number else ''}: {key}: give '{key} n', the "
+                f"number of grid lines", file=name, line=number, field=key, value=None)
+        number, fields = rows[k]
+        value = _numbers(name, number, key, fields[1:2])[0]
+        if value < 1 or value != int(value):
+            raise MooringFileError(f"{name}, line {number}: {key}: {fields[1]!r}: give an "
+                                   f"integer >= 1", file=name, line=number, field=key,
+                                   value=fields[1])
+        counts.append(int(value))
+    nx, ny = counts
+    if len(rows) != 3 + ny:
+        raise MooringFileError(
+            f"{name}: the x ticks and {ny} rows of a y tick and {nx} depths: the file has "
+            f"{len(rows) - 2} lines after nGridY", file=name, line=None, field="nGridY",
+            value=len(rows) - 2)
+    number, fields = rows[2]
+    if len(fields) != nx:
+        raise MooringFileError(f"{name}, line {number}: x ticks: {len(fields)} values where "
+                               f"nGridX says {nx}", file=name, line=number, field="x ticks",
+                               value=len(fields))
+    x = np.array(_numbers(name, number, "x tick", fields))
+    y, depths = [], []
+    for number, fields in rows[3:]:
+        if len(fields) != nx + 1:
+            raise MooringFileError(
+                f"{name}, line {number}: y depths: {len(fields)} values; give the y tick and "
+                f"the {nx} depths along it", file=name, line=number, field="y depths",
+                value=len(fields))
+        values = _numbers(name, number, "y depths", fields)
+        y.append(values[0])
+        depths.append(values[1:])
+    for axis, ticks, number in (("x", x, rows[2][0]), ("y", np.array(y), rows[3][0])):
+        if np.any(np.diff(ticks) <= 0.0):
+            raise MooringFileError(
+                f"{name}, line {number}: {axis} ticks: give increasing ticks", file=name,
+                line=number, field=f"{axis} ticks", value=ticks.tolist())
+    # Depths are positive down: the seabed's height is -depth; z[i, j] at (x[i], y[j]).
+    return Seafloor(x=x, y=np.array(y), z=-np.array(depths).T, path=path, layout="F")
