@@ -132,6 +132,7 @@ impl SeabedGrid {
     }
 
     /// The height z_b at (x, y) (m).
+    #[inline]
     pub fn height(&self, x: f64, y: f64) -> f64 {
         self.height_and_slope(x, y).0
     }
