@@ -14,6 +14,7 @@ rho g A z and the inertia (m + m_a) z'', m_a = Ca rho A T, the heave RAO is
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 from pathlib import Path
@@ -127,3 +128,16 @@ def test_case_with_a_measured_record_reproduces_it_at_the_buoy(tmp_path):
     case = mb.read_case(case_file)
     np.testing.assert_allclose(case.sea.elevation(t), eta - eta.mean(), atol=1e-10)
     assert case.sea.current.kind == "table"
+
+
+def test_a_mooring_file_with_its_own_current_is_refused(tmp_path):
+    # The case's sea is the water of the whole run; a MoorDyn file's Currents 1 would be a
+    # second current, silently dropped: refused, named.
+    case = mb.read_case(EXAMPLES / "single_line.toml")
+    text = case.mooring.read_text().replace(
+        "------------------------- need this line", "1  Currents\n---------- need this line", 1)
+    (tmp_path / "current_profile.txt").write_text("h\nh\nh\n-100 0.5 0 0\n0 0.5 0 0\n")
+    mooring = tmp_path / case.mooring.name
+    mooring.write_text(text)
+    with pytest.raises(InvalidInputError, match="Currents 1"):
+        mb.build(dataclasses.replace(case, mooring=mooring))

@@ -7,6 +7,8 @@
   reference of the line statics.
 - :mod:`vinculo.mooring.seafloor`: a seabed of varying height, MoorDyn's 3D seafloor
   (:class:`Seafloor`, :func:`read_seafloor`), which a file names by its SeafloorFile option.
+- :mod:`vinculo.mooring.current_profile`: MoorDyn's steady current (``Currents 1``,
+  :func:`read_current_profile`).
 - :mod:`vinculo.mooring.motion`: the prescribed motion of the coupled (Vessel) points.
 - :mod:`vinculo.mooring.model`: the vinculo model of a file (:func:`build_model`).
 - :mod:`vinculo.mooring.analysis`: :func:`statics` (the static equilibrium: end tensions and
@@ -34,6 +36,7 @@ from vinculo.mooring.catenary import (
     solve_catenary_on_slope,
     weight_in_water,
 )
+from vinculo.mooring.current_profile import CurrentProfile, read_current_profile
 from vinculo.mooring.model import MooringModel, build_model
 from vinculo.mooring.moordyn_file import (
     FileLine,
@@ -77,6 +80,7 @@ the module of the equilibrium solver (``vinculo.mooring.statics.solve_statics``)
 
 __all__ = [
     "CatenarySolution",
+    "CurrentProfile",
     "FileLine",
     "FileOptions",
     "FilePoint",
@@ -90,6 +94,7 @@ __all__ = [
     "build_model",
     "format_moordyn",
     "parse_moordyn",
+    "read_current_profile",
     "read_moordyn",
     "read_seafloor",
     "run",

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from vinculo.errors import InvalidInputError, MooringFileError
+from vinculo.mooring.current_profile import PROFILE_FILE, CurrentProfile, read_current_profile
 from vinculo.mooring.line import LineType
 from vinculo.mooring.seafloor import Seafloor, read_seafloor
 
@@ -173,6 +174,8 @@ class FileOptions:
             (:func:`vinculo.mooring.seafloor.read_seafloor`; None: the flat seabed at
             z = -depth). Without a numeric WtrDpth, the depth is the grid's average depth, as
             MoorDyn's.
+        current: the steady current of ``Currents 1``, read from ``current_profile.txt``
+            beside the input file (:mod:`vinculo.mooring.current_profile`; None: still water).
         settings: MoorDyn's simulation settings that do not change the model (writeLog,
             tScheme, CFL, dtOut, the initial-condition settings dtIC, TmaxIC, CdScaleIC,
             threshIC, ...), as (key, text) pairs in file order, kept for writing back.
@@ -190,6 +193,7 @@ class FileOptions:
     time_step: float | None = None
     settings: tuple[tuple[str, str], ...] = ()
     seafloor: Seafloor | None = None
+    current: CurrentProfile | None = None
 
 
 @dataclass(frozen=True)
@@ -471,7 +475,6 @@ _SETTINGS = {
 # switches the feature off and is accepted.
 _UNSUPPORTED_OPTIONS = {
     "wavekin": "wave kinematics",
-    "currents": "currents",
     "waterkin": "water kinematics",
     "dtwave": "wave kinematics",
     "unifycurrentgrid": None,
@@ -494,10 +497,30 @@ def _seafloor(path: str, line: _Line, key: str, text: str) -> Seafloor:
                  f"{text!r}: no such seafloor file (looked for {looked})", text)
 
 
+def _current(path: str, line: _Line, key: str, text: str) -> CurrentProfile | None:
+    """The current of option ``Currents``: none for 0, the profile beside the input file for
+    1 (MoorDyn-C's steady current), an error for the others."""
+    mode = _number(path, line, key, text)
+    if mode == 0.0:
+        return None
+    if mode != 1.0:
+        raise _error(path, line.number, key,
+                     f"{text!r}: only steady currents (1, from {PROFILE_FILE}) are supported "
+                     f"yet, not dynamic or gridded ones; give 0 or 1", text)
+    folder = Path(path).parent if Path(path).is_file() else Path.cwd()
+    profile = folder / PROFILE_FILE
+    if not profile.is_file():
+        raise _error(path, line.number, key,
+                     f"{text!r}: Currents 1 reads {PROFILE_FILE} beside the input file; there "
+                     f"is no {str(profile)!r}", text)
+    return read_current_profile(profile)
+
+
 def _options(path: str, body: list[_Line]) -> FileOptions:
     values: dict[str, float] = {}
     settings: list[tuple[str, str]] = []
     seafloor: Seafloor | None = None
+    current: CurrentProfile | None = None
     for line in body:
         fields = line.text.split()
         if not fields:
@@ -527,6 +550,8 @@ def _options(path: str, body: list[_Line]) -> FileOptions:
             values[name] = value
         elif lower in _SETTINGS:
             settings.append((key, text))
+        elif lower == "currents":
+            current = _current(path, line, key, text)
         elif lower == "seafloorfile":
             if text.lower() not in _OFF:
                 if seafloor is not None:
@@ -550,7 +575,7 @@ def _options(path: str, body: list[_Line]) -> FileOptions:
                          f"unknown option {key!r}; known options: {', '.join(known)}", key)
     if seafloor is not None and "depth" not in values:
         values["depth"] = seafloor.mean_depth
-    return FileOptions(**values, settings=tuple(settings), seafloor=seafloor)
+    return FileOptions(**values, settings=tuple(settings), seafloor=seafloor, current=current)
 
 
 def parse_moordyn(text: str, path: str | Path = "<text>") -> MoorDynFile:
@@ -768,6 +793,8 @@ def format_moordyn(model: MoorDynFile, seafloor_path: str | Path | None = None) 
                 value=None)
         option_lines.append((str(Path(floor).resolve()) if seafloor_path is None else str(floor),
                              "SeafloorFile", "3D seafloor file path"))
+    if o.current is not None:
+        option_lines.append(("1", "Currents", f"steady current from {PROFILE_FILE}"))
     width_v = max((len(v) for v, _, _ in option_lines), default=1)
     width_k = max((len(k) for _, k, _ in option_lines), default=1)
     out += [f"{v.ljust(width_v)}  {k.ljust(width_k)}  {d}".rstrip() for v, k, d in option_lines]
@@ -799,6 +826,9 @@ def write_moordyn(model: MoorDynFile, path: str | Path) -> Path:
         # (MoorDyn looks in the working directory, vinculo beside the file first).
         seafloor_path = floor.write(path.with_name(path.stem + "_seafloor.txt")).name
     try:
+        if model.options.current is not None:
+            # MoorDyn reads the profile of Currents 1 beside the input file.
+            model.options.current.write(path.with_name(PROFILE_FILE))
         path.write_text(format_moordyn(model, seafloor_path), encoding="utf-8")
     except OSError as exc:
         raise MooringFileError(f"cannot write the MoorDyn file {str(path)!r}: {exc.strerror}",

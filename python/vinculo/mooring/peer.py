@@ -155,9 +155,9 @@ def _model_and_file(source: str | Path | MoorDynFile, folder: Path,
         model = dataclasses.replace(
             model, options=dataclasses.replace(model.options, time_step=float(time_step)))
     if isinstance(source, MoorDynFile) or time_step is not None or (
-            model.options.seafloor is not None):
+            model.options.seafloor is not None or model.options.current is not None):
         # Written again: a seafloor file is then named by its absolute path, which MoorDyn
-        # finds from any working directory.
+        # finds from any working directory, and a current profile written beside it.
         path = write_moordyn(model, folder / "mooring.txt")
     else:
         path = Path(shutil.copy(source, folder / "mooring.txt"))
