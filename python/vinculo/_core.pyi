@@ -624,21 +624,26 @@ class System:
         added_mass_coefficient: float,
         density: float = 1000.0,
         fluid_motion: Vector | None = None,
+        in_water: bool = False,
     ) -> ForceId:
         """Fluid forces on a body's centre particle (Morison equation, docs/theory/hydrodynamics.md).
 
         The fluid moves as a rigid body by X_f(t) = fluid_motion: rho V (a_f - g) + Ca rho V a_f
         + 1/2 rho Cd A |u_f - v| (u_f - v), with u_f, a_f the derivatives of X_f; the added mass
-        Ca rho V joins the particle's translational inertia.
+        Ca rho V joins the particle's translational inertia. With ``in_water``, u_f and a_f are
+        the system's water's velocity and local acceleration at the particle (``set_water``:
+        its current and waves; the particle counted as submerged), as a MoorDyn point's.
 
         Arguments:
             particle: the body's reference particle (its centre).
-            volume: displaced volume V (m^3, > 0).
+            volume: displaced volume V (m^3, > 0; >= 0 in water).
             area: frontal area A for the drag (m^2, >= 0).
             drag_coefficient: Cd (>= 0).
             added_mass_coefficient: Ca (>= 0).
             density: fluid density rho (kg/m^3, > 0).
             fluid_motion: X_f(t) (m), numbers or Laws; None: still fluid.
+            in_water: in the system's water instead (then no ``fluid_motion``; the volume may
+                be 0, for drag alone).
 
         Returns:
             The force's handle.

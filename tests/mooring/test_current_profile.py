@@ -95,13 +95,47 @@ def test_currents_other_than_steady_and_a_missing_profile_are_refused(tmp_path):
     assert read_moordyn(tmp_path / "rope.txt").options.current is None
 
 
-def test_a_free_point_with_drag_in_a_current_is_refused(tmp_path):
-    (tmp_path / "current_profile.txt").write_text(HEADER + "-100 0 1.0 0\n0 0 1.0 0\n")
-    text = TAUT.replace("2   Fixed        50.0   0.0  -20.0  0     0       0    0",
-                        "2   Free         50.0   0.0  -20.0  10    0       0.5  0")
-    (tmp_path / "rope.txt").write_text(text)
-    with pytest.raises(MooringFileError, match="point 2: CdA"):
-        statics(tmp_path / "rope.txt")
+BUOY = """--------------------- MoorDyn Input File ------------------------------------
+A 500 kg buoy of 2 m^3 and CdA 1 m^2 on a 50 m tether, neutrally buoyant and without drag
+---------------------- LINE TYPES ----------------------------------------------
+TypeName  Diam   Mass/m   EA     BA/-zeta  EI  Cd   Ca   CdAx  CaAx
+(name)    (m)    (kg/m)   (N)    (N-s/-)   (N-m^2) (-) (-) (-)   (-)
+rope      0.05   {mass}  1.0e9  -1.0      0   0.0  1.0  0.0   0.0
+---------------------- POINTS --------------------------------------------------
+ID  Attachment  X       Y    Z       Mass  Volume  CdA  Ca
+(#) (-)         (m)     (m)  (m)     (kg)  (m^3)   (m^2) (-)
+1   Fixed       0.0     0.0  -100.0  0     0       0    0
+2   Free        0.0     0.0  -50.0   500   2.0     1.0  1.0
+---------------------- LINES ---------------------------------------------------
+ID  LineType  AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
+(#) (name)    (#)      (#)      (m)       (-)      (-)
+1   rope      1        2        50.0      10       -
+---------------------- OPTIONS -------------------------------------------------
+200.0         WtrDpth    water depth (m)
+1             Currents   steady current from current_profile.txt
+------------------------- need this line ---------------------------------------
+""".replace("{mass}", repr(1025.0 * math.pi * 0.05**2 / 4.0))
+
+
+def test_a_buoy_on_its_tether_leans_in_a_current_by_drag_over_buoyancy(tmp_path):
+    # A free point (MoorDyn: volume V, CdA) in a uniform current U on a straight tether: its
+    # drag D = 1/2 rho CdA U^2 and net buoyancy B = (rho V - m) g tilt the tether by
+    # atan(D / B), stretched by sqrt(D^2 + B^2) / EA. Exact in the statics (the tether carries
+    # no load of its own), to 1e-9 m.
+    (tmp_path / "current_profile.txt").write_text(HEADER + "-200 0.5 0 0\n0 0.5 0 0\n")
+    (tmp_path / "buoy.txt").write_text(BUOY)
+    from vinculo.mooring.model import build_model
+
+    built = build_model(tmp_path / "buoy.txt")
+    buoy = np.asarray(built.statics.positions)[built.points[1].index]
+    rho, g = 1025.0, 9.80665
+    drag, lift = 0.5 * rho * 1.0 * 0.5**2, (rho * 2.0 - 500.0) * g
+    length = 50.0 * (1.0 + math.hypot(drag, lift) / 1.0e9)
+    tilt = math.atan2(drag, lift)
+    np.testing.assert_allclose(buoy, [length * math.sin(tilt), 0.0,
+                                      -100.0 + length * math.cos(tilt)], rtol=0, atol=1e-9)
+    ends = statics(tmp_path / "buoy.txt").ends
+    assert ends[1].force == pytest.approx((-drag, 0.0, -lift), rel=1e-9)
 
 
 def test_a_model_in_a_current_is_written_back_with_its_profile(tmp_path):

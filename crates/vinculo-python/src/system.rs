@@ -679,8 +679,9 @@ impl PySystem {
     }
 
     /// Fluid forces on a body's centre: buoyancy and Froude-Krylov, added mass, Morison drag,
-    /// for a fluid moving as a rigid body with displacement `fluid_motion` (3 numbers or Laws).
-    #[pyo3(signature = (particle, *, volume, area, drag_coefficient, added_mass_coefficient, density=1000.0, fluid_motion=None))]
+    /// for a fluid moving as a rigid body with displacement `fluid_motion` (3 numbers or Laws),
+    /// or, with `in_water`, in the system's water (`set_water`: its current and waves).
+    #[pyo3(signature = (particle, *, volume, area, drag_coefficient, added_mass_coefficient, density=1000.0, fluid_motion=None, in_water=false))]
     #[allow(clippy::too_many_arguments)]
     fn add_morison(
         &mut self,
@@ -691,8 +692,16 @@ impl PySystem {
         added_mass_coefficient: f64,
         density: f64,
         fluid_motion: Option<&Bound<'_, PyAny>>,
+        in_water: bool,
     ) -> PyResult<PyForceId> {
         let p = self.particle(particle)?;
+        if in_water && fluid_motion.is_some() {
+            return Err(invalid(
+                "fluid_motion",
+                "a fluid motion with in_water=True",
+                "give one: the fluid's rigid motion or the system's water",
+            ));
+        }
         let fluid = match fluid_motion {
             Some(f) => vector(f, "fluid_motion")?,
             None => vinculo::laws::VectorLaw::constant([0.0; 3]),
@@ -704,6 +713,7 @@ impl PySystem {
             drag_coefficient,
             added_mass_coefficient,
             fluid,
+            in_water,
         };
         let id = self.inner.add_morison(p, spec).map_err(to_py)?;
         Ok(PyForceId { index: id.0 })

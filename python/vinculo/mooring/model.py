@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from vinculo._core import ParticleId, System
-from vinculo.errors import InvalidInputError, MooringFileError
+from vinculo.errors import InvalidInputError
 from vinculo.mooring.moordyn_file import (
     FileOptions,
     MoorDynFile,
@@ -169,14 +169,8 @@ def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, 
     options = model.options
     system = System(gravity=(0.0, 0.0, -options.gravity))
     if options.current is not None:
-        for point in model.points:
-            if point.attachment == "free" and point.cda > 0.0:
-                raise MooringFileError(
-                    f"{model.path or 'the model'}: point {point.id}: CdA: the drag of a free "
-                    f"point in a current (Currents 1) is not supported yet; set its CdA to 0 "
-                    f"or remove the current", file=str(model.path) if model.path else None,
-                    line=None, field="CdA", value=point.cda)
-        # The lines' drag on their velocity relative to the file's steady current.
+        # The lines' and free points' drag on their velocity relative to the file's steady
+        # current.
         system.set_water(options.current.water(options.depth, options.gravity))
     the_water, the_seabed = water(options), seabed(options)
     start = motion.positions(0.0) if motion is not None else None
@@ -204,7 +198,13 @@ def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, 
             coupled_index += 1
             continue
         particle = system.add_particle(mass, point.position)
-        if point.volume > 0.0:
+        if options.current is not None and (point.volume > 0.0 or point.cda > 0.0):
+            # In the file's current: buoyancy, added mass and drag in the system's water.
+            system.add_morison(particle, volume=point.volume, area=point.cda,
+                               drag_coefficient=1.0 if point.cda > 0.0 else 0.0,
+                               added_mass_coefficient=point.ca, density=options.density,
+                               in_water=True)
+        elif point.volume > 0.0:
             system.add_morison(particle, volume=point.volume, area=point.cda,
                                drag_coefficient=1.0 if point.cda > 0.0 else 0.0,
                                added_mass_coefficient=point.ca, density=options.density)

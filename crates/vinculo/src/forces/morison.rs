@@ -18,10 +18,20 @@
 //! Jacobian: the force does not depend on q. With r = u - b' and c = 1/2 rho Cd A,
 //! d(c |r| r)/dr = c (|r| I + r r^T / |r|), and dr/db' = -I, so
 //! df/db' = -c (|r| I + r r^T / |r|) (zero at r = 0, where the drag is C1).
+//!
+//! In the system's water instead ([`MorisonSpec::in_water`]: a MoorDyn point in a current),
+//! u and a are the water's velocity and local acceleration at the particle,
+//! [`crate::water::Water::flow`] (the point counted as submerged), and the force depends on
+//! the particle's position through them: df/db = c (|r| I + r r^T / |r|) du/db
+//! + (1 + Ca) rho V da/db.
 
+use std::sync::Arc;
+
+use super::line_node::mul as mat_mul;
 use super::Jacobian;
 use crate::laws::VectorLaw;
-use crate::math::{add_mat, diag, norm, outer, scale, sub, Vec3};
+use crate::math::{add_mat, diag, norm, outer, scale, scale_mat, sub, Mat3, Vec3};
+use crate::water::Water;
 
 /// The fluid and body data of a [`Morison`] element, as given to
 /// [`System::add_morison`](crate::model::System::add_morison).
@@ -37,8 +47,12 @@ pub struct MorisonSpec {
     pub drag_coefficient: f64,
     /// Added-mass coefficient Ca (>= 0).
     pub added_mass_coefficient: f64,
-    /// Displacement of the fluid X_f(t) (m); a constant law for still fluid.
+    /// Displacement of the fluid X_f(t) (m); a constant law for still fluid. Unused in water.
     pub fluid: VectorLaw,
+    /// In the system's water (its current and waves at the particle,
+    /// [`System::set_water`](crate::model::System::set_water)) instead of the fluid's rigid
+    /// motion; the volume may then be 0 (drag alone).
+    pub in_water: bool,
 }
 
 /// Buoyancy, Froude-Krylov, added mass and drag of a fluid in rigid motion, on one particle.
@@ -60,6 +74,9 @@ pub struct Morison {
     pub fluid: VectorLaw,
     /// Gravity of the system (m/s^2).
     pub gravity: Vec3,
+    /// The system's water, when the element is in it (module documentation); None: the
+    /// fluid's rigid motion `fluid`.
+    pub water: Option<Arc<Water>>,
 }
 
 impl Morison {
@@ -81,8 +98,29 @@ impl Morison {
         0.5 * self.density * self.drag_coefficient * self.area
     }
 
-    pub(crate) fn force(&self, _q: &[Vec3], v: &[Vec3], t: f64) -> [Vec3; 1] {
-        let (_, u, a) = self.fluid.eval(t);
+    /// The fluid's velocity and acceleration at the particle at `q`, time `t`, and their
+    /// gradients (zero for the rigid motion) when asked.
+    #[inline]
+    fn flow(&self, q: Vec3, t: f64, gradients: bool) -> (Vec3, Vec3, Mat3, Mat3) {
+        match &self.water {
+            Some(water) => {
+                let f = water.flow(q, t, gradients);
+                (
+                    f.velocity,
+                    f.acceleration,
+                    f.velocity_gradient,
+                    f.acceleration_gradient,
+                )
+            }
+            None => {
+                let (_, u, a) = self.fluid.eval(t);
+                (u, a, [[0.0; 3]; 3], [[0.0; 3]; 3])
+            }
+        }
+    }
+
+    pub(crate) fn force(&self, q: &[Vec3], v: &[Vec3], t: f64) -> [Vec3; 1] {
+        let (u, a, _, _) = self.flow(q[self.particles[0]], t, false);
         let mf = self.displaced_mass();
         let drag = self.drag_at(u, v[self.particles[0]]);
         let f = std::array::from_fn(|k| {
@@ -93,24 +131,35 @@ impl Morison {
 
     pub(crate) fn add_jacobian(
         &self,
-        _q: &[Vec3],
+        q: &[Vec3],
         v: &[Vec3],
         t: f64,
-        _dq: &mut Jacobian,
+        dq: &mut Jacobian,
         dv: &mut Jacobian,
     ) {
-        let (_, u, _) = self.fluid.eval(t);
-        let r = sub(u, v[self.particles[0]]);
+        let p = self.particles[0];
+        let in_water = self.water.is_some();
+        let (u, _, du, da) = self.flow(q[p], t, in_water);
+        let r = sub(u, v[p]);
         let s = norm(r);
-        if s > 0.0 {
+        // d(drag)/du = c (|r| I + r r^T / |r|) = -d(drag)/db'.
+        let dd_du = if s > 0.0 {
             let c = self.drag_factor();
-            dv[0][0] = add_mat(dv[0][0], add_mat(diag(-c * s), outer(-c / s, r, r)));
+            add_mat(diag(c * s), outer(c / s, r, r))
+        } else {
+            [[0.0; 3]; 3]
+        };
+        dv[0][0] = add_mat(dv[0][0], scale_mat(-1.0, dd_du));
+        if in_water {
+            let inertia = self.displaced_mass() + self.added_mass();
+            let df_dq = add_mat(mat_mul(dd_du, du), scale_mat(inertia, da));
+            dq[0][0] = add_mat(dq[0][0], df_dq);
         }
     }
 
-    /// The drag force alone on a body moving at `v` at time `t`, for output.
-    pub fn drag(&self, v: Vec3, t: f64) -> Vec3 {
-        self.drag_at(self.fluid.eval(t).1, v)
+    /// The drag force alone on a body at `q` moving at `v` at time `t`, for output.
+    pub fn drag(&self, q: Vec3, v: Vec3, t: f64) -> Vec3 {
+        self.drag_at(self.flow(q, t, false).0, v)
     }
 
     /// 1/2 rho Cd A |u - v| (u - v) for fluid velocity `u`.
@@ -140,7 +189,50 @@ mod tests {
                 Law::Constant(0.0),
             ]),
             gravity: [0.0, 0.0, -9.81],
+            water: None,
         }
+    }
+
+    /// A point in water with a sheared current (0.2 m/s at -40 m to 1 m/s at 0, along x and
+    /// y) and a regular wave: its force depends on its position through the flow.
+    fn in_water() -> Morison {
+        use crate::water::{Current, Stretching, WaveSpec};
+        let mut m = element();
+        let current = Current::Table {
+            z: vec![-40.0, 0.0],
+            velocity: vec![[0.2, 0.1, 0.0], [1.0, 0.5, 0.0]],
+        };
+        let wave = WaveSpec {
+            amplitude: 0.4,
+            omega: 0.9,
+            direction: 0.3,
+            phase: 0.2,
+        };
+        let mut water = Water::new(60.0, 9.81, current, &[wave], Stretching::Wheeler).unwrap();
+        water.free_surface = false;
+        m.water = Some(Arc::new(water));
+        m
+    }
+
+    /// In water the Jacobian's position part (through the current's shear and the wave's
+    /// gradients) meets central differences too, on both sides of the drag's kink, and a
+    /// point held still in a uniform current feels 1/2 rho Cd A U^2 along it.
+    #[test]
+    fn in_water_the_jacobian_and_the_drag_follow_the_flow() {
+        let f = Force::Morison(Box::new(in_water()));
+        for v in [[0.03, -0.01, 0.02], [0.9, 0.4, -0.1]] {
+            fd::check(&f, &[[1.0, -2.0, -15.0]], &[v], 1.3);
+        }
+        let mut m = element();
+        let current = crate::water::Current::Uniform([0.5, 0.0, 0.0]);
+        let still = Water::new(60.0, 9.81, current, &[], crate::water::Stretching::Wheeler);
+        m.water = Some(Arc::new(still.unwrap()));
+        let drag = m.drag([3.0, 0.0, -10.0], [0.0; 3], 0.0);
+        let expected = 0.5 * 1000.0 * 0.22 * 7.85e-3 * 0.25;
+        assert!(
+            (drag[0] - expected).abs() < 1e-15 && drag[1] == 0.0,
+            "{drag:?}"
+        );
     }
 
     #[test]
@@ -172,6 +264,6 @@ mod tests {
         for k in 0..3 {
             assert!((f[k] - expected[k]).abs() < 1e-12 * (1.0 + expected[k].abs()));
         }
-        assert_eq!(m.drag(u, t), [0.0; 3]);
+        assert_eq!(m.drag([0.0; 3], u, t), [0.0; 3]);
     }
 }

@@ -84,6 +84,7 @@ pub(crate) fn every_kind() -> System {
                 Law::Constant(0.0),
                 Law::Constant(0.0),
             ]),
+            in_water: false,
         },
     )
     .unwrap();

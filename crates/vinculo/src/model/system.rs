@@ -547,10 +547,16 @@ impl System {
         let i = self.check(p)?;
         let index = self.forces.len();
         let what = |field: &str| format!("{field} of fluid forces #{index} (particle {i})");
+        let volume = if spec.in_water {
+            // In water a point may have drag alone (MoorDyn's point with CdA and no volume).
+            non_negative(what("volume"), spec.volume)?
+        } else {
+            positive(what("volume"), spec.volume)?
+        };
         let element = Morison {
             particles: [i],
             density: positive(what("fluid density"), spec.density)?,
-            volume: positive(what("volume"), spec.volume)?,
+            volume,
             area: non_negative(what("frontal area"), spec.area)?,
             drag_coefficient: non_negative(what("drag coefficient"), spec.drag_coefficient)?,
             added_mass_coefficient: non_negative(
@@ -559,6 +565,7 @@ impl System {
             )?,
             fluid: spec.fluid,
             gravity: self.gravity,
+            water: spec.in_water.then(|| self.water.clone()),
         };
         let element = Force::Morison(Box::new(element));
         self.note_user_laws(element.name(index), element.laws());
@@ -721,6 +728,7 @@ impl System {
         for f in &mut self.forces {
             match f {
                 Force::LineHydro(h) => h.water = self.water.clone(),
+                Force::Morison(m) if m.water.is_some() => m.water = Some(self.water.clone()),
                 Force::FloatingBody(b) => {
                     b.water = self.water.clone();
                     b.default_added_mass(&q);
