@@ -865,6 +865,23 @@ class System:
             InvalidInputError: a constraint that is not such a segment, or not one of this
                 system's.
         """
+    def set_strain_curve(self, constraint: ConstraintId, strains: Sequence[float],
+                         tensions: Sequence[float]) -> None:
+        """Give an elastic segment a tension-strain curve (MoorDyn's nonlinear EA): its
+        tension follows the piecewise linear curve through (strains[k], tensions[k]),
+        continued along its end pieces, instead of Hooke's law; its equation becomes
+        ``Phi + L e(T) = 0`` with the compliance ``L e'(T)`` at the current tension
+        (docs/theory/moorings.md). Its EA is then the curve's stiffest piece's.
+
+        Arguments:
+            constraint: an elastic segment of finite EA between two particles.
+            strains: increasing strains (-).
+            tensions: increasing tensions (N), one per strain.
+
+        Raises:
+            InvalidInputError: fewer than two points, values not finite or not increasing, or
+                a constraint that is not such a segment.
+        """
     def set_axial_damping(self, constraint: ConstraintId, damping: float) -> None:
         """Give an elastic segment internal axial damping: the tension
         ``damping * u . (v_a - v_b)`` along it (``u`` the unit vector from b to a), stretched or

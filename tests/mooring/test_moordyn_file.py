@@ -105,7 +105,7 @@ def _line_of(text: str, needle: str) -> int:
         ("rope      0.08   8.0     1.0e7  -1.0      0   1.2  1.0  0.01  0.0",
          "rope      0.08   8.0     1.0e7  -1.0      0   1.2  1.0  0.01", "CaAx", "needs 10"),
         ("1.0e7  -1.0", "1.0e7|2.0e7  -1.0", "EA", "not supported"),
-        ("1.0e7  -1.0", "ea_table.txt  -1.0", "EA", "non-linear"),
+        ("1.0e7  -1.0", "ea_table.txt  -1.0", "EA", "no such strain-tension file"),
         ("1.0e7  -1.0      0   1.2  1.0  0.01  0.0",
          "1.0e7  -1.0      0   1.2  1.0  0.01  0.0  0.8", "Cl", "vortex"),
         ("1   rope      1        2", "1   chain     1        2", "LineType", "not a line type"),

@@ -985,6 +985,20 @@ impl PySystem {
         self.inner.set_axial_damping(c, damping).map_err(to_py)
     }
 
+    /// Gives an elastic segment a tension-strain curve (MoorDyn's nonlinear EA; see the stub).
+    fn set_strain_curve(
+        &mut self,
+        constraint: &Bound<'_, PyAny>,
+        strains: Vec<f64>,
+        tensions: Vec<f64>,
+    ) -> PyResult<()> {
+        let c = constraint_id(constraint, "System.add_elastic_distance")?;
+        let curve = vinculo::constraints::StrainCurve::new(strains, tensions).map_err(to_py)?;
+        self.inner
+            .set_strain_curve(c, std::sync::Arc::new(curve))
+            .map_err(to_py)
+    }
+
     /// Declares a distance constraint a string: a run stops with NegativeTensionError when it
     /// would have to push.
     fn set_tension_only(&mut self, constraint: &Bound<'_, PyAny>) -> PyResult<()> {

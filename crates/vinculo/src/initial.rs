@@ -203,7 +203,13 @@ fn rest_right_hand_side(
             // The tension of the stretch, none for a slack segment shorter than its length.
             let phi = con.residual(q, t);
             let phi = if con.can_slack() { phi.min(0.0) } else { phi };
-            -phi / (con.compliance(t) * ws.scales[c] * ws.mass_ref)
+            match con.compliant_segment() {
+                // A nonlinear line: its curve's tension at that stretch.
+                Some(segment) if segment.curve.is_some() => {
+                    segment.tension_of(t, -phi) / (ws.scales[c] * ws.mass_ref)
+                }
+                _ => -phi / (con.compliance(t) * ws.scales[c] * ws.mass_ref),
+            }
         } else {
             -ws.scales[c] * con.gamma(q, v, t)
         };

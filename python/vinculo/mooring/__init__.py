@@ -9,6 +9,8 @@
   (:class:`Seafloor`, :func:`read_seafloor`), which a file names by its SeafloorFile option.
 - :mod:`vinculo.mooring.current_profile`: MoorDyn's steady current (``Currents 1``,
   :func:`read_current_profile`).
+- :mod:`vinculo.mooring.stiffness_curve`: MoorDyn's nonlinear EA, a tension-strain table
+  (:func:`read_stiffness_curve`).
 - :mod:`vinculo.mooring.motion`: the prescribed motion of the coupled (Vessel) points.
 - :mod:`vinculo.mooring.model`: the vinculo model of a file (:func:`build_model`).
 - :mod:`vinculo.mooring.analysis`: :func:`statics` (the static equilibrium: end tensions and
@@ -50,6 +52,7 @@ from vinculo.mooring.moordyn_file import (
 )
 from vinculo.mooring.motion import Motion
 from vinculo.mooring.seafloor import Seafloor, read_seafloor
+from vinculo.mooring.stiffness_curve import StiffnessCurve, read_stiffness_curve
 
 
 class _CallableModule(types.ModuleType):
@@ -91,12 +94,14 @@ __all__ = [
     "Motion",
     "Seafloor",
     "SlopeCatenarySolution",
+    "StiffnessCurve",
     "build_model",
     "format_moordyn",
     "parse_moordyn",
     "read_current_profile",
     "read_moordyn",
     "read_seafloor",
+    "read_stiffness_curve",
     "run",
     "solve_catenary",
     "solve_catenary_on_slope",

@@ -58,6 +58,9 @@ class LineType:
         ca: the normal added-mass coefficient.
         cdax: the axial drag coefficient.
         caax: the axial added-mass coefficient.
+        ea_curve: the tension-strain curve of a nonlinear line
+            (:class:`vinculo.mooring.stiffness_curve.StiffnessCurve`, MoorDyn's EA table), in
+            place of Hooke's law; ``ea`` is then its stiffest piece's slope. None: Hooke's law.
     """
 
     name: str
@@ -70,6 +73,7 @@ class LineType:
     ca: float = 0.0
     cdax: float = 0.0
     caax: float = 0.0
+    ea_curve: Any = None
 
 
 @dataclass(frozen=True)
@@ -208,7 +212,10 @@ class Line:
         else:
             lengths = np.array([float(self.length_law(float(t))) for t in times])
         segment = (lengths / len(self.segments))[:, None]
-        return np.maximum(0.0, self.line_type.ea * (stretched - segment) / segment)
+        strain = (stretched - segment) / segment
+        if self.line_type.ea_curve is not None:
+            return np.where(strain > 0.0, self.line_type.ea_curve.tension(strain), 0.0)
+        return np.maximum(0.0, self.line_type.ea * strain)
 
     def end_forces(self, solution: Any) -> tuple[np.ndarray, np.ndarray]:
         """The forces of the line on its end particles A and B, as MoorDyn reports a point's
@@ -290,6 +297,10 @@ def _damping(line_type: LineType, segment: float) -> float:
     if ba < 0.0:
         if not math.isfinite(line_type.ea):
             return 0.0
+        if line_type.ea_curve is not None:
+            raise InvalidInputError(
+                f"line type {line_type.name!r}: BA = {ba:g}, a damping ratio, with a tabulated "
+                f"EA: give BA in N s (the ratio needs one EA)", name="ba", value=ba)
         # MoorDyn: BA = zeta (L / N) sqrt(EA w).
         ba = -ba * segment * math.sqrt(line_type.ea * line_type.mass_per_length)
     return ba / segment
@@ -435,6 +446,11 @@ def add_line(system: Any, end_a: int, end_b: int, line_type: LineType,
         # MoorDyn's segments go slack instead of pushing (docs/theory/moorings.md).
         for link in links:
             system.set_slack(link)
+    if line_type.ea_curve is not None:
+        strains = [float(e) for e in line_type.ea_curve.strains]
+        tensions = [float(t) for t in line_type.ea_curve.tensions]
+        for link in links:
+            system.set_strain_curve(link, strains, tensions)
     damping = _damping(line_type, segment)
     if damping > 0.0:
         # The segments' internal damping (MoorDyn's BA / l), carried by the segments themselves.

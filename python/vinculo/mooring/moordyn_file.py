@@ -12,8 +12,8 @@ NODE PROPERTIES; attachments Fixed, Coupled/Vessel and Free/Point/Connect), LINE
 (water depth, density, gravity, seabed contact and friction, time step and MoorDyn's own
 simulation settings) and OUTPUTS (kept for writing back). What is not supported yet raises a
 :class:`~vinculo.errors.MooringFileError` that names the file, the line and the field: rods,
-bodies, failures, external loads, control channels, wave and current kinematics, non-linear
-or viscoelastic stiffness, vortex-induced vibration, points attached to bodies.
+bodies, failures, external loads, control channels, wave kinematics and dynamic currents,
+viscoelastic stiffness, vortex-induced vibration, points attached to bodies.
 
 Units are SI throughout (m, kg, N, s), as in the file.
 """
@@ -30,6 +30,7 @@ from vinculo.errors import InvalidInputError, MooringFileError
 from vinculo.mooring.current_profile import PROFILE_FILE, CurrentProfile, read_current_profile
 from vinculo.mooring.line import LineType
 from vinculo.mooring.seafloor import Seafloor, read_seafloor
+from vinculo.mooring.stiffness_curve import StiffnessCurve, read_stiffness_curve
 
 __all__ = [
     "ATTACHMENTS",
@@ -366,15 +367,46 @@ def _line_type(path: str, line: _Line, fields: list[str]) -> LineType:
     name = cols["TypeName"]
     diameter = _positive(path, line, "Diam", _number(path, line, "Diam", cols["Diam"]))
     mass = _positive(path, line, "Mass/m", _number(path, line, "Mass/m", cols["Mass/m"]))
-    ea = _positive(path, line, "EA", _stiffness(path, line, "EA", cols["EA"], "EA"))
+    curve = None
+    if _is_number(cols["EA"]) or "|" in cols["EA"]:
+        ea = _positive(path, line, "EA", _stiffness(path, line, "EA", cols["EA"], "EA"))
+    else:
+        # MoorDyn's nonlinear EA: a strain-tension table beside the input file.
+        curve = _curve(path, line, cols["EA"])
+        ea = curve.stiffest
     ba = _stiffness(path, line, "BA/-zeta", cols["BA/-zeta"], "BA")
+    if curve is not None and ba < 0.0:
+        raise _error(path, line.number, "BA/-zeta",
+                     f"{ba:g}: a damping ratio with a tabulated EA is not supported (the ratio "
+                     f"needs one EA); give BA in N s", ba)
     values = {}
     for column in ("EI", "Cd", "Ca", "CdAx", "CaAx"):
         values[column] = _positive(path, line, column,
                                    _number(path, line, column, cols[column]), allow_zero=True)
     return LineType(name=name, diameter=diameter, mass_per_length=mass, ea=ea, ba=ba,
                         ei=values["EI"], cd=values["Cd"], ca=values["Ca"],
-                        cdax=values["CdAx"], caax=values["CaAx"])
+                        cdax=values["CdAx"], caax=values["CaAx"], ea_curve=curve)
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _curve(path: str, line: _Line, text: str) -> StiffnessCurve:
+    """The strain-tension table named in a line type's EA: beside the input file, or at the
+    path given (MoorDyn-C's rule)."""
+    given = Path(text.strip('"'))
+    folder = Path(path).parent if Path(path).is_file() else Path.cwd()
+    candidate = given if given.is_absolute() else folder / given
+    if not candidate.is_file():
+        raise _error(path, line.number, "EA",
+                     f"{text!r}: no such strain-tension file (looked for {str(candidate)!r})",
+                     text)
+    return read_stiffness_curve(candidate)
 
 
 _POINT_COLUMNS = ("ID", "Attachment", "X", "Y", "Z", "Mass", "Volume", "CdA", "Ca")
@@ -719,21 +751,42 @@ def _header(phrase: str) -> str:
 _ATTACHMENT_WORDS = {"fixed": "Fixed", "coupled": "Coupled", "free": "Free"}
 
 
-def format_moordyn(model: MoorDynFile, seafloor_path: str | Path | None = None) -> str:
+def _ea_text(line_type: LineType, curve_paths: dict[str, str] | None) -> str:
+    """The EA column of a line type: the number, or the file of its tension-strain curve."""
+    curve = line_type.ea_curve
+    if curve is None:
+        return _g(line_type.ea)
+    if curve_paths and line_type.name in curve_paths:
+        return curve_paths[line_type.name]
+    if curve.path is None:
+        raise InvalidInputError(
+            f"line type {line_type.name!r}: its stiffness curve was built in code and has no "
+            f"file: give curve_paths (write_moordyn writes it beside the file)",
+            name="curve_paths", value=None)
+    # MoorDyn looks for the file beside the input file, whatever the path says.
+    return Path(curve.path).name
+
+
+def format_moordyn(model: MoorDynFile, seafloor_path: str | Path | None = None,
+                   curve_paths: dict[str, str] | None = None) -> str:
     """The text of a MoorDyn v2 input file for ``model``.
 
     Arguments:
         model: the model to write.
         seafloor_path: the seafloor file the text names in SeafloorFile (default: the one the
             model's seafloor was read from, absolute).
+        curve_paths: the strain-tension file each nonlinear line type names in its EA column,
+            by type name (default: the name of the file its curve was read from, which MoorDyn
+            looks for beside the input file).
 
     Returns:
         The file's text; :func:`parse_moordyn` reads it back to an equal model.
 
     Raises:
         InvalidInputError: for a model with a seafloor built in code (or read from MoorDyn-F's
-            bathymetry file, which MoorDyn-C does not read) and no ``seafloor_path``
-            (:func:`write_moordyn` writes the grid beside the file).
+            bathymetry file, which MoorDyn-C does not read) and no ``seafloor_path``, or a
+            stiffness curve built in code and no ``curve_paths`` (:func:`write_moordyn` writes
+            them beside the file).
     """
     out = [_header("MoorDyn Input File")]
     out += (model.title or "MoorDyn v2 input file written by vinculo").splitlines()
@@ -741,8 +794,9 @@ def format_moordyn(model: MoorDynFile, seafloor_path: str | Path | None = None) 
     out += _table(
         ["TypeName", "Diam", "Mass/m", "EA", "BA/-zeta", "EI", "Cd", "Ca", "CdAx", "CaAx"],
         ["(name)", "(m)", "(kg/m)", "(N)", "(N-s/-)", "(N-m^2)", "(-)", "(-)", "(-)", "(-)"],
-        [[t.name, *map(_g, (t.diameter, t.mass_per_length, t.ea, t.ba, t.ei, t.cd, t.ca,
-                            t.cdax, t.caax))] for t in model.line_types.values()],
+        [[t.name, _g(t.diameter), _g(t.mass_per_length), _ea_text(t, curve_paths),
+          *map(_g, (t.ba, t.ei, t.cd, t.ca, t.cdax, t.caax))]
+         for t in model.line_types.values()],
     )
     out.append(_header("POINTS"))
     out += _table(
@@ -825,11 +879,15 @@ def write_moordyn(model: MoorDynFile, path: str | Path) -> Path:
         # A grid built in code: written beside the file, which names it by its file name
         # (MoorDyn looks in the working directory, vinculo beside the file first).
         seafloor_path = floor.write(path.with_name(path.stem + "_seafloor.txt")).name
+    # Stiffness curves: written beside the file, where MoorDyn looks for them (it prefixes
+    # the input file's folder to the name given, even to an absolute path).
+    curve_paths = {t.name: t.ea_curve.write(path.with_name(f"{path.stem}_{t.name}_ea.txt")).name
+                   for t in model.line_types.values() if t.ea_curve is not None}
     try:
         if model.options.current is not None:
             # MoorDyn reads the profile of Currents 1 beside the input file.
             model.options.current.write(path.with_name(PROFILE_FILE))
-        path.write_text(format_moordyn(model, seafloor_path), encoding="utf-8")
+        path.write_text(format_moordyn(model, seafloor_path, curve_paths), encoding="utf-8")
     except OSError as exc:
         raise MooringFileError(f"cannot write the MoorDyn file {str(path)!r}: {exc.strerror}",
                                file=str(path), line=None, field=None, value=None) from None

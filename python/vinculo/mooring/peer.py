@@ -155,9 +155,11 @@ def _model_and_file(source: str | Path | MoorDynFile, folder: Path,
         model = dataclasses.replace(
             model, options=dataclasses.replace(model.options, time_step=float(time_step)))
     if isinstance(source, MoorDynFile) or time_step is not None or (
-            model.options.seafloor is not None or model.options.current is not None):
-        # Written again: a seafloor file is then named by its absolute path, which MoorDyn
-        # finds from any working directory, and a current profile written beside it.
+            model.options.seafloor is not None or model.options.current is not None
+            or any(t.ea_curve is not None for t in model.line_types.values())):
+        # Written again: a seafloor file and stiffness curves are then named by their absolute
+        # paths, which MoorDyn finds from any working directory, and a current profile written
+        # beside it.
         path = write_moordyn(model, folder / "mooring.txt")
     else:
         path = Path(shutil.copy(source, folder / "mooring.txt"))

@@ -315,7 +315,7 @@ impl Layout {
         // Hessian term's weight over -sigma, and has its compliance in its own column,
         // d(s c lambda)/d(lambda sigma / s).
         let row = if con.is_compliant() {
-            let compliance = con.compliance(at.t_eval);
+            let compliance = con.compliance_at(at.t_eval, at.lambda[c]);
             values.add(self.constraint_diagonal[c], s * s * compliance / at.sigma);
             if at.is_slack(con, c) {
                 0.0

@@ -157,7 +157,7 @@ impl ResidualTerms<'_> {
                 } else {
                     psi
                 };
-                held + segment.compliance(self.t_eval) * self.lambda[c]
+                held + segment.stretch(self.t_eval, self.lambda[c]).0
             }
             None => phi,
         }

@@ -42,6 +42,9 @@
 //! and the blocks (i, j), (j, i) the negatives, (j, j) the same (as a spring-damper of zero
 //! stiffness, `forces/spring_damper.rs`, whose numbers they are).
 
+use std::sync::Arc;
+
+use super::strain_curve::StrainCurve;
 use super::Hessian;
 use crate::laws::Law;
 use crate::math::{dot, norm, outer, scale_mat, sub, Mat3, Vec3};
@@ -56,8 +59,12 @@ pub struct ElasticDistance {
     pub length: Law,
     /// The segment's share of `length` (1 for a segment of its own).
     pub share: f64,
-    /// The axial stiffness EA (N); infinity: inextensible.
+    /// The axial stiffness EA (N); infinity: inextensible. With a `curve`, its stiffest
+    /// piece's (the scale of [`ElasticDistance::compliance`]).
     pub ea: f64,
+    /// The tension-strain curve of a nonlinear line (MoorDyn's EA table,
+    /// `strain_curve.rs`); None: Hooke's law with `ea`.
+    pub curve: Option<Arc<StrainCurve>>,
     /// Whether the segment goes slack (tension 0) instead of pushing when shorter than L.
     pub slack: bool,
     /// Internal axial damping c (N s/m; 0: none): the tension c u.(v_i - v_j) along the segment.
@@ -166,13 +173,40 @@ impl ElasticDistance {
     }
 
     /// The compliance c(t) = L(t)/EA (m/N) of the constraint equation Phi + c T = 0; 0 when
-    /// inextensible.
+    /// inextensible (with a curve, its stiffest piece's: a scale).
     #[inline]
     pub(crate) fn compliance(&self, t: f64) -> f64 {
         if self.ea.is_finite() {
             self.share * self.length.value(t) / self.ea
         } else {
             0.0
+        }
+    }
+
+    /// The stretch |d| - L that the tension `lambda` gives the segment at time `t`, and its
+    /// derivative in `lambda`: c(t) lambda and c(t) (Hooke's law), or L e(lambda) and
+    /// L e'(lambda) along its curve (`strain_curve.rs`).
+    #[inline(always)]
+    pub(crate) fn stretch(&self, t: f64, lambda: f64) -> (f64, f64) {
+        match &self.curve {
+            None => {
+                let c = self.compliance(t);
+                (c * lambda, c)
+            }
+            Some(curve) => {
+                let l = self.share * self.length.value(t);
+                let (e, de) = curve.strain(lambda);
+                (l * e, l * de)
+            }
+        }
+    }
+
+    /// The tension of the stretch `stretch` (m) at time `t`: the inverse of
+    /// [`ElasticDistance::stretch`].
+    pub fn tension_of(&self, t: f64, stretch: f64) -> f64 {
+        match &self.curve {
+            None => stretch / self.compliance(t),
+            Some(curve) => curve.tension(stretch / (self.share * self.length.value(t))),
         }
     }
 }
@@ -194,6 +228,7 @@ mod tests {
             ea: 1e5,
             slack: false,
             damping: 0.0,
+            curve: None,
         }));
         let q = [[0.1, 0.2, -0.3], [9.0, 9.0, 9.0], [0.5, -0.4, 0.25]];
         let v = [[0.3, -1.0, 0.2], [0.0; 3], [-0.6, 0.1, 0.9]];
@@ -214,6 +249,7 @@ mod tests {
             ea: 1e5,
             slack: true,
             damping: 3.5,
+            curve: None,
         };
         let force = |q: &[Vec3], v: &[Vec3]| -> [Vec3; 2] {
             let grad = e.gradient(q, 0.0);
@@ -282,6 +318,7 @@ mod tests {
             ea: 4e6,
             slack: false,
             damping: 0.0,
+            curve: None,
         };
         assert_eq!(e.compliance(0.0), 2.0 / 4e6);
         e.ea = f64::INFINITY;

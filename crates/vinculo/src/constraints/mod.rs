@@ -32,6 +32,7 @@ mod plane;
 mod point_distance;
 mod redundancy;
 mod relative_coordinate;
+mod strain_curve;
 pub mod user;
 
 pub use distance::Distance;
@@ -43,6 +44,7 @@ pub use plane::Plane;
 pub use point_distance::PointDistance;
 pub use redundancy::{explain_singular, find_redundant, MAX_ENTRIES, RANK_TOLERANCE};
 pub use relative_coordinate::RelativeCoordinate;
+pub use strain_curve::StrainCurve;
 pub use user::{ConstraintCall, ConstraintGroup, UserConstraint, UserConstraints};
 
 use crate::laws::Law;
@@ -246,6 +248,14 @@ impl Constraint {
     #[inline(always)]
     pub fn compliance(&self, t: f64) -> f64 {
         self.compliant_segment().map_or(0.0, |s| s.compliance(t))
+    }
+
+    /// The compliance at the tension `lambda`: d(stretch)/d(lambda) of an elastic segment
+    /// (its c(t), or L e'(lambda) along a curve), 0 for every other kind.
+    #[inline(always)]
+    pub fn compliance_at(&self, t: f64, lambda: f64) -> f64 {
+        self.compliant_segment()
+            .map_or(0.0, |s| s.stretch(t, lambda).1)
     }
 
     /// True for an elastic segment that goes slack instead of pushing

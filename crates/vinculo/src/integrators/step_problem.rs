@@ -622,6 +622,27 @@ mod tests {
         assert_parallel_assembly_is_serial(&s, GeneralizedTrapezoidal { alpha: 0.6 });
     }
 
+    /// Segments along tension-strain curves (`constraints/strain_curve.rs`): their rows'
+    /// compliance is L e'(lambda) at the multiplier (0.8 N on the curve's second piece, -1.2 N
+    /// beyond its first point), and the Jacobian equals finite differences of the residual,
+    /// stretched and slack, with the sparse LU's and the tree elimination's layouts.
+    #[test]
+    fn nonlinear_segments_jacobian_matches_finite_differences() {
+        use crate::constraints::StrainCurve;
+        use crate::model::ConstraintId;
+        let curve = std::sync::Arc::new(
+            StrainCurve::new(vec![0.0, 1e-4, 5e-4], vec![0.0, 0.5, 3.0]).unwrap(),
+        );
+        for mut s in [elastic_chain(), slack_chain()] {
+            for c in 0..2 {
+                s.set_strain_curve(ConstraintId(c), curve.clone()).unwrap();
+            }
+            let solvers = [(0, SparseSolver::SparseLu), (0, SparseSolver::Auto)];
+            assert_compliant_jacobians_match(&s, s.constraints().len(), &solvers);
+            assert_parallel_assembly_is_serial(&s, GeneralizedTrapezoidal { alpha: 0.6 });
+        }
+    }
+
     /// The assembled Jacobian equals finite differences of the assembled residual, for a system
     /// with every constraint and force kind, fixed particles and non-zero multipliers (and, for
     /// generalised-alpha, non-zero old accelerations), over the range of each rule's parameter,

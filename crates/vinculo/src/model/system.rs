@@ -243,6 +243,7 @@ impl System {
             ea,
             slack: false,
             damping: 0.0,
+            curve: None,
         })))
     }
 
@@ -618,6 +619,35 @@ impl System {
                 value: c.0 as f64,
                 expected: "must be an elastic segment of finite EA (add_elastic_distance); an \
                            inextensible string is made tension-only with set_tension_only"
+                    .into(),
+            }),
+            None => Err(self.unknown_constraint(c)),
+        }
+    }
+
+    /// Gives elastic segment `c` a nonlinear tension-strain curve (MoorDyn's EA table): its
+    /// tension follows `curve` instead of Hooke's law, and its EA becomes the curve's
+    /// stiffest piece's (the scale the static solve uses; `constraints/strain_curve.rs`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] when `c` is not an elastic segment of finite EA between
+    /// two particles.
+    pub fn set_strain_curve(
+        &mut self,
+        c: ConstraintId,
+        curve: std::sync::Arc<crate::constraints::StrainCurve>,
+    ) -> Result<()> {
+        match self.constraints.get_mut(c.0) {
+            Some(Constraint::ElasticDistance(e)) if e.ea.is_finite() => {
+                e.ea = curve.stiffest();
+                e.curve = Some(curve);
+                Ok(())
+            }
+            Some(other) => Err(Error::InvalidParameter {
+                name: format!("nonlinear segment ({})", other.name(c.0)),
+                value: c.0 as f64,
+                expected: "must be an elastic segment of finite EA between two particles \
+                           (add_elastic_distance)"
                     .into(),
             }),
             None => Err(self.unknown_constraint(c)),

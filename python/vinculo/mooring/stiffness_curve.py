@@ -1,0 +1,178 @@
+"""A line whose tension is a function of its strain: MoorDyn's nonlinear EA, a file name in the
+EA column of a line type.
+
+The file (beside the input file, or at the path given) holds three header lines, then one line
+per point of the curve, ``strain tension`` (-, N), both increasing::
+
+    ----Polyester----
+    Strain    Tension
+    (-)       (N)
+    0.0       0.0
+    0.01      2.0e5
+    0.03      9.0e5
+
+Between the points the tension is linear in the strain; beyond the last point it continues
+along the last piece (MoorDyn holds the last tension there, which no implicit step can solve),
+below the first along the first; a segment shorter than its length is slack (no tension), as
+MoorDyn's (``docs/theory/moorings.md``, "Nonlinear stiffness"). :func:`read_stiffness_curve`
+reads such a file (a row that is not two numbers, or values that do not increase, is an error
+naming the file, the line and the field).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from vinculo.errors import InvalidInputError, MooringFileError
+
+__all__ = ["StiffnessCurve", "read_stiffness_curve"]
+
+
+@dataclass(frozen=True, eq=False)
+class StiffnessCurve:
+    """Tensions of a line at its strains (both increasing), linear between them.
+
+    Arguments:
+        strains: the strains (-).
+        tensions: the tensions (N), one per strain.
+        path: the file it was read from (None when built in code).
+
+    Raises:
+        InvalidInputError: for fewer than two points, values that are not finite, or strains
+            or tensions that do not increase.
+    """
+
+    strains: np.ndarray
+    tensions: np.ndarray
+    path: Path | None = None
+
+    def __post_init__(self) -> None:
+        e = np.ascontiguousarray(self.strains, dtype=float).reshape(-1)
+        t = np.ascontiguousarray(self.tensions, dtype=float).reshape(-1)
+        if e.size < 2 or e.size != t.size:
+            raise InvalidInputError(
+                f"a stiffness curve of {e.size} strains and {t.size} tensions: give at least "
+                f"two points, a tension per strain", name="strains", value=e.size)
+        if not (np.all(np.isfinite(e)) and np.all(np.isfinite(t))):
+            raise InvalidInputError("a stiffness curve's strains and tensions must be finite",
+                                    name="strains", value=None)
+        for name, values in (("strains", e), ("tensions", t)):
+            if np.any(np.diff(values) <= 0.0):
+                raise InvalidInputError(f"a stiffness curve's {name} must increase",
+                                        name=name, value=values.tolist())
+        object.__setattr__(self, "strains", e)
+        object.__setattr__(self, "tensions", t)
+
+    def __eq__(self, other: object) -> bool:
+        """The same points (wherever they were read from)."""
+        if not isinstance(other, StiffnessCurve):
+            return NotImplemented
+        return (np.array_equal(self.strains, other.strains)
+                and np.array_equal(self.tensions, other.tensions))
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def tension(self, strain: Any) -> np.ndarray:
+        """The tension at ``strain`` (N): linear between the points, continued along the first
+        and last pieces beyond them; no slack here (a segment is slack below zero strain)."""
+        e = np.asarray(strain, dtype=float)
+        k = np.clip(np.searchsorted(self.strains, e, side="right") - 1, 0,
+                    self.strains.size - 2)
+        e0, e1 = self.strains[k], self.strains[k + 1]
+        t0, t1 = self.tensions[k], self.tensions[k + 1]
+        return t0 + (t1 - t0) / (e1 - e0) * (e - e0)
+
+    def strain(self, tension: Any) -> np.ndarray:
+        """The strain at ``tension`` (the curve read the other way)."""
+        t = np.asarray(tension, dtype=float)
+        k = np.clip(np.searchsorted(self.tensions, t, side="right") - 1, 0,
+                    self.tensions.size - 2)
+        t0, t1 = self.tensions[k], self.tensions[k + 1]
+        e0, e1 = self.strains[k], self.strains[k + 1]
+        return e0 + (e1 - e0) / (t1 - t0) * (t - t0)
+
+    @property
+    def stiffest(self) -> float:
+        """The largest slope dT/de of the curve (N): the EA that stands for it where one
+        number must (an initial shape, the static solve's scales)."""
+        return float(np.max(np.diff(self.tensions) / np.diff(self.strains)))
+
+    def write(self, path: str | Path) -> Path:
+        """Write the curve in MoorDyn's format (module documentation).
+
+        Arguments:
+            path: the file to write (replaced if it exists).
+
+        Returns:
+            The path written.
+        """
+        rows = ["---- tension-strain curve (written by vinculo) ----", "Strain    Tension",
+                "(-)       (N)"]
+        rows += [f"{float(e)!r} {float(t)!r}"
+                 for e, t in zip(self.strains, self.tensions, strict=True)]
+        path = Path(path)
+        # No newline after the last point: MoorDyn 2.7 reads an empty last line as a point.
+        path.write_text("\n".join(rows), encoding="utf-8")
+        return path
+
+
+def read_stiffness_curve(path: str | Path) -> StiffnessCurve:
+    """Read a strain-tension file (module documentation).
+
+    Arguments:
+        path: the file.
+
+    Returns:
+        The curve.
+
+    Raises:
+        MooringFileError: when the file cannot be read or is malformed: the message names the
+            file, the line and the field.
+    """
+    path = Path(path)
+    name = str(path)
+    try:
+        lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
+    except OSError as exc:
+        raise MooringFileError(f"cannot read the stiffness curve {name!r}: {exc.strerror}",
+                               file=name, line=None, field=None, value=None) from None
+    points: list[tuple[float, float, int]] = []
+    for number, text in enumerate(lines[3:], start=4):
+        fields = text.split()
+        if not fields:
+            continue
+        if len(fields) != 2:
+            raise MooringFileError(
+                f"{name}, line {number}: strain tension: {len(fields)} values; give a strain "
+                f"and the tension there", file=name, line=number, field="strain tension",
+                value=text.strip())
+        values = []
+        for field, item in zip(("strain", "tension"), fields, strict=True):
+            try:
+                value = float(item)
+            except ValueError:
+                value = math.nan
+            if not math.isfinite(value):
+                raise MooringFileError(f"{name}, line {number}: {field}: {item!r} is not a "
+                                       f"finite number", file=name, line=number, field=field,
+                                       value=item)
+            values.append(value)
+        if points:
+            for k, field in enumerate(("strain", "tension")):
+                if values[k] <= points[-1][k]:
+                    raise MooringFileError(
+                        f"{name}, line {number}: {field}: {fields[k]} is not above the one "
+                        f"before it (line {points[-1][2]}); give increasing strains and "
+                        f"tensions", file=name, line=number, field=field, value=values[k])
+        points.append((values[0], values[1], number))
+    if len(points) < 2:
+        raise MooringFileError(f"{name}: {len(points)} points after the three header lines; "
+                               f"give at least two", file=name, line=None,
+                               field="strain tension", value=len(points))
+    return StiffnessCurve(np.array([p[0] for p in points]), np.array([p[1] for p in points]),
+                          path=path)
