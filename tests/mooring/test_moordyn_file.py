@@ -117,7 +117,7 @@ def _line_of(text: str, needle: str) -> int:
         ("2   Coupled", "2   Sliding", "Attachment", "not a point attachment"),
         ("2   Coupled", "3   Coupled", "ID", "numbered"),
         ("80.0          WtrDpth", "bathy.txt     WtrDpth", "WtrDpth", "no such seafloor file"),
-        ("0             writeLog", "1             WaveKin ", "WaveKin", "not supported"),
+        ("0             writeLog", "1             WaveKin ", "WaveKin", "only waves summed"),
         ("0             writeLog", "2             Currents", "Currents", "only steady currents"),
         ("0             writeLog", "0.3           fooBar  ", "fooBar", "unknown option"),
         ("1.0e-4        dtM", "-1.0e-4       dtM", "dtM", "must be > 0"),

@@ -11,6 +11,8 @@
   :func:`read_current_profile`).
 - :mod:`vinculo.mooring.stiffness_curve`: MoorDyn's nonlinear EA, a tension-strain table
   (:func:`read_stiffness_curve`).
+- :mod:`vinculo.mooring.wave_components`: MoorDyn's waves summed from their components
+  (``WaveKin 7``, :func:`read_wave_frequencies`).
 - :mod:`vinculo.mooring.motion`: the prescribed motion of the coupled (Vessel) points.
 - :mod:`vinculo.mooring.model`: the vinculo model of a file (:func:`build_model`).
 - :mod:`vinculo.mooring.analysis`: :func:`statics` (the static equilibrium: end tensions and
@@ -53,6 +55,7 @@ from vinculo.mooring.moordyn_file import (
 from vinculo.mooring.motion import Motion
 from vinculo.mooring.seafloor import Seafloor, read_seafloor
 from vinculo.mooring.stiffness_curve import StiffnessCurve, read_stiffness_curve
+from vinculo.mooring.wave_components import WaveComponents, read_wave_frequencies
 
 
 class _CallableModule(types.ModuleType):
@@ -95,6 +98,7 @@ __all__ = [
     "Seafloor",
     "SlopeCatenarySolution",
     "StiffnessCurve",
+    "WaveComponents",
     "build_model",
     "format_moordyn",
     "parse_moordyn",
@@ -102,6 +106,7 @@ __all__ = [
     "read_moordyn",
     "read_seafloor",
     "read_stiffness_curve",
+    "read_wave_frequencies",
     "run",
     "solve_catenary",
     "solve_catenary_on_slope",

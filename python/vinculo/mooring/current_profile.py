@@ -84,24 +84,6 @@ class CurrentProfile:
         return np.stack([np.interp(z, self.heights, self.velocities[:, k]) for k in range(3)],
                         axis=-1)
 
-    def water(self, depth: float, gravity: float) -> Any:
-        """The core's water of this current (``vinculo.System.set_water``): water that fills
-        all space, as a MoorDyn file's lines are in without waves, moving with the current.
-
-        Arguments:
-            depth: the water depth (m).
-            gravity: the acceleration of gravity (m/s^2).
-
-        Returns:
-            A ``vinculo._core.Water``.
-        """
-        from vinculo import _core
-
-        empty = np.zeros(0)
-        return _core.Water(float(depth) if depth > 0.0 else math.inf, float(gravity), empty,
-                           empty, empty, empty, "table", self.velocities, self.heights, 0.0,
-                           "wheeler", False)
-
     def write(self, path: str | Path) -> Path:
         """Write the profile in MoorDyn's format (module documentation).
 

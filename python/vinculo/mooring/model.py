@@ -18,6 +18,7 @@ file's OPTIONS), and the initial state is the static equilibrium
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -52,6 +53,41 @@ def water(options: FileOptions) -> Any:
     from vinculo.mooring.line import Water
 
     return Water(depth=options.depth, density=options.density, gravity=options.gravity)
+
+
+def file_water(options: FileOptions) -> Any | None:
+    """The water of a file's current (``Currents 1``) and waves (``WaveKin 7``), None for still
+    water (MoorDyn's lines in water that fills all space).
+
+    Without waves the water has no free surface (as in still water); with them it has one,
+    with Wheeler's stretching, as MoorDyn's (``docs/theory/ocean.md``).
+
+    Arguments:
+        options: the options.
+
+    Returns:
+        A ``vinculo._core.Water``, or None.
+    """
+    from vinculo import _core
+
+    current, waves = options.current, options.waves
+    if current is None and waves is None:
+        return None
+    empty = np.zeros(0)
+    if current is not None:
+        kind, velocities, heights = "table", current.velocities, current.heights
+    else:
+        kind, velocities, heights = "uniform", np.zeros((1, 3)), empty
+    if waves is not None:
+        amplitudes, omegas = np.abs(waves.amplitudes), waves.omegas
+        directions, phases = waves.directions, waves.phases
+    else:
+        amplitudes = omegas = directions = phases = empty
+    depth = options.depth if options.depth > 0.0 else math.inf
+    return _core.Water(float(depth), float(options.gravity), amplitudes, omegas, directions,
+                       phases, kind, np.ascontiguousarray(velocities, dtype=float),
+                       np.ascontiguousarray(heights, dtype=float), 0.0, "wheeler",
+                       waves is not None, float(options.wave_ramp))
 
 
 def seabed(options: FileOptions) -> Any:
@@ -168,10 +204,10 @@ def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, 
     _check_motion(model, motion)
     options = model.options
     system = System(gravity=(0.0, 0.0, -options.gravity))
-    if options.current is not None:
-        # The lines' and free points' drag on their velocity relative to the file's steady
-        # current.
-        system.set_water(options.current.water(options.depth, options.gravity))
+    flowing = file_water(options)
+    if flowing is not None:
+        # The lines' and free points' loads in the file's current and waves.
+        system.set_water(flowing)
     the_water, the_seabed = water(options), seabed(options)
     start = motion.positions(0.0) if motion is not None else None
     points: list[ParticleId] = []
@@ -198,8 +234,8 @@ def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, 
             coupled_index += 1
             continue
         particle = system.add_particle(mass, point.position)
-        if options.current is not None and (point.volume > 0.0 or point.cda > 0.0):
-            # In the file's current: buoyancy, added mass and drag in the system's water.
+        if flowing is not None and (point.volume > 0.0 or point.cda > 0.0):
+            # In the file's current and waves: buoyancy, added mass and drag in its water.
             system.add_morison(particle, volume=point.volume, area=point.cda,
                                drag_coefficient=1.0 if point.cda > 0.0 else 0.0,
                                added_mass_coefficient=point.ca, density=options.density,

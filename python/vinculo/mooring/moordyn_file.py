@@ -12,7 +12,7 @@ NODE PROPERTIES; attachments Fixed, Coupled/Vessel and Free/Point/Connect), LINE
 (water depth, density, gravity, seabed contact and friction, time step and MoorDyn's own
 simulation settings) and OUTPUTS (kept for writing back). What is not supported yet raises a
 :class:`~vinculo.errors.MooringFileError` that names the file, the line and the field: rods,
-bodies, failures, external loads, control channels, wave kinematics and dynamic currents,
+bodies, failures, external loads, control channels, wave grids and dynamic currents,
 viscoelastic stiffness, vortex-induced vibration, points attached to bodies.
 
 Units are SI throughout (m, kg, N, s), as in the file.
@@ -31,6 +31,7 @@ from vinculo.mooring.current_profile import PROFILE_FILE, CurrentProfile, read_c
 from vinculo.mooring.line import LineType
 from vinculo.mooring.seafloor import Seafloor, read_seafloor
 from vinculo.mooring.stiffness_curve import StiffnessCurve, read_stiffness_curve
+from vinculo.mooring.wave_components import WAVE_FILE, WaveComponents, read_wave_frequencies
 
 __all__ = [
     "ATTACHMENTS",
@@ -177,6 +178,9 @@ class FileOptions:
             MoorDyn's.
         current: the steady current of ``Currents 1``, read from ``current_profile.txt``
             beside the input file (:mod:`vinculo.mooring.current_profile`; None: still water).
+        waves: the wave components of ``WaveKin 7``, read from ``wave_frequencies.txt``
+            beside the input file (:mod:`vinculo.mooring.wave_components`; None: no waves).
+        wave_ramp: MoorDyn's ``waveKin_rampT``, the time over which the waves grow (s).
         settings: MoorDyn's simulation settings that do not change the model (writeLog,
             tScheme, CFL, dtOut, the initial-condition settings dtIC, TmaxIC, CdScaleIC,
             threshIC, ...), as (key, text) pairs in file order, kept for writing back.
@@ -195,6 +199,8 @@ class FileOptions:
     settings: tuple[tuple[str, str], ...] = ()
     seafloor: Seafloor | None = None
     current: CurrentProfile | None = None
+    waves: WaveComponents | None = None
+    wave_ramp: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -494,6 +500,7 @@ _MODEL_OPTIONS = {
     "statdynfricscale": "static_dynamic_scale",
     "mc": "static_dynamic_scale",
     "dtm": "time_step",
+    "wavekin_rampt": "wave_ramp",
 }
 
 # MoorDyn's settings of its own run that do not change the model: kept, written back.
@@ -506,7 +513,6 @@ _SETTINGS = {
 # Options of features not supported yet: key -> what it asks for. A zero (or empty) value
 # switches the feature off and is accepted.
 _UNSUPPORTED_OPTIONS = {
-    "wavekin": "wave kinematics",
     "waterkin": "water kinematics",
     "dtwave": "wave kinematics",
     "unifycurrentgrid": None,
@@ -548,11 +554,32 @@ def _current(path: str, line: _Line, key: str, text: str) -> CurrentProfile | No
     return read_current_profile(profile)
 
 
+def _waves(path: str, line: _Line, key: str, text: str) -> WaveComponents | None:
+    """The waves of option ``WaveKin``: none for 0, the components beside the input file for
+    7 (MoorDyn-C's component summing), an error for the others."""
+    mode = _number(path, line, key, text)
+    if mode == 0.0:
+        return None
+    if mode != 7.0:
+        raise _error(path, line.number, key,
+                     f"{text!r}: only waves summed from their components (7, from "
+                     f"{WAVE_FILE}) are supported yet, not wave grids or external waves; "
+                     f"give 0 or 7", text)
+    folder = Path(path).parent if Path(path).is_file() else Path.cwd()
+    components = folder / WAVE_FILE
+    if not components.is_file():
+        raise _error(path, line.number, key,
+                     f"{text!r}: WaveKin 7 reads {WAVE_FILE} beside the input file; there is "
+                     f"no {str(components)!r}", text)
+    return read_wave_frequencies(components)
+
+
 def _options(path: str, body: list[_Line]) -> FileOptions:
     values: dict[str, float] = {}
     settings: list[tuple[str, str]] = []
     seafloor: Seafloor | None = None
     current: CurrentProfile | None = None
+    waves: WaveComponents | None = None
     for line in body:
         fields = line.text.split()
         if not fields:
@@ -584,6 +611,8 @@ def _options(path: str, body: list[_Line]) -> FileOptions:
             settings.append((key, text))
         elif lower == "currents":
             current = _current(path, line, key, text)
+        elif lower == "wavekin":
+            waves = _waves(path, line, key, text)
         elif lower == "seafloorfile":
             if text.lower() not in _OFF:
                 if seafloor is not None:
@@ -607,7 +636,11 @@ def _options(path: str, body: list[_Line]) -> FileOptions:
                          f"unknown option {key!r}; known options: {', '.join(known)}", key)
     if seafloor is not None and "depth" not in values:
         values["depth"] = seafloor.mean_depth
-    return FileOptions(**values, settings=tuple(settings), seafloor=seafloor, current=current)
+    if waves is not None and not values.get("depth", 0.0) > 0.0:
+        raise MooringFileError(f"{path}: WtrDpth: waves (WaveKin 7) need a water depth > 0",
+                               file=path, line=None, field="WtrDpth", value=values.get("depth"))
+    return FileOptions(**values, settings=tuple(settings), seafloor=seafloor, current=current,
+                       waves=waves)
 
 
 def parse_moordyn(text: str, path: str | Path = "<text>") -> MoorDynFile:
@@ -830,6 +863,7 @@ def format_moordyn(model: MoorDynFile, seafloor_path: str | Path | None = None,
         ("axial_friction", "MU_KA", "axial seabed friction coefficient (-)"),
         ("friction_damping", "FricDamp", "friction damping (s/m)"),
         ("static_dynamic_scale", "StatDynFricScale", "static over dynamic friction (-)"),
+        ("wave_ramp", "waveKin_rampT", "the waves' ramp time (s)"),
     ]
     for attr, key, description in named:
         value = getattr(o, attr)
@@ -849,6 +883,8 @@ def format_moordyn(model: MoorDynFile, seafloor_path: str | Path | None = None,
                              "SeafloorFile", "3D seafloor file path"))
     if o.current is not None:
         option_lines.append(("1", "Currents", f"steady current from {PROFILE_FILE}"))
+    if o.waves is not None:
+        option_lines.append(("7", "WaveKin", f"waves summed from {WAVE_FILE}"))
     width_v = max((len(v) for v, _, _ in option_lines), default=1)
     width_k = max((len(k) for _, k, _ in option_lines), default=1)
     out += [f"{v.ljust(width_v)}  {k.ljust(width_k)}  {d}".rstrip() for v, k, d in option_lines]
@@ -887,6 +923,8 @@ def write_moordyn(model: MoorDynFile, path: str | Path) -> Path:
         if model.options.current is not None:
             # MoorDyn reads the profile of Currents 1 beside the input file.
             model.options.current.write(path.with_name(PROFILE_FILE))
+        if model.options.waves is not None:
+            model.options.waves.write(path.with_name(WAVE_FILE))
         path.write_text(format_moordyn(model, seafloor_path, curve_paths), encoding="utf-8")
     except OSError as exc:
         raise MooringFileError(f"cannot write the MoorDyn file {str(path)!r}: {exc.strerror}",

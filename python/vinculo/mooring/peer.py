@@ -156,6 +156,7 @@ def _model_and_file(source: str | Path | MoorDynFile, folder: Path,
             model, options=dataclasses.replace(model.options, time_step=float(time_step)))
     if isinstance(source, MoorDynFile) or time_step is not None or (
             model.options.seafloor is not None or model.options.current is not None
+            or model.options.waves is not None
             or any(t.ea_curve is not None for t in model.line_types.values())):
         # Written again: a seafloor file and stiffness curves are then named by their absolute
         # paths, which MoorDyn finds from any working directory, and a current profile written

@@ -304,12 +304,15 @@ def _assemble(case: MooredBuoyCase, hold_yaw: bool = False) -> Built:
 
     if case.mooring is not None:
         model = build_model(case.mooring, solve=False, couple=False)
-        if model.file.options.current is not None:
-            # The case's sea is the water of the whole run: a second current would be ignored.
+        options = model.file.options
+        if options.current is not None or options.waves is not None:
+            # The case's sea is the water of the whole run: a second current or second waves
+            # would be ignored.
+            key = "Currents 1" if options.current is not None else "WaveKin 7"
             raise InvalidInputError(
-                f"{case.mooring}: Currents 1: the lines' current comes from the case's sea "
-                f"here (its current); set Currents to 0 in the MoorDyn file",
-                name="Currents", value=1)
+                f"{case.mooring}: {key}: the lines' current and waves come from the case's "
+                f"sea here; set Currents and WaveKin to 0 in the MoorDyn file",
+                name=key.split()[0], value=key)
         system, lines = model.system, model.lines
         coupled = {p.id for p in model.file.points if p.attachment == "coupled"}
         fairlead_points = [model.points[p.id - 1] for p in model.file.points
