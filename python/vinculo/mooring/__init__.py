@@ -13,6 +13,8 @@
   (:func:`read_stiffness_curve`).
 - :mod:`vinculo.mooring.wave_components`: MoorDyn's waves summed from their components
   (``WaveKin 7``, :func:`read_wave_frequencies`).
+- :mod:`vinculo.mooring.channels`: MoorDyn's output channels (``FAIRTEN1``, ``L1N5PZ``, ...),
+  which a run writes (:meth:`MooringRun.channels`).
 - :mod:`vinculo.mooring.motion`: the prescribed motion of the coupled (Vessel) points.
 - :mod:`vinculo.mooring.model`: the vinculo model of a file (:func:`build_model`).
 - :mod:`vinculo.mooring.analysis`: :func:`statics` (the static equilibrium: end tensions and

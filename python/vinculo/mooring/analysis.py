@@ -189,6 +189,37 @@ class MooringRun:
         return [f"line{row.id}_{end}_{q}" for row in self.model.file.lines for end in "AB"
                 for q in ("fx", "fy", "fz", "tension")]
 
+    def channels(self) -> dict[str, np.ndarray]:
+        """The file's output channels (its OUTPUTS section) over the stored times, by name
+        (:mod:`vinculo.mooring.channels`).
+
+        Returns:
+            ``{name: (times,) values}``, in the file's order.
+        """
+        from vinculo.mooring.channels import channel_values, parse_channel
+
+        return {name: channel_values(self, parse_channel(name))
+                for name in self.model.file.outputs}
+
+    def channels_csv(self, path: str | Path) -> Path:
+        """Write the output channels over time (MoorDyn's main output, as CSV).
+
+        Arguments:
+            path: the CSV file: ``time``, then one column per channel, named as in the file.
+
+        Returns:
+            The path written.
+        """
+        path = Path(path)
+        values = self.channels()
+        with path.open("w", newline="", encoding="utf-8") as handle:
+            writer = csv.writer(handle)
+            writer.writerow(["time", *values])
+            columns = list(values.values())
+            for i, t in enumerate(self.times):
+                writer.writerow([repr(float(t)), *(repr(float(c[i])) for c in columns)])
+        return path
+
     def to_csv(self, path: str | Path) -> Path:
         """Write the end forces and tensions over time.
 
@@ -293,6 +324,8 @@ def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_en
         folder = Path(output)
         folder.mkdir(parents=True, exist_ok=True)
         result.files["tensions"] = result.to_csv(folder / "tensions.csv")
+        if built.file.outputs:
+            result.files["channels"] = result.channels_csv(folder / "channels.csv")
         result.files["netcdf"] = Path(solution.save_netcdf(
             folder / "run.nc", attributes=_attributes(built, dt)) or folder / "run.nc")
         if plots:

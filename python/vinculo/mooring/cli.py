@@ -10,8 +10,9 @@ Usage::
 (columns ``line,end,point,x,y,z,fx,fy,fz,tension,laid_length``, two rows per line: end A, then
 end B; ``fx fy fz`` the force the line exerts on the end point). ``run`` starts from that
 equilibrium, moves the Vessel/Coupled points by the motion file (``time``, then ``x, y, z`` of
-each coupled point in file order) and writes ``DIR/tensions.csv``, ``DIR/run.nc`` and the plots
-``DIR/shapes.png`` and ``DIR/tensions.png``.
+each coupled point in file order) and writes ``DIR/tensions.csv``, ``DIR/run.nc``, the plots
+``DIR/shapes.png`` and ``DIR/tensions.png``, and, when the file has an OUTPUTS section,
+``DIR/channels.csv`` (its channels over time, :mod:`vinculo.mooring.channels`).
 """
 
 from __future__ import annotations
@@ -90,8 +91,9 @@ def add_mooring_parser(commands: Any) -> None:
         description=(
             "Start from the static equilibrium and move the Vessel/Coupled points by a recorded "
             "motion; write the end forces and tensions over time (DIR/tensions.csv), the whole "
-            "run as NetCDF (DIR/run.nc) and plots of the line shapes and tensions "
-            "(DIR/shapes.png, DIR/tensions.png)."
+            "run as NetCDF (DIR/run.nc), plots of the line shapes and tensions "
+            "(DIR/shapes.png, DIR/tensions.png) and the file's OUTPUTS channels "
+            "(DIR/channels.csv)."
         ),
     )
     run.add_argument("file", metavar="FILE", type=_existing_file,

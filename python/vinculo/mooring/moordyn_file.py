@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from vinculo.errors import InvalidInputError, MooringFileError
+from vinculo.mooring.channels import parse_channel
 from vinculo.mooring.current_profile import PROFILE_FILE, CurrentProfile, read_current_profile
 from vinculo.mooring.line import LineType
 from vinculo.mooring.seafloor import Seafloor, read_seafloor
@@ -213,7 +214,8 @@ class MoorDynFile:
         lines: the LINES rows, in file order.
         options: the OPTIONS section.
         title: the free text before the first section (without its header line).
-        outputs: the OUTPUTS channel names, kept for writing back.
+        outputs: the OUTPUTS channel names (:mod:`vinculo.mooring.channels`): a run writes
+            them (``channels.csv``), and they are written back.
         path: the file read (None for a model parsed from text or built in code).
     """
 
@@ -725,8 +727,14 @@ def parse_moordyn(text: str, path: str | Path = "<text>") -> MoorDynFile:
         elif kind == "options":
             options = _options(name, body)
         elif kind == "outputs":
-            outputs = [ln.text.strip() for ln in body if ln.text.strip()]
-            outputs = [o for o in outputs if o.upper() != "END"]
+            rows = [ln for ln in body if ln.text.strip() and ln.text.strip().upper() != "END"]
+            for ln in rows:
+                try:
+                    parse_channel(ln.text.strip())
+                except InvalidInputError as exc:
+                    raise _error(name, ln.number, "OUTPUTS", str(exc),
+                                 ln.text.strip()) from None
+            outputs = [ln.text.strip() for ln in rows]
     if not lines:
         raise _error(name, None, "LINES",
                      "the file has no LINES section or no line in it; a MoorDyn model needs "

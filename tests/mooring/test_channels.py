@@ -1,0 +1,94 @@
+"""MoorDyn's output channels (OUTPUTS): their values against the closed-form catenary and the
+prescribed motion, the CSV a run writes, and the names refused."""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from vinculo import cli
+from vinculo.errors import MooringFileError
+from vinculo.mooring import read_moordyn, solve_catenary, weight_in_water
+from vinculo.mooring.analysis import run
+from vinculo.mooring.bench import motion_for
+
+DATA = Path(__file__).resolve().parent.parent / "data" / "moordyn"
+CHANNELS = ["FAIRTEN1", "AnchTen1", "L1N20T", "L1N40PZ", "CON2PX", "Con2vX", "LINE1TENA",
+            "Point2PZ"]
+
+
+def _file(tmp_path: Path) -> Path:
+    """hanging_line.txt with 40 segments and the channels above."""
+    text = (DATA / "hanging_line.txt").read_text().replace("100.0     20 ", "100.0     40 ")
+    text = text.replace("------------------------- need this line",
+                        "---------------------- OUTPUTS ---------\n" + "\n".join(CHANNELS)
+                        + "\nEND\n------------------------- need this line")
+    path = tmp_path / "hanging.txt"
+    path.write_text(text)
+    return path
+
+
+def test_channels_are_the_catenary_at_rest_and_follow_the_motion(tmp_path):
+    model = read_moordyn(_file(tmp_path))
+    assert model.outputs == tuple(CHANNELS)
+    motion = motion_for(model)
+    result = run(model, motion, 5.0, dt=0.05, plots=False)
+    values = result.channels()
+    assert list(values) == CHANNELS
+    # At t = 0 (the statics): the elastic catenary between the two points (40 segments: the
+    # lumped-mass error below the 1e-3 asserted), the mid node's tension that at s = L/2.
+    kind = model.line_types["chain"]
+    w = weight_in_water(kind.mass_per_length, kind.diameter, model.options.density,
+                        model.options.gravity)
+    cat = solve_catenary(80.0, 0.0, 100.0, w, kind.ea, seabed_contact=False)
+    assert values["FAIRTEN1"][0] == pytest.approx(cat.fairlead_tension, rel=1e-3)
+    assert values["AnchTen1"][0] == pytest.approx(cat.anchor_tension, rel=1e-3)
+    assert values["L1N20T"][0] == pytest.approx(float(cat.tension(50.0)), rel=1e-3)
+    assert math.isclose(values["L1N20T"][0], cat.fairlead_tension, rel_tol=1e-3) is False
+    np.testing.assert_array_equal(values["LINE1TENA"], values["AnchTen1"])
+    # The coupled point follows the motion exactly; the line's last node is that point.
+    times = np.asarray(result.times)
+    x = np.array([motion.positions(t)[0][0] for t in times])
+    vx = np.array([motion.velocities(t)[0][0] for t in times])
+    np.testing.assert_allclose(values["CON2PX"], x, rtol=0, atol=1e-9)
+    # Its velocity is the time rule's (trapezoidal: the velocity of the positions, second
+    # order), within h^2/6 |x'''| of the motion's (A omega^3 = 2 m (2 pi / 10 s)^3; measured
+    # 7.8e-5 m/s at h = 0.05 s).
+    bound = 0.05**2 / 6.0 * 2.0 * (2.0 * math.pi / 10.0) ** 3
+    np.testing.assert_allclose(values["Con2vX"], vx, rtol=0, atol=bound)
+    np.testing.assert_array_equal(values["L1N40PZ"], values["Point2PZ"])
+
+
+def test_a_run_writes_the_channels_beside_its_results(tmp_path, capsys):
+    path = _file(tmp_path)
+    motion = tmp_path / "still.csv"
+    motion.write_text("time,x,y,z\n0,40,0,-20\n10,40,0,-20\n")
+    assert cli.main(["mooring", "run", str(path), "--motion", str(motion), "--t-end", "1",
+                     "--dt", "0.1", "--no-plots", "--no-progress", "--output",
+                     str(tmp_path / "out")]) == 0
+    capsys.readouterr()
+    with (tmp_path / "out" / "channels.csv").open() as handle:
+        rows = list(csv.reader(handle))
+    assert rows[0] == ["time", *CHANNELS] and len(rows) == 12
+    # At rest: the fairlead tension stays the statics' (the same particle and state).
+    fair = [float(r[1]) for r in rows[1:]]
+    assert max(fair) - min(fair) < 1e-6 * fair[0]
+
+
+@pytest.mark.parametrize("name", ["BODY1PX", "L1N5AX", "FAIRTEN", "ROD1SUB"])
+def test_a_channel_vinculo_cannot_give_is_refused_by_line(tmp_path, name):
+    text = (DATA / "hanging_line.txt").read_text().replace(
+        "------------------------- need this line",
+        f"---------------------- OUTPUTS ---------\nFAIRTEN1\n{name}\nEND\n"
+        "------------------------- need this line")
+    path = tmp_path / "bad.txt"
+    path.write_text(text)
+    with pytest.raises(MooringFileError) as info:
+        read_moordyn(path)
+    number = next(k + 1 for k, ln in enumerate(text.splitlines()) if ln == name)
+    assert (info.value.line, info.value.field) == (number, "OUTPUTS")
+    assert name in str(info.value)
