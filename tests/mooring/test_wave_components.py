@@ -85,6 +85,25 @@ def test_a_malformed_components_file_names_the_file_line_and_field(tmp_path, row
         WaveComponents(np.array([-1.0]), np.array([1.0]), np.array([0.0]))
 
 
+def test_the_equilibrium_is_in_still_water_and_the_run_then_in_the_waves(tmp_path):
+    # The statics of the chain in a wave (here without a ramp: the wave is there at t = 0) is
+    # the chain's in still water (MoorDyn's initial condition leaves the waves out too), to
+    # round-off; the run then feels the wave.
+    from vinculo.mooring.analysis import statics
+
+    text = (DATA / "chain_in_waves.txt").read_text().replace("10.0          waveKin_rampT",
+                                                             "0.0  waveKin_rampT")
+    (tmp_path / "m.txt").write_text(text)
+    (tmp_path / "wave_frequencies.txt").write_text((DATA / "wave_frequencies.txt").read_text())
+    waves = statics(read_moordyn(tmp_path / "m.txt")).ends
+    still = statics(read_moordyn(DATA.parent / "hanging_line.txt")).ends
+    for a, b in zip(waves, still, strict=True):
+        assert a.force == pytest.approx(b.force, rel=1e-12, abs=1e-9)
+    result = run(read_moordyn(DATA / "chain_in_waves.txt"), None, 30.0, dt=0.05, plots=False)
+    swing = np.ptp(result.end_tensions[result.times > 15.0, 0, 1])
+    assert swing > 40.0
+
+
 def test_other_wave_modes_are_refused(tmp_path):
     text = (DATA / "chain_in_waves.txt").read_text().replace("7             WaveKin",
                                                              "3             WaveKin")

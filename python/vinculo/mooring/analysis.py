@@ -305,6 +305,11 @@ def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_en
     every = 1 if output_every is None else _output_steps(output_every, dt)
     _check_motion(path, motion)
     built = build_model(path, motion)
+    if built.file.options.waves is not None:
+        # The file's waves, from the equilibrium in its current alone.
+        from vinculo.mooring.model import file_water
+
+        built.system.set_water(file_water(built.file.options))
     if motion is not None and np.any(motion.velocities(0.0) != 0.0):
         # The coupled points start moving: the velocities of the lines' nodes are made
         # consistent with theirs (the least mass-weighted change).

@@ -18,6 +18,7 @@ file's OPTIONS), and the initial state is the static equilibrium
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -206,8 +207,12 @@ def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, 
     system = System(gravity=(0.0, 0.0, -options.gravity))
     flowing = file_water(options)
     if flowing is not None:
-        # The lines' and free points' loads in the file's current and waves.
-        system.set_water(flowing)
+        # The lines' and free points' loads in the file's current; its waves join for a
+        # run (:func:`vinculo.mooring.analysis.run`), the equilibrium and its end forces are
+        # in the current alone, as MoorDyn's initial condition leaves the waves out.
+        still = (file_water(dataclasses.replace(options, waves=None))
+                 if options.waves is not None else flowing)
+        system.set_water(still if still is not None else _core_still(options))
     the_water, the_seabed = water(options), seabed(options)
     start = motion.positions(0.0) if motion is not None else None
     points: list[ParticleId] = []
@@ -260,3 +265,12 @@ def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, 
 
         built.statics = solve_statics(system, **statics_options)
     return built
+
+
+def _core_still(options: FileOptions) -> Any:
+    """Still water that fills all space, as a system's water is before any is given."""
+    from vinculo import _core
+
+    empty = np.zeros(0)
+    return _core.Water(math.inf, float(options.gravity), empty, empty, empty, empty, "uniform",
+                       np.zeros((1, 3)), empty, 0.0, "wheeler", False, 0.0)
