@@ -20,7 +20,6 @@ do not increase, is an error naming the file, the line and the field).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -28,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from vinculo.errors import InvalidInputError, MooringFileError
+from vinculo.mooring.table_file import numbers, read_lines
 
 __all__ = ["PROFILE_FILE", "CurrentProfile", "read_current_profile"]
 
@@ -118,11 +118,7 @@ def read_current_profile(path: str | Path) -> CurrentProfile:
     """
     path = Path(path)
     name = str(path)
-    try:
-        lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
-    except OSError as exc:
-        raise MooringFileError(f"cannot read the current profile {name!r}: {exc.strerror}",
-                               file=name, line=None, field=None, value=None) from None
+    lines = read_lines(path, "current profile")
     heights, velocities = [], []
     for number, text in enumerate(lines[3:], start=4):
         fields = text.split()
@@ -133,18 +129,7 @@ def read_current_profile(path: str | Path) -> CurrentProfile:
                 f"{name}, line {number}: z ux uy uz: {len(fields)} values; give the height "
                 f"and the three components of the current there", file=name, line=number,
                 field="z ux uy uz", value=text.strip())
-        values = []
-        for k, item in enumerate(fields):
-            try:
-                value = float(item)
-            except ValueError:
-                value = math.nan
-            if not math.isfinite(value):
-                field = ("z", "ux", "uy", "uz")[k]
-                raise MooringFileError(f"{name}, line {number}: {field}: {item!r} is not a "
-                                       f"finite number", file=name, line=number, field=field,
-                                       value=item)
-            values.append(value)
+        values = numbers(name, number, fields, ("z", "ux", "uy", "uz"))
         if heights and values[0] <= heights[-1][0]:
             raise MooringFileError(
                 f"{name}, line {number}: z: {fields[0]} is not above the height before it "

@@ -537,43 +537,42 @@ def _seafloor(path: str, line: _Line, key: str, text: str) -> Seafloor:
                  f"{text!r}: no such seafloor file (looked for {looked})", text)
 
 
-def _current(path: str, line: _Line, key: str, text: str) -> CurrentProfile | None:
-    """The current of option ``Currents``: none for 0, the profile beside the input file for
-    1 (MoorDyn-C's steady current), an error for the others."""
+def _beside(path: str, line: _Line, key: str, text: str, modes: dict[float, str],
+            what: str) -> Path | None:
+    """The file that option ``key`` = ``text`` reads beside the input file: None for mode 0,
+    ``modes[mode]`` for a supported mode, an error for the others (``what`` they are) or for a
+    missing file."""
     mode = _number(path, line, key, text)
     if mode == 0.0:
         return None
-    if mode != 1.0:
+    if mode not in modes:
+        given = ", ".join(f"{m:g} ({f})" for m, f in modes.items())
         raise _error(path, line.number, key,
-                     f"{text!r}: only steady currents (1, from {PROFILE_FILE}) are supported "
-                     f"yet, not dynamic or gridded ones; give 0 or 1", text)
+                     f"{text!r}: only {what} are supported yet ({given}); give 0 or "
+                     f"{' or '.join(f'{m:g}' for m in modes)}", text)
     folder = Path(path).parent if Path(path).is_file() else Path.cwd()
-    profile = folder / PROFILE_FILE
-    if not profile.is_file():
+    found = folder / modes[mode]
+    if not found.is_file():
         raise _error(path, line.number, key,
-                     f"{text!r}: Currents 1 reads {PROFILE_FILE} beside the input file; there "
-                     f"is no {str(profile)!r}", text)
-    return read_current_profile(profile)
+                     f"{text!r}: {key} {mode:g} reads {modes[mode]} beside the input file; "
+                     f"there is no {str(found)!r}", text)
+    return found
+
+
+def _current(path: str, line: _Line, key: str, text: str) -> CurrentProfile | None:
+    """The current of option ``Currents``: none for 0, the profile beside the input file for
+    1 (MoorDyn-C's steady current), an error for the others."""
+    found = _beside(path, line, key, text, {1.0: PROFILE_FILE},
+                    "steady currents (not dynamic or gridded ones)")
+    return None if found is None else read_current_profile(found)
 
 
 def _waves(path: str, line: _Line, key: str, text: str) -> WaveComponents | None:
     """The waves of option ``WaveKin``: none for 0, the components beside the input file for
     7 (MoorDyn-C's component summing), an error for the others."""
-    mode = _number(path, line, key, text)
-    if mode == 0.0:
-        return None
-    if mode != 7.0:
-        raise _error(path, line.number, key,
-                     f"{text!r}: only waves summed from their components (7, from "
-                     f"{WAVE_FILE}) are supported yet, not wave grids or external waves; "
-                     f"give 0 or 7", text)
-    folder = Path(path).parent if Path(path).is_file() else Path.cwd()
-    components = folder / WAVE_FILE
-    if not components.is_file():
-        raise _error(path, line.number, key,
-                     f"{text!r}: WaveKin 7 reads {WAVE_FILE} beside the input file; there is "
-                     f"no {str(components)!r}", text)
-    return read_wave_frequencies(components)
+    found = _beside(path, line, key, text, {7.0: WAVE_FILE},
+                    "waves summed from their components (not wave grids or external waves)")
+    return None if found is None else read_wave_frequencies(found)
 
 
 def _options(path: str, body: list[_Line]) -> FileOptions:

@@ -49,6 +49,7 @@ __all__ = [
     "moordyn_available",
     "moordyn_initial_state",
     "run_moordyn",
+    "settled_end_forces",
 ]
 
 
@@ -384,6 +385,38 @@ def moordyn_initial_state(source: str | Path | MoorDynFile, motion: Motion | Non
                 md.Close(system)
     np.savez(_forces_file(path), end_forces=forces, segment_tensions=tensions)
     return path
+
+
+def settled_end_forces(source: str | Path | MoorDynFile, t_end: float, settle: float, *,
+                       dt_output: float = 0.5) -> np.ndarray:
+    """MoorDyn's equilibrium by its dynamics: the mean of each line's end forces over
+    ``[settle, t_end]`` of a run with the coupled points held where the file puts them.
+
+    MoorDyn's own initial condition leaves a file's current and waves out and can stop short
+    on a sloping seabed; its dynamics from there settle about the equilibrium (with the light
+    oscillation that its damping leaves, which the mean averages out).
+
+    Arguments:
+        source: the MoorDyn input file, or a model to write to one.
+        t_end: the end of the run (s).
+        settle: the time from which its forces are averaged (s, below ``t_end``).
+        dt_output: the interval of the forces averaged (s).
+
+    Returns:
+        ``(lines, 2, 3)``: the mean force of each line on its end A and end B (N).
+
+    Raises:
+        PeerError: when MoorDyn is not installed, rejects the file or blows up.
+        InvalidInputError: for a ``settle`` not below ``t_end``.
+    """
+    if not 0.0 <= settle < t_end:
+        raise InvalidInputError(f"settled_end_forces: settle = {settle!r} s: give a time in "
+                                f"[0, t_end = {t_end!r})", name="settle", value=settle)
+    run = run_moordyn(source, None, t_end, dt_output=dt_output)
+    if run.error is not None:
+        raise PeerError(f"MoorDyn did not settle: {run.error}")
+    later = np.asarray(run.times) >= settle
+    return np.asarray(run.end_forces)[later].mean(axis=0)
 
 
 def largest_stable_step(source: str | Path | MoorDynFile, motion: Motion | None, t_end: float,

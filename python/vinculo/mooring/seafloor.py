@@ -33,7 +33,6 @@ line and the field); :meth:`Seafloor.write` writes MoorDyn-C's.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -42,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from vinculo.errors import InvalidInputError, MooringFileError
+from vinculo.mooring.table_file import numbers, read_lines
 
 __all__ = ["Seafloor", "read_seafloor"]
 
@@ -160,21 +160,6 @@ class Seafloor:
         return path
 
 
-def _numbers(path: str, number: int, what: str, fields: list[str]) -> list[float]:
-    values = []
-    for k, text in enumerate(fields):
-        try:
-            value = float(text)
-        except ValueError:
-            value = math.nan
-        if not math.isfinite(value):
-            raise MooringFileError(
-                f"{path}, line {number}: {what} {k + 1}: {text!r} is not a finite number",
-                file=path, line=number, field=what, value=text)
-        values.append(value)
-    return values
-
-
 def _tick(ticks: np.ndarray, value: float) -> int | None:
     """The index of the tick ``value`` is (within 1e-9 of the grid's extent), None if none."""
     k = int(np.argmin(np.abs(ticks - value)))
@@ -197,12 +182,8 @@ def read_seafloor(path: str | Path) -> Seafloor:
     """
     path = Path(path)
     name = str(path)
-    try:
-        text = path.read_text(encoding="utf-8", errors="replace")
-    except OSError as exc:
-        raise MooringFileError(f"cannot read the seafloor file {name!r}: {exc.strerror}",
-                               file=name, line=None, field=None, value=None) from None
-    rows = [(k + 1, ln.split()) for k, ln in enumerate(text.splitlines()) if ln.strip()]
+    lines = read_lines(path, "seafloor file")
+    rows = [(k + 1, ln.split()) for k, ln in enumerate(lines) if ln.strip()]
     heading = next((k for k, (_, fields) in enumerate(rows[:3])
                     if fields[0].lower() == "ngridx"), None)
     if heading is not None:
@@ -213,7 +194,7 @@ def read_seafloor(path: str | Path) -> Seafloor:
             f"'x y z' for each grid point; it has {len(rows)} lines", file=name, line=None,
             field="nx ny", value=len(rows))
     number, head = rows[0]
-    counts = _numbers(name, number, "nx ny", head[:2]) if len(head) >= 2 else []
+    counts = numbers(name, number, head[:2], ["nx ny"]) if len(head) >= 2 else []
     if len(counts) != 2 or any(c < 1 or c != int(c) for c in counts):
         raise MooringFileError(
             f"{name}, line {number}: nx ny: {' '.join(head)!r}: give the numbers of x and y "
@@ -226,7 +207,7 @@ def read_seafloor(path: str | Path) -> Seafloor:
             raise MooringFileError(
                 f"{name}, line {number}: {axis} ticks: {len(fields)} values where line 1 says "
                 f"{n}", file=name, line=number, field=f"{axis} ticks", value=len(fields))
-        values = np.array(_numbers(name, number, f"{axis} tick", fields))
+        values = np.array(numbers(name, number, fields, [f"{axis} tick"]))
         if np.any(np.diff(values) <= 0.0):
             k = int(np.argmax(np.diff(values) <= 0.0))
             raise MooringFileError(
@@ -243,7 +224,7 @@ def read_seafloor(path: str | Path) -> Seafloor:
                 f"{name}, line {number}: x y z: {len(fields)} values; give the point's x, y "
                 f"and the seabed's height z", file=name, line=number, field="x y z",
                 value=" ".join(fields))
-        a, b, height = _numbers(name, number, "x y z", fields)
+        a, b, height = numbers(name, number, fields, ["x y z"])
         i, j = _tick(x, a), _tick(y, b)
         for axis, index, value in (("x", i, a), ("y", j, b)):
             if index is None:
@@ -283,7 +264,7 @@ def _read_bathymetry(path: Path, rows: list[tuple[int, list[str]]]) -> Seafloor:
                 f"{name}{f', line {number}' if number else ''}: {key}: give '{key} n', the "
                 f"number of grid lines", file=name, line=number, field=key, value=None)
         number, fields = rows[k]
-        value = _numbers(name, number, key, fields[1:2])[0]
+        value = numbers(name, number, fields[1:2], [key])[0]
         if value < 1 or value != int(value):
             raise MooringFileError(f"{name}, line {number}: {key}: {fields[1]!r}: give an "
                                    f"integer >= 1", file=name, line=number, field=key,
@@ -300,7 +281,7 @@ def _read_bathymetry(path: Path, rows: list[tuple[int, list[str]]]) -> Seafloor:
         raise MooringFileError(f"{name}, line {number}: x ticks: {len(fields)} values where "
                                f"nGridX says {nx}", file=name, line=number, field="x ticks",
                                value=len(fields))
-    x = np.array(_numbers(name, number, "x tick", fields))
+    x = np.array(numbers(name, number, fields, ["x tick"]))
     y, depths = [], []
     for number, fields in rows[3:]:
         if len(fields) != nx + 1:
@@ -308,7 +289,7 @@ def _read_bathymetry(path: Path, rows: list[tuple[int, list[str]]]) -> Seafloor:
                 f"{name}, line {number}: y depths: {len(fields)} values; give the y tick and "
                 f"the {nx} depths along it", file=name, line=number, field="y depths",
                 value=len(fields))
-        values = _numbers(name, number, "y depths", fields)
+        values = numbers(name, number, fields, ["y depths"])
         y.append(values[0])
         depths.append(values[1:])
     for axis, ticks, number in (("x", x, rows[2][0]), ("y", np.array(y), rows[3][0])):

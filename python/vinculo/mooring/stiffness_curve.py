@@ -21,7 +21,6 @@ naming the file, the line and the field).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -29,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from vinculo.errors import InvalidInputError, MooringFileError
+from vinculo.mooring.table_file import numbers, read_lines
 
 __all__ = ["StiffnessCurve", "read_stiffness_curve"]
 
@@ -136,11 +136,7 @@ def read_stiffness_curve(path: str | Path) -> StiffnessCurve:
     """
     path = Path(path)
     name = str(path)
-    try:
-        lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
-    except OSError as exc:
-        raise MooringFileError(f"cannot read the stiffness curve {name!r}: {exc.strerror}",
-                               file=name, line=None, field=None, value=None) from None
+    lines = read_lines(path, "stiffness curve")
     points: list[tuple[float, float, int]] = []
     for number, text in enumerate(lines[3:], start=4):
         fields = text.split()
@@ -151,17 +147,7 @@ def read_stiffness_curve(path: str | Path) -> StiffnessCurve:
                 f"{name}, line {number}: strain tension: {len(fields)} values; give a strain "
                 f"and the tension there", file=name, line=number, field="strain tension",
                 value=text.strip())
-        values = []
-        for field, item in zip(("strain", "tension"), fields, strict=True):
-            try:
-                value = float(item)
-            except ValueError:
-                value = math.nan
-            if not math.isfinite(value):
-                raise MooringFileError(f"{name}, line {number}: {field}: {item!r} is not a "
-                                       f"finite number", file=name, line=number, field=field,
-                                       value=item)
-            values.append(value)
+        values = numbers(name, number, fields, ("strain", "tension"))
         if points:
             for k, field in enumerate(("strain", "tension")):
                 if values[k] <= points[-1][k]:

@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from vinculo.errors import InvalidInputError, MooringFileError
+from vinculo.mooring.table_file import numbers, read_lines
 
 __all__ = ["WAVE_FILE", "WaveComponents", "read_wave_frequencies"]
 
@@ -120,11 +121,7 @@ def read_wave_frequencies(path: str | Path) -> WaveComponents:
     """
     path = Path(path)
     name = str(path)
-    try:
-        lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
-    except OSError as exc:
-        raise MooringFileError(f"cannot read the wave components {name!r}: {exc.strerror}",
-                               file=name, line=None, field=None, value=None) from None
+    lines = read_lines(path, "wave components")
     omegas, amplitudes, directions = [], [], []
     for number, text in enumerate(lines, start=1):
         fields = text.split("#", 1)[0].split()
@@ -136,17 +133,7 @@ def read_wave_frequencies(path: str | Path) -> WaveComponents:
                 f"frequency, the amplitude's real and imaginary parts and optionally the "
                 f"direction", file=name, line=number, field="omega re im [beta]",
                 value=text.strip())
-        values = []
-        for field, item in zip(("omega", "re", "im", "beta"), fields, strict=False):
-            try:
-                value = float(item)
-            except ValueError:
-                value = math.nan
-            if not math.isfinite(value):
-                raise MooringFileError(f"{name}, line {number}: {field}: {item!r} is not a "
-                                       f"finite number", file=name, line=number, field=field,
-                                       value=item)
-            values.append(value)
+        values = numbers(name, number, fields, ("omega", "re", "im", "beta"))
         omega, amplitude = values[0], complex(values[1], values[2])
         if omega < 0.0 or (omega == 0.0 and amplitude != 0.0):
             raise MooringFileError(
