@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from vinculo.errors import InvalidInputError, MooringFileError
-from vinculo.mooring.table_file import numbers, read_lines
+from vinculo.mooring._table_file import numbers, read_lines
 
 __all__ = ["StiffnessCurve", "read_stiffness_curve"]
 

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from vinculo.errors import InvalidInputError, MooringFileError
-from vinculo.mooring.table_file import numbers, read_lines
+from vinculo.mooring._table_file import numbers, read_lines
 
 __all__ = ["WAVE_FILE", "WaveComponents", "read_wave_frequencies"]
 
