@@ -92,3 +92,55 @@ def test_a_channel_vinculo_cannot_give_is_refused_by_line(tmp_path, name):
     number = next(k + 1 for k, ln in enumerate(text.splitlines()) if ln == name)
     assert (info.value.line, info.value.field) == (number, "OUTPUTS")
     assert name in str(info.value)
+
+
+PENDULUM = """--------------------- MoorDyn Input File ------------------------------------
+A 100 kg bob on a 10 m neutrally buoyant rope, released at rest 5 degrees from the vertical
+---------------------- LINE TYPES ----------------------------------------------
+TypeName  Diam   Mass/m   EA     BA/-zeta  EI  Cd   Ca   CdAx  CaAx
+(name)    (m)    (kg/m)   (N)    (N-s/-)   (N-m^2) (-) (-) (-)   (-)
+rope      0.01   {rho}  1.0e9  0.0      0   0.0  0.0  0.0   0.0
+---------------------- POINTS --------------------------------------------------
+ID  Attachment  X       Y    Z       Mass  Volume  CdA  Ca
+(#) (-)         (m)     (m)  (m)     (kg)  (m^3)   (m^2) (-)
+1   Fixed       0.0     0.0  -5.0    0     0       0    0
+2   Free        {x}  0.0  {z}   100   0       0    0
+---------------------- LINES ---------------------------------------------------
+ID  LineType  AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
+(#) (name)    (#)      (#)      (m)       (-)      (-)
+1   rope      1        2        10.0      1        -
+---------------------- OPTIONS -------------------------------------------------
+200.0         WtrDpth    water depth (m)
+---------------------- OUTPUTS -------------------------------------------------
+CON2PX
+------------------------- need this line ---------------------------------------
+"""
+
+
+def test_a_run_from_the_files_positions_swings_the_pendulum_it_describes(tmp_path):
+    # start="file": the bob released where the file puts it, at rest (MoorDyn without its
+    # initial condition). A pendulum of 10 m, 5 degrees: its period is
+    # 2 pi sqrt(L m_i / (m g)) (1 + theta^2 / 16 + 11 theta^4 / 3072), m_i = 100.4 kg with the
+    # rope's half segment lumped on the bob (neutrally buoyant: inertia, no weight); the run's
+    # period between two upward crossings of x = 0 meets it within 1e-4 (the trapezoidal
+    # rule's phase error at 5 ms is 2e-6, the amplitude term 4.8e-4). From the statics it would
+    # hang still.
+    theta = math.radians(5.0)
+    rho = 1025.0 * math.pi * 0.01**2 / 4.0
+    text = PENDULUM.replace("{rho}", repr(rho)).replace(
+        "{x}", repr(10.0 * math.sin(theta))).replace("{z}", repr(-5.0 - 10.0 * math.cos(theta)))
+    path = tmp_path / "pendulum.txt"
+    path.write_text(text)
+    result = run(path, None, 14.0, dt=0.005, plots=False, start="file")
+    t, x = np.asarray(result.times), result.channels()["CON2PX"]
+    assert x[0] == pytest.approx(10.0 * math.sin(theta), rel=1e-12)
+    up = [t[k] - x[k] * (t[k + 1] - t[k]) / (x[k + 1] - x[k])
+          for k in range(len(t) - 1) if x[k] < 0.0 <= x[k + 1]]
+    inertia = 100.0 + rho * 10.0 / 2.0
+    g = 9.80665
+    period = (2.0 * math.pi * math.sqrt(10.0 * inertia / (100.0 * g))
+              * (1.0 + theta**2 / 16.0 + 11.0 * theta**4 / 3072.0))
+    assert len(up) >= 2
+    assert up[1] - up[0] == pytest.approx(period, rel=1e-4)
+    still = run(path, None, 1.0, dt=0.005, plots=False).channels()["CON2PX"]
+    assert np.abs(still).max() < 1e-9

@@ -247,7 +247,7 @@ class MooringRun:
 def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_end: float, *,
         dt: float = 0.02, output_every: float | None = None, output: str | Path | None = None,
         plots: bool = True, progress: bool | Callable[[float, float], None] = False,
-        **options: Any) -> MooringRun:
+        start: str = "statics", **options: Any) -> MooringRun:
     """Run a mooring from its static equilibrium with the coupled points moved by a motion.
 
     Arguments:
@@ -263,6 +263,11 @@ def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_en
         output: a folder for ``tensions.csv``, ``run.nc`` and the plots (None: write nothing).
         plots: also draw ``shapes.png`` and ``tensions.png`` into ``output``.
         progress: True draws a progress bar on standard error (see :func:`vinculo.simulate`).
+        start: ``"statics"`` (the default): from the static equilibrium; ``"file"``: from the
+            file's point positions and the lines' initial shapes (the catenary between their
+            ends, or a parabola where there is none) at rest, as MoorDyn without its initial
+            condition (TmaxIC 0): a model released from a shape, or one without a unique
+            equilibrium (a slack neutrally buoyant line).
         **options: run options passed to :func:`vinculo.simulate`. ``t_eval`` defaults to
             the multiples of ``output_every`` (else ``dt``) and ``t_end`` (unless
             ``save_every`` or ``adaptive`` is given): the run's stored states are at those
@@ -295,16 +300,19 @@ def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_en
     if not (math.isfinite(t_end) and t_end > 0.0):
         raise InvalidInputError(f"t_end = {t_end!r}: give an end time > 0 s", name="t_end",
                                 value=t_end)
+    if start not in ("statics", "file"):
+        raise InvalidInputError(f"start = {start!r}: give \"statics\" or \"file\"",
+                                name="start", value=start)
     if motion is not None:
-        start, end = motion.domain()
-        if start > 0.0 or end < t_end:
+        first, last = motion.domain()
+        if first > 0.0 or last < t_end:
             raise InvalidInputError(
-                f"{motion.source} covers t = {start:g} to {end:g} s; the run needs 0 to "
+                f"{motion.source} covers t = {first:g} to {last:g} s; the run needs 0 to "
                 f"{t_end:g} s: give a shorter --t-end or a longer record", name="t_end",
                 value=t_end)
     every = 1 if output_every is None else _output_steps(output_every, dt)
     _check_motion(path, motion)
-    built = build_model(path, motion)
+    built = build_model(path, motion, solve=start == "statics")
     if built.file.options.waves is not None:
         # The file's waves, from the equilibrium in its current alone.
         from vinculo.mooring.model import file_water

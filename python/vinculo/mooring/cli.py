@@ -4,6 +4,7 @@ Usage::
 
     vinculo mooring statics FILE [--output DIR]
     vinculo mooring run FILE [--motion FILE.csv] --t-end T [--dt DT] [--output-every S]
+                        [--start statics|file]
                         [--output DIR] [--no-plots] [--no-progress]
 
 ``statics`` prints each line's end tensions and laid length and writes ``DIR/statics.csv``
@@ -112,6 +113,10 @@ def add_mooring_parser(commands: Any) -> None:
                      "as MoorDyn's dtOut (default: every step)")
     run.add_argument("--output", "-o", metavar="DIR", type=Path, default=Path("output"),
                      help="folder of the results (created if missing; default: output)")
+    run.add_argument("--start", choices=("statics", "file"), default="statics",
+                     help="the initial state: the static equilibrium (default), or the file's "
+                     "point positions and the lines' initial shapes at rest (MoorDyn with "
+                     "TmaxIC 0)")
     run.add_argument("--no-plots", action="store_true", help="do not draw the plots")
     run.add_argument("--no-progress", action="store_true", help="do not draw a progress bar")
     run.set_defaults(handler=_run)
@@ -156,7 +161,8 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
                      f"of --dt {args.dt:g} s")
     folder = _output(args.output, parser)
     result = run(model, motion, args.t_end, dt=args.dt, output_every=args.output_every,
-                 output=folder, plots=not args.no_plots, progress=not args.no_progress)
+                 output=folder, plots=not args.no_plots, progress=not args.no_progress,
+                 start=args.start)
     tensions = result.end_tensions
     print(f"{args.file}: t = 0 to {result.times[-1]:g} s in {result.solution.steps_taken} steps "
           f"of {args.dt:g} s, {result.cpu_time:.3g} s CPU", flush=True)

@@ -384,7 +384,8 @@ def _guess(a: np.ndarray, b: np.ndarray, line_type: LineType, length: float,
 
 def add_line(system: Any, end_a: int, end_b: int, line_type: LineType,
              unstretched_length: float | Law, segments: int, water: Water,
-             seabed: Seabed | None = None, name: str = "") -> Line:
+             seabed: Seabed | None = None, name: str = "",
+             ends_carry_mass: tuple[bool, bool] = (False, False)) -> Line:
     """Add a line of ``segments`` elastic segments between two particles of ``system``.
 
     Arguments:
@@ -399,6 +400,10 @@ def add_line(system: Any, end_a: int, end_b: int, line_type: LineType,
             seabed has a surface of its own).
         seabed: the seabed contact (None: the line does not touch the seabed).
         name: a name for messages.
+        ends_carry_mass: whether the particle of end A, end B already carries the mass of the
+            half segment at that end (a free point, :func:`vinculo.mooring.model.build_model`:
+            its weight then comes with it); otherwise the half segment's weight alone is put on
+            the end particle as a force (a fixed or moved end, whose inertia does not matter).
 
     Returns:
         The :class:`Line`: its nodes, segment handles and results.
@@ -476,7 +481,7 @@ def add_line(system: Any, end_a: int, end_b: int, line_type: LineType,
                 axial_friction=seabed.axial_friction, friction_damping=seabed.friction_damping,
                 static_dynamic_scale=seabed.static_dynamic_scale,
                 grid=None if seabed.surface is None else seabed.surface.core))
-        if end:
+        if end and not ends_carry_mass[0 if k == 0 else 1]:
             system.add_force(node, tuple(float(c) for c in 0.5 * mass * gravity))
     load = line_type.mass_per_length * 0.5 * segment * gravity
     return Line(nodes=nodes, segments=links, line_type=line_type, unstretched_length=length0,

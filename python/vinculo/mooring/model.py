@@ -218,8 +218,12 @@ def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, 
     points: list[ParticleId] = []
     coupling: list[list[Any]] = []
     coupled_index = 0
+    # The half segments at the lines' ends: a free point carries their mass (MoorDyn's point
+    # takes its lines' end nodes' masses into its own), their weight with it.
+    ends = _end_masses(model)
     for point in model.points:
-        mass = max(point.mass, _POINT_MASS_FLOOR)
+        carried = ends.get(point.id, 0.0) if point.attachment == "free" else 0.0
+        mass = max(point.mass + carried, _POINT_MASS_FLOOR)
         if point.attachment == "fixed":
             points.append(system.add_particle(mass, point.position, fixed=True))
             continue
@@ -254,10 +258,11 @@ def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, 
         points.append(particle)
     lines = []
     for row in model.lines:
+        free = tuple(model.point(k).attachment == "free" for k in (row.attach_a, row.attach_b))
         lines.append(add_line(
             system, points[row.attach_a - 1].index, points[row.attach_b - 1].index,
             model.line_types[row.line_type], row.unstretched_length, row.segments,
-            the_water, the_seabed, name=f"line {row.id}"))
+            the_water, the_seabed, name=f"line {row.id}", ends_carry_mass=free))
     built = MooringModel(file=model, system=system, points=points, lines=lines, motion=motion,
                          coupling_constraints=coupling)
     if solve:
@@ -265,6 +270,17 @@ def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, 
 
         built.statics = solve_statics(system, **statics_options)
     return built
+
+
+def _end_masses(model: MoorDynFile) -> dict[int, float]:
+    """The mass of the half segments at the ends of the lines on each point (kg), by point id."""
+    masses: dict[int, float] = {}
+    for row in model.lines:
+        kind = model.line_types[row.line_type]
+        half = 0.5 * kind.mass_per_length * row.unstretched_length / row.segments
+        for point in (row.attach_a, row.attach_b):
+            masses[point] = masses.get(point, 0.0) + half
+    return masses
 
 
 def _core_still(options: FileOptions) -> Any:
