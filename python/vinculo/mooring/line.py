@@ -372,12 +372,37 @@ def _guess(a: np.ndarray, b: np.ndarray, line_type: LineType, length: float,
         return nodes if low is a else nodes[::-1]
     except (InvalidInputError, ValueError, ArithmeticError):
         pass
-    # A parabola z = -4 f u (1 - u) below the chord, its sag f from the arc-length
-    # approximation L = c + 8 f^2 / (3 c) (c the chord), clipped at the seabed.
-    u = s / length
-    chord = float(np.linalg.norm(b - a))
-    sag = math.sqrt(max(3.0 * chord * (length - chord) / 8.0, 0.0))
-    nodes = a + np.outer(u, b - a) - np.outer(4.0 * sag * u * (1.0 - u), [0.0, 0.0, 1.0])
+    # A parabola -4 f u (1 - u) e_z below the chord whose arc length is the line's, its nodes
+    # at equal arc lengths: each segment's chord a little shorter than its length, so that
+    # the shape holds no tension (a run from the file's shape starts slack, not snapping);
+    # clipped at the seabed. The sag f by bisection on the arc length (increasing in f).
+    return _parabola(a, b, length, segments, water)
+
+
+def _parabola(a: np.ndarray, b: np.ndarray, length: float, segments: int,
+              water: Water) -> np.ndarray:
+    """The nodes of :func:`_guess`'s parabola (its comment)."""
+    u = np.linspace(0.0, 1.0, 2049)
+    chord = b - a
+
+    def curve(sag: float) -> tuple[np.ndarray, np.ndarray]:
+        points = a + np.outer(u, chord) - np.outer(4.0 * sag * u * (1.0 - u), [0.0, 0.0, 1.0])
+        arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0),
+                                                              axis=1))])
+        return points, arc
+
+    low, high = 0.0, max(length, 1e-12)
+    if curve(0.0)[1][-1] < length:
+        for _ in range(100):
+            mid = 0.5 * (low + high)
+            if curve(mid)[1][-1] < length:
+                low = mid
+            else:
+                high = mid
+    points, arc = curve(low)
+    targets = np.linspace(0.0, arc[-1], segments + 1)
+    nodes = np.column_stack([np.interp(targets, arc, points[:, k]) for k in range(3)])
+    nodes[0], nodes[-1] = a, b
     nodes[:, 2] = np.maximum(nodes[:, 2], -water.depth)
     return nodes
 
