@@ -144,3 +144,24 @@ def test_a_run_from_the_files_positions_swings_the_pendulum_it_describes(tmp_pat
     assert up[1] - up[0] == pytest.approx(period, rel=1e-4)
     still = run(path, None, 1.0, dt=0.005, plots=False).channels()["CON2PX"]
     assert np.abs(still).max() < 1e-9
+
+
+def test_a_shape_without_a_catenary_holds_no_tension():
+    # A neutrally buoyant line (no catenary: no weight) of 32 m between points 29.7 m apart:
+    # its initial shape is a parabola of arc length 32 m with the nodes at equal arc lengths,
+    # so that every segment's chord is at most its length (slack, no tension), and close to it
+    # (within 5 %: the last segments bend round the parabola's lower end, up to 3.5 % short;
+    # the first fifteen within 1e-4).
+    import vinculo
+    from vinculo.mooring.line import LineType, Water, add_line
+
+    system = vinculo.System(gravity=(0.0, 0.0, -9.80665))
+    a = system.add_particle(1.0, (0.0, -1.0, 0.0), fixed=True)
+    b = system.add_particle(10.0, (10.0, -1.0, -28.0))
+    rope = LineType("rope", 0.1, 1025.0 * math.pi * 0.1**2 / 4.0, 1e9)
+    line = add_line(system, a.index, b.index, rope, 32.0, 20, Water(depth=500.0))
+    q = np.asarray(system.initial_positions())[line.nodes]
+    chords = np.linalg.norm(np.diff(q, axis=0), axis=1)
+    assert np.all(chords <= 32.0 / 20 * (1.0 + 1e-12))
+    assert np.all(chords >= 32.0 / 20 * (1.0 - 0.05))
+    assert np.all(chords[:15] >= 32.0 / 20 * (1.0 - 1e-4))
