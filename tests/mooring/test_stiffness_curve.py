@@ -89,6 +89,7 @@ def test_the_curve_is_read_and_read_back(tmp_path):
     ("h\nh\nh\n0 0\n0.01 ten\n", 5, "tension"),
     ("h\nh\nh\n0 0\n0.01 5\n0.02 4\n", 6, "tension"),
     ("h\nh\nh\n0 0\n", None, "strain tension"),
+    ("h\nh\nh\n0.001 0\n0.01 5\n", 4, "strain tension"),
 ])
 def test_a_malformed_curve_names_the_file_line_and_field(tmp_path, text, line, field):
     path = tmp_path / "curve.txt"

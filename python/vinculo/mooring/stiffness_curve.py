@@ -2,7 +2,7 @@
 EA column of a line type.
 
 The file (beside the input file, or at the path given) holds three header lines, then one line
-per point of the curve, ``strain tension`` (-, N), both increasing::
+per point of the curve, ``strain tension`` (-, N), both increasing from (0, 0)::
 
     ----Polyester----
     Strain    Tension
@@ -43,8 +43,8 @@ class StiffnessCurve:
         path: the file it was read from (None when built in code).
 
     Raises:
-        InvalidInputError: for fewer than two points, values that are not finite, or strains
-            or tensions that do not increase.
+        InvalidInputError: for fewer than two points, values that are not finite, strains or
+            tensions that do not increase, or a first point other than (0, 0).
     """
 
     strains: np.ndarray
@@ -65,6 +65,10 @@ class StiffnessCurve:
             if np.any(np.diff(values) <= 0.0):
                 raise InvalidInputError(f"a stiffness curve's {name} must increase",
                                         name=name, value=values.tolist())
+        if e[0] != 0.0 or t[0] != 0.0:
+            raise InvalidInputError(
+                f"a stiffness curve starts at strain 0 and tension 0 (a segment at its length "
+                f"has no tension), not ({e[0]:g}, {t[0]:g})", name="strains", value=e[0])
         object.__setattr__(self, "strains", e)
         object.__setattr__(self, "tensions", t)
 
@@ -160,5 +164,11 @@ def read_stiffness_curve(path: str | Path) -> StiffnessCurve:
         raise MooringFileError(f"{name}: {len(points)} points after the three header lines; "
                                f"give at least two", file=name, line=None,
                                field="strain tension", value=len(points))
+    if points[0][:2] != (0.0, 0.0):
+        raise MooringFileError(
+            f"{name}, line {points[0][2]}: strain tension: the curve starts at strain 0 and "
+            f"tension 0 (a segment at its length has no tension; shorter, it is slack), not "
+            f"({points[0][0]:g}, {points[0][1]:g})", file=name, line=points[0][2],
+            field="strain tension", value=points[0][:2])
     return StiffnessCurve(np.array([p[0] for p in points]), np.array([p[1] for p in points]),
                           path=path)

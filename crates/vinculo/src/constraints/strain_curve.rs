@@ -29,7 +29,8 @@ impl StrainCurve {
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] for fewer than two points, lists of different lengths, a
-    /// value that is not finite, or strains or tensions that do not increase.
+    /// value that is not finite, strains or tensions that do not increase, or a first point
+    /// other than (0, 0) (a segment at its length has no tension; shorter, it is slack).
     pub fn new(strains: Vec<f64>, tensions: Vec<f64>) -> Result<StrainCurve> {
         if strains.len() < 2 || strains.len() != tensions.len() {
             return Err(Error::InvalidParameter {
@@ -59,6 +60,16 @@ impl StrainCurve {
                     ),
                 });
             }
+        }
+        if strains[0] != 0.0 || tensions[0] != 0.0 {
+            return Err(Error::InvalidParameter {
+                name: "first point of the strain-tension curve".into(),
+                value: strains[0],
+                expected: format!(
+                    "strain 0 at tension 0 (the segment slack below its length), not ({}, {})",
+                    strains[0], tensions[0]
+                ),
+            });
         }
         Ok(StrainCurve { strains, tensions })
     }
@@ -144,5 +155,7 @@ mod tests {
         assert!(e.to_string().contains("tension 3"), "{e}");
         let e = StrainCurve::new(vec![0.0, f64::NAN], vec![0.0, 1.0]).unwrap_err();
         assert!(e.to_string().contains("strain 2"), "{e}");
+        let e = StrainCurve::new(vec![0.001, 0.01], vec![0.0, 1.0]).unwrap_err();
+        assert!(e.to_string().contains("first point"), "{e}");
     }
 }
