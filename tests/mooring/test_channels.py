@@ -18,7 +18,7 @@ from vinculo.mooring.bench import motion_for
 
 DATA = Path(__file__).resolve().parent.parent / "data" / "moordyn"
 CHANNELS = ["FAIRTEN1", "AnchTen1", "L1N20T", "L1N40PZ", "CON2PX", "Con2vX", "LINE1TENA",
-            "Point2PZ"]
+            "Point2PZ", "CON1FX", "CON1FZ", "CON2FZ"]
 
 
 def _file(tmp_path: Path) -> Path:
@@ -61,6 +61,12 @@ def test_channels_are_the_catenary_at_rest_and_follow_the_motion(tmp_path):
     bound = 0.05**2 / 6.0 * 2.0 * (2.0 * math.pi / 10.0) ** 3
     np.testing.assert_allclose(values["Con2vX"], vx, rtol=0, atol=bound)
     np.testing.assert_array_equal(values["L1N40PZ"], values["Point2PZ"])
+    # The anchor's load at rest: the catenary's pull, H towards the fairlead and V_A, up, with
+    # the points' weight (none here); the two points together carry the chain's weight in
+    # water (100 m of it, hanging symmetric at t = 0).
+    assert values["CON1FX"][0] == pytest.approx(cat.horizontal_tension, rel=1e-3)
+    assert values["CON1FZ"][0] == pytest.approx(values["CON2FZ"][0], rel=1e-9)
+    assert values["CON1FZ"][0] + values["CON2FZ"][0] == pytest.approx(-w * 100.0, rel=1e-9)
 
 
 def test_a_run_writes_the_channels_beside_its_results(tmp_path, capsys):
@@ -79,7 +85,7 @@ def test_a_run_writes_the_channels_beside_its_results(tmp_path, capsys):
     assert max(fair) - min(fair) < 1e-6 * fair[0]
 
 
-@pytest.mark.parametrize("name", ["BODY1PX", "L1N5AX", "FAIRTEN", "ROD1SUB"])
+@pytest.mark.parametrize("name", ["BODY1PX", "L1N5AX", "FAIRTEN", "ROD1SUB", "CON1AX"])
 def test_a_channel_vinculo_cannot_give_is_refused_by_line(tmp_path, name):
     text = (DATA / "hanging_line.txt").read_text().replace(
         "------------------------- need this line",
@@ -144,6 +150,12 @@ def test_a_run_from_the_files_positions_swings_the_pendulum_it_describes(tmp_pat
     assert up[1] - up[0] == pytest.approx(period, rel=1e-4)
     still = run(path, None, 1.0, dt=0.005, plots=False).channels()["CON2PX"]
     assert np.abs(still).max() < 1e-9
+    # A free point's net force is its mass times its acceleration, not a load: refused.
+    from vinculo.errors import InvalidInputError
+    from vinculo.mooring.channels import channel_values, parse_channel
+
+    with pytest.raises(InvalidInputError, match="is free"):
+        channel_values(result, parse_channel("CON2FX"))
 
 
 def test_a_shape_without_a_catenary_holds_no_tension():

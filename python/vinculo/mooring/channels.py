@@ -8,7 +8,11 @@ line from 0 at end A to N at end B):
 - ``L<n>N<m>P{X,Y,Z}`` / ``LINE<n>N<m>P{X,Y,Z}``: a node's position (m); ``V{X,Y,Z}``: its
   velocity (m/s); ``T`` or ``TEN``: its tension (N), the mean of its two segments' tensions
   for an inner node and the end tension for an end node (MoorDyn's rule);
-- ``CON<n>`` / ``POINT<n>`` with ``P{X,Y,Z}`` or ``V{X,Y,Z}``: a point's position or velocity.
+- ``CON<n>`` / ``POINT<n>`` with ``P{X,Y,Z}`` or ``V{X,Y,Z}``: a point's position or velocity;
+  with ``F{X,Y,Z}``, for a fixed or coupled point, the load it takes (N): the forces of its
+  lines on it with its own weight and buoyancy (MoorDyn's net force of such a point: an
+  anchor's load, a fairlead's). A free point's net force (its mass times its acceleration, with
+  its drag) is not given.
 
 A run of a file with OUTPUTS writes them beside its other results (``channels.csv``: ``time``
 and one column per channel, named as in the file); :func:`parse_channel` refuses a name it does
@@ -29,7 +33,7 @@ __all__ = ["Channel", "channel_values", "parse_channel"]
 
 _LINE_END = re.compile(r"(FAIRTEN|ANCHTEN)(\d+)|LINE(\d+)TEN([AB])")
 _NODE = re.compile(r"(?:L|LINE)(\d+)N(\d+)(PX|PY|PZ|VX|VY|VZ|TEN|T)")
-_POINT = re.compile(r"(?:CON|POINT)(\d+)(PX|PY|PZ|VX|VY|VZ)")
+_POINT = re.compile(r"(?:CON|POINT)(\d+)(PX|PY|PZ|VX|VY|VZ|FX|FY|FZ)")
 
 
 @dataclass(frozen=True)
@@ -76,8 +80,8 @@ def parse_channel(name: str) -> Channel:
         return Channel(name, "point", int(m.group(1)), 0, m.group(2).lower())
     raise InvalidInputError(
         f"output channel {name!r} is not supported: give FAIRTEN<n>, ANCHTEN<n>, "
-        f"LINE<n>TENA/B, L<n>N<m> with PX..PZ, VX..VZ or T, or CON<n> (POINT<n>) with PX..PZ "
-        f"or VX..VZ", name="outputs", value=name)
+        f"LINE<n>TENA/B, L<n>N<m> with PX..PZ, VX..VZ or T, or CON<n> (POINT<n>) with PX..PZ, "
+        f"VX..VZ or FX..FZ", name="outputs", value=name)
 
 
 def _checked(channel: Channel, count: int, what: str, last: int | None = None) -> None:
@@ -104,11 +108,14 @@ def channel_values(run: Any, channel: Channel) -> np.ndarray:
         InvalidInputError: for a line, node or point the model does not have.
     """
     model = run.model
-    axis = "xyz".index(channel.quantity[1]) if channel.quantity[:1] in ("p", "v") else 0
+    axis = "xyz".index(channel.quantity[1]) if channel.quantity[:1] in ("p", "v", "f") else 0
     solution = run.solution
     if channel.kind == "end":
         _checked(channel, len(model.lines), "line")
         return np.asarray(run.end_tensions[:, channel.number - 1, channel.node])
+    if channel.kind == "point" and channel.quantity[0] == "f":
+        _checked(channel, len(model.points), "point")
+        return _point_load(run, channel)[:, axis]
     if channel.kind == "point":
         _checked(channel, len(model.points), "point")
         index = model.points[channel.number - 1].index
@@ -127,3 +134,23 @@ def channel_values(run: Any, channel: Channel) -> np.ndarray:
         return 0.5 * (tensions[:, channel.node - 1] + tensions[:, channel.node])
     source = solution.positions if channel.quantity[0] == "p" else solution.velocities
     return np.asarray(source)[:, line.nodes[channel.node], axis]
+
+
+def _point_load(run: Any, channel: Channel) -> np.ndarray:
+    """``(times, 3)``: the forces of the lines on a fixed or coupled point, with its weight and
+    buoyancy (module documentation)."""
+    file = run.model.file
+    point = file.point(channel.number)
+    if point.attachment == "free":
+        raise InvalidInputError(
+            f"output channel {channel.name!r}: point {point.id} is free; its net force (its "
+            f"mass times its acceleration) is not given, only a fixed or coupled point's load",
+            name="outputs", value=channel.name)
+    o = file.options
+    own = np.array([0.0, 0.0, (o.density * point.volume - point.mass) * o.gravity])
+    load = np.zeros((len(run.times), 3)) + own
+    for k, row in enumerate(file.lines):
+        for end, attached in enumerate((row.attach_a, row.attach_b)):
+            if attached == point.id:
+                load = load + run.end_forces[:, k, end]
+    return load
