@@ -10,7 +10,7 @@ from pathlib import Path
 
 from vinculo.errors import MooringFileError
 
-__all__ = ["file_error", "numbers", "read_lines"]
+__all__ = ["file_error", "numbers", "read_lines", "write_lines"]
 
 
 def file_error(name: str, line: int | None, field: str | None, message: str,
@@ -56,3 +56,16 @@ def numbers(name: str, line: int, fields: Sequence[str], names: Sequence[str]) -
                                    f"number", file=name, line=line, field=field, value=text)
         values.append(value)
     return values
+
+
+def write_lines(path: str | Path, rows: Sequence[str], *, final_newline: bool = True) -> Path:
+    """Write ``rows`` as the lines of the file ``path`` (replaced if it exists), with a newline
+    after the last unless ``final_newline`` is False (MoorDyn 2.7 reads an empty last line of a
+    curve file as a point).
+
+    Returns:
+        The path written.
+    """
+    path = Path(path)
+    path.write_text("\n".join(rows) + ("\n" if final_newline else ""), encoding="utf-8")
+    return path

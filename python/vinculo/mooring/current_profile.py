@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from vinculo.errors import InvalidInputError, MooringFileError
-from vinculo.mooring._table_file import numbers, read_lines
+from vinculo.mooring._table_file import numbers, read_lines, write_lines
 
 __all__ = ["PROFILE_FILE", "CurrentProfile", "read_current_profile"]
 
@@ -98,9 +98,7 @@ class CurrentProfile:
                 "z (m), ux (m/s), uy (m/s), uz (m/s)"]
         rows += [" ".join(repr(float(v)) for v in (z, *u))
                  for z, u in zip(self.heights, self.velocities, strict=True)]
-        path = Path(path)
-        path.write_text("\n".join(rows) + "\n", encoding="utf-8")
-        return path
+        return write_lines(path, rows)
 
 
 def read_current_profile(path: str | Path) -> CurrentProfile:

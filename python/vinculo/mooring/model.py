@@ -147,11 +147,8 @@ class MooringModel:
         Returns:
             The heights, of the points' shape.
         """
-        floor = self.file.options.seafloor
-        if floor is not None:
-            return floor.height(x, y)
-        shape = np.broadcast_shapes(np.shape(x), np.shape(y))
-        return np.full(shape, self.seabed_z)
+        options = self.file.options
+        return seabed(options).height(water(options), x, y)
 
     def line_ends(self, k: int) -> tuple[int, int]:
         """The particle indices of the two ends of line ``k`` (0-based).

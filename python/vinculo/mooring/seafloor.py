@@ -41,7 +41,7 @@ from typing import Any
 import numpy as np
 
 from vinculo.errors import InvalidInputError, MooringFileError
-from vinculo.mooring._table_file import numbers, read_lines
+from vinculo.mooring._table_file import numbers, read_lines, write_lines
 
 __all__ = ["Seafloor", "read_seafloor"]
 
@@ -155,9 +155,7 @@ class Seafloor:
                 " ".join(repr(float(v)) for v in self.y)]
         rows += [f"{float(a)!r} {float(b)!r} {float(self.z[i, j])!r}"
                  for i, a in enumerate(self.x) for j, b in enumerate(self.y)]
-        path = Path(path)
-        path.write_text("\n".join(rows) + "\n", encoding="utf-8")
-        return path
+        return write_lines(path, rows)
 
 
 def _tick(ticks: np.ndarray, value: float) -> int | None:

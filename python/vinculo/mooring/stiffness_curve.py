@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from vinculo.errors import InvalidInputError, MooringFileError
-from vinculo.mooring._table_file import numbers, read_lines
+from vinculo.mooring._table_file import numbers, read_lines, write_lines
 
 __all__ = ["StiffnessCurve", "read_stiffness_curve"]
 
@@ -119,10 +119,8 @@ class StiffnessCurve:
                 "(-)       (N)"]
         rows += [f"{float(e)!r} {float(t)!r}"
                  for e, t in zip(self.strains, self.tensions, strict=True)]
-        path = Path(path)
         # No newline after the last point: MoorDyn 2.7 reads an empty last line as a point.
-        path.write_text("\n".join(rows), encoding="utf-8")
-        return path
+        return write_lines(path, rows, final_newline=False)
 
 
 def read_stiffness_curve(path: str | Path) -> StiffnessCurve:

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from vinculo.errors import InvalidInputError, MooringFileError
-from vinculo.mooring._table_file import numbers, read_lines
+from vinculo.mooring._table_file import numbers, read_lines, write_lines
 
 __all__ = ["WAVE_FILE", "WaveComponents", "read_wave_frequencies"]
 
@@ -101,9 +101,7 @@ class WaveComponents:
         rows = ["0.0 0.0 0.0 0.0"]
         rows += [f"{float(w)!r} {float(a.real)!r} {float(a.imag)!r} {float(b)!r}"
                  for w, a, b in zip(self.omegas, self.amplitudes, self.directions, strict=True)]
-        path = Path(path)
-        path.write_text("\n".join(rows) + "\n", encoding="utf-8")
-        return path
+        return write_lines(path, rows)
 
 
 def read_wave_frequencies(path: str | Path) -> WaveComponents:
