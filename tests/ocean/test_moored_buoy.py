@@ -71,6 +71,23 @@ def test_moored_statics_balance_buoyancy_weight_and_mooring():
     assert pull > 0.0
 
 
+def test_the_moving_mass_is_the_buoys_and_its_lines():
+    """The particles that move carry the buoy's mass and the lines' (mass per length times
+    unstretched length), less the half segments whose nodes are the fixed anchors: a fairlead,
+    a particle that moves with the buoy, carries the half segment at its end, as MoorDyn's
+    body takes its points' end-node masses (three_chains.txt: 50 kg/m, 112 m in 20 segments,
+    so 140 kg at each fairlead, 420 kg in all, that a fairlead's weight alone would leave out
+    of the buoy's inertia)."""
+    case = mb.read_case(EXAMPLES / "surface_buoy.toml")
+    built = mb.build(case, solve=False)
+    system = built.system
+    moving = np.asarray(system.masses())[~np.asarray(system.fixed())].sum()
+    lines = 3 * 50.0 * 112.0
+    anchors = 3 * 0.5 * 50.0 * 112.0 / 20
+    # Each point without a mass of its own gets 1e-6 kg (a particle needs one).
+    assert moving == pytest.approx(case.mass + lines - anchors, abs=1e-5)
+
+
 def test_case_file_errors_name_the_file_and_entry(tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text('[buoy]\nmass = 100.0\ncentre = [0, 0]\n')

@@ -184,7 +184,9 @@ def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, 
             statics uses their positions at t = 0.
         solve: solve the static equilibrium and start the system from it.
         couple: hold the coupled points on the motion (or where the file puts them); False:
-            leave them free particles for the caller to attach (to a floating body).
+            leave them free particles for the caller to attach (to a floating body), each
+            carrying the mass of its lines' end half segments (the body then moves it), as a
+            free point does.
         **statics_options: passed to :func:`vinculo.mooring.statics.solve_statics`
             (``tolerance``, ``max_iterations``).
 
@@ -215,11 +217,16 @@ def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, 
     points: list[ParticleId] = []
     coupling: list[list[Any]] = []
     coupled_index = 0
-    # The half segments at the lines' ends: a free point carries their mass (MoorDyn's point
-    # takes its lines' end nodes' masses into its own), their weight with it.
+    # The half segments at the lines' ends: a point that moves with the dynamics (a free point,
+    # or a coupled one left free for a body) carries their mass, their weight with it
+    # (MoorDyn's point takes its lines' end nodes' masses into its own, and a body its points').
     ends = _end_masses(model)
+
+    def dynamic(attachment: str) -> bool:
+        return attachment == "free" or (attachment == "coupled" and not couple)
+
     for point in model.points:
-        carried = ends.get(point.id, 0.0) if point.attachment == "free" else 0.0
+        carried = ends.get(point.id, 0.0) if dynamic(point.attachment) else 0.0
         mass = max(point.mass + carried, _POINT_MASS_FLOOR)
         if point.attachment == "fixed":
             points.append(system.add_particle(mass, point.position, fixed=True))
@@ -255,7 +262,7 @@ def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, 
         points.append(particle)
     lines = []
     for row in model.lines:
-        free = tuple(model.point(k).attachment == "free" for k in (row.attach_a, row.attach_b))
+        free = tuple(dynamic(model.point(k).attachment) for k in (row.attach_a, row.attach_b))
         lines.append(add_line(
             system, points[row.attach_a - 1].index, points[row.attach_b - 1].index,
             model.line_types[row.line_type], row.unstretched_length, row.segments,
