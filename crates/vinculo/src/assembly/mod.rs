@@ -283,9 +283,21 @@ impl Layout {
         dq.reset(n);
         dv.reset(n);
         f.add_jacobian(at.q_eval, at.v_eval, at.t_eval, dq, dv);
+        // The rows of the particles the force acts on come first (x-major blocks); the others
+        // are zero (a line node's neighbours) and have no slots.
+        let acting = f.acting() * n;
         let mut place = |blocks: &[Block]| {
-            let weights = ((at.force_dq, &*dq), (at.force_dv, &*dv));
-            add_force_blocks(values, (blocks, blocks), weights.0, weights.1)
+            let (wq, wv) = (at.force_dq, at.force_dv);
+            let local = dq.as_slice().iter().zip(dv.as_slice());
+            for (b, (mq, mv)) in blocks[..acting].iter().zip(local) {
+                if b[0] != NO_SLOT {
+                    // One pass for df/dq and df/dv: their blocks are the same here.
+                    let m = std::array::from_fn(|r| {
+                        std::array::from_fn(|c| wq * mq[r][c] + wv * mv[r][c])
+                    });
+                    values.add_block(b, 1.0, &m);
+                }
+            }
         };
         let pairs = self.force_offsets.pairs(fi);
         match self.force_block.as_plain() {

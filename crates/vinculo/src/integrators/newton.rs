@@ -178,6 +178,12 @@ pub const FLOOR_CONTRACTION: f64 = 0.9;
 /// documentation).
 pub const FLOOR_RESIDUAL_DROP: f64 = 1e-2;
 
+/// Relative difference of two step sizes below which an iteration matrix made for one serves
+/// the other ([`IterationMatrix::holds`]): far above the rounding of a step computed from two
+/// times (1e-12 of a 3 ms step at t = 15 s), far below any change that moves a kept matrix's
+/// contraction (the mass term's share of the matrix changes by twice it).
+pub const SAME_STEP: f64 = 1e-9;
+
 /// What the linear solver's current factorisation is, for reuse by modified Newton.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct IterationMatrix {
@@ -196,9 +202,14 @@ pub struct IterationMatrix {
 }
 
 impl IterationMatrix {
-    /// True when the current factorisation was made for `key`.
+    /// True when the current factorisation was made for `key`: the same scheme coefficient,
+    /// and a step size within [`SAME_STEP`] of its own (a step computed as the difference of
+    /// two times, such as the second half of a step back to the run's grid, differs from the
+    /// first half by the rounding of those times; the matrix made for one serves the other).
     pub fn holds(&self, key: [f64; 2]) -> bool {
-        self.key == Some(key)
+        self.key.is_some_and(|[h, c]| {
+            c == key[1] && (h == key[0] || (h - key[0]).abs() <= SAME_STEP * h.abs())
+        })
     }
 
     /// Marks the factorisation as unusable (the solver was used for another matrix, or the
