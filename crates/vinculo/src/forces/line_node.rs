@@ -34,32 +34,47 @@ pub struct LineNode {
 
 /// The tangent of the last line node asked for, at one configuration: the elements on one node
 /// (its hydrodynamics, its seabed contact) share it within one evaluation of the residual
-/// instead of each computing it (a square root and a division). A cache lives for one
+/// instead of each computing it (a square root and a division). It is kept under the two
+/// particles it runs between (a tangent depends on them alone), with its unit vector and
+/// 1/|d|; the local indices of a node asking for it are that node's own. A cache lives for one
 /// configuration only (the assembler makes one per residual).
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub(crate) struct TangentCache {
-    /// The last node asked for and its tangent.
-    last: Option<(NodeKey, Option<Tangent>)>,
+    /// The particles (a, b) of the last tangent computed ([`NO_KEY`]: none yet).
+    key: [usize; 2],
+    /// Its unit vector and 1/|d|; None where a and b coincide.
+    value: Option<(Vec3, f64)>,
 }
 
-/// What identifies a line node's tangent: its touched particles and the local indices of its
-/// tangent's particles.
-type NodeKey = ([usize; 3], Option<[usize; 2]>);
+/// The key of an empty [`TangentCache`].
+const NO_KEY: [usize; 2] = [usize::MAX; 2];
+
+impl Default for TangentCache {
+    fn default() -> Self {
+        TangentCache {
+            key: NO_KEY,
+            value: None,
+        }
+    }
+}
 
 impl TangentCache {
     /// The tangent of `node` at `q` ([`LineNode::tangent`]), computed unless it was the last
-    /// node asked for.
+    /// one asked for.
     #[inline(always)]
     pub(crate) fn tangent(&mut self, node: &LineNode, q: &[Vec3]) -> Option<Tangent> {
-        let key = (node.particles, node.tangent);
-        match self.last {
-            Some((kept, tangent)) if kept == key => tangent,
-            _ => {
-                let tangent = node.tangent(q);
-                self.last = Some((key, tangent));
-                tangent
-            }
+        let [a, b] = node.tangent?;
+        let key = [node.particles[a], node.particles[b]];
+        if key != self.key {
+            self.key = key;
+            self.value = unit_chord(q[key[0]], q[key[1]]);
         }
+        let (t, inv_len) = self.value?;
+        Some(Tangent {
+            t,
+            inv_len,
+            ends: [a, b],
+        })
     }
 }
 

@@ -171,6 +171,14 @@ impl Index3Rule for AlphaStep<'_> {
         (v, *q, v)
     }
 
+    /// v_{n+1} of every particle over zipped slices (the evaluation point is the step's end).
+    #[inline(always)]
+    fn kinematics_all(&self, q: &[Vec3], v: &mut [Vec3], _eval: (&mut [Vec3], &mut [Vec3])) {
+        for (v, (q, (p, w))) in v.iter_mut().zip(q.iter().zip(self.p.iter().zip(self.w))) {
+            *v = self.known.kinematics(q, p, w).1;
+        }
+    }
+
     /// M qdd_{n+1} - m g, qdd_{n+1} from a_{n+1} (module documentation).
     #[inline(always)]
     fn inertia_row(&self, i: usize, q: &Vec3, _: &Vec3, inertia: f64, mass: f64, g: &Vec3) -> Vec3 {

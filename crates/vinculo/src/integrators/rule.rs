@@ -109,6 +109,20 @@ pub trait Index3Rule: Sync {
     /// (v_{n+1}, q_e, v_e) of particle `i` at the iterate `q` (q_e and v_e unused when
     /// [`Index3Rule::AT_END`]).
     fn kinematics(&self, i: usize, q: &Vec3) -> (Vec3, Vec3, Vec3);
+    /// [`Index3Rule::kinematics`] of every particle: v_{n+1} into `v` and, unless
+    /// [`Index3Rule::AT_END`], (q_e, v_e) into `eval` (the same numbers, particle by particle;
+    /// a rule may override it with a pass the compiler sees whole).
+    #[inline(always)]
+    fn kinematics_all(&self, q: &[Vec3], v: &mut [Vec3], eval: (&mut [Vec3], &mut [Vec3])) {
+        let (qe, ve) = eval;
+        for i in 0..q.len() {
+            let (vi, qi, wi) = self.kinematics(i, &q[i]);
+            v[i] = vi;
+            if !Self::AT_END {
+                (qe[i], ve[i]) = (qi, wi);
+            }
+        }
+    }
     /// The inertia and gravity terms M qdd_{n+1} - m g of particle `i`, from its iterate `q` and
     /// new velocity `v` (unscaled: the step problem multiplies them by sigma).
     fn inertia_row(&self, i: usize, q: &Vec3, v: &Vec3, inertia: f64, mass: f64, g: &Vec3) -> Vec3;

@@ -92,15 +92,9 @@ impl<'a, R: Index3Rule> StepProblem<'a, R> {
 
     /// [`StepProblem::kinematics`] on this thread.
     fn kinematics_serial(&mut self) {
-        let rule = &self.rule;
         let b = &mut *self.buffers;
-        for i in 0..b.q.len() {
-            let (v, qe, ve) = rule.kinematics(i, &b.q[i]);
-            b.v[i] = v;
-            if !R::AT_END {
-                (b.q_eval[i], b.v_eval[i]) = (qe, ve);
-            }
-        }
+        self.rule
+            .kinematics_all(&b.q, &mut b.v, (&mut b.q_eval, &mut b.v_eval));
     }
 
     /// [`StepProblem::kinematics`] on rayon's thread pool (the same numbers).
