@@ -18,8 +18,10 @@ PYTHON ?= python3
 # processors since about 2013-2015) gets code for that level: the mooring lines' steps take 5
 # to 9 % less CPU time (the benchmark's chain on the seabed of 20, 100 and 1,000 segments,
 # least of three runs), the pendulum's and the 10^6-particle chain's the same. Other machines
-# get the default level. A RUSTFLAGS of the environment is used as it is. Every cargo and
-# maturin command below runs with the same flags, so that they share their compiled work.
+# get the default level. A RUSTFLAGS of the environment is used as it is (`RUSTFLAGS= make
+# build` for the baseline level: valgrind 3.19 does not decode some x86-64-v3 instructions).
+# Every cargo and maturin command below runs with the same flags, so that they share their
+# compiled work.
 X86_64_V3 := $(shell f=/proc/cpuinfo; [ "$$(uname -m)" = x86_64 ] && \
 	for x in avx2 fma bmi2 f16c movbe abm; do grep -qw $$x $$f 2>/dev/null || exit 1; done && \
 	echo yes)
