@@ -15,9 +15,9 @@
 PYTHON ?= python3
 
 # An x86-64 machine with the instructions of x86-64-v3 (AVX2, FMA, BMI2, F16C, MOVBE, LZCNT:
-# processors since about 2013-2015) gets code for that level: the mooring lines' steps take 5
-# to 9 % less CPU time (the benchmark's chain on the seabed of 20, 100 and 1,000 segments,
-# least of three runs), the pendulum's and the 10^6-particle chain's the same. Other machines
+# processors since about 2013-2015) gets code for that level: the mooring lines' steps take 4
+# to 8 % less CPU time (the benchmark's chain on the seabed of 20, 100 and 1,000 segments,
+# least of three or four runs), the pendulum's and the 10^6-particle chain's the same. Other machines
 # get the default level. A RUSTFLAGS of the environment is used as it is (`RUSTFLAGS= make
 # build` for the baseline level: valgrind 3.19 does not decode some x86-64-v3 instructions).
 # Every cargo and maturin command below runs with the same flags, so that they share their
