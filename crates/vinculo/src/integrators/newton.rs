@@ -652,6 +652,25 @@ mod tests {
         solve(problem, work, [1.0, 1.0], &NewtonOptions::default())
     }
 
+    /// A matrix made for the first half of a step back to the run's grid serves its second
+    /// half, computed as the rest of the span from the rounded midpoint (t = 15.003 s: they
+    /// differ by 2.8e-13 of the step), not a step 1e-6 longer nor another scheme coefficient.
+    #[test]
+    fn a_kept_matrix_serves_a_step_that_differs_by_the_rounding_of_times() {
+        let mut matrix = IterationMatrix::default();
+        let (t, at) = (15.003_f64, 15.009352680000001_f64);
+        let h1 = 0.5 * (at - t);
+        let h2 = at - (t + h1);
+        assert_ne!(h1, h2, "the two halves differ by rounding");
+        matrix.adopt([h1, 0.5], 0.0, &[]);
+        assert!(matrix.holds([h1, 0.5]));
+        assert!(matrix.holds([h2, 0.5]));
+        assert!(!matrix.holds([h1 * (1.0 + 1e-6), 0.5]));
+        assert!(!matrix.holds([h1, 0.6]));
+        matrix.invalidate();
+        assert!(!matrix.holds([h1, 0.5]));
+    }
+
     /// A residual whose round-off (4e-9 an evaluation) is above the tolerance: unattainable, so a
     /// problem that reports that round-off converges at it, within 3 noise / slope of the root.
     #[test]
