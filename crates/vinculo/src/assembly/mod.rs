@@ -287,17 +287,8 @@ impl Layout {
         // are zero (a line node's neighbours) and have no slots.
         let acting = f.acting() * n;
         let mut place = |blocks: &[Block]| {
-            let (wq, wv) = (at.force_dq, at.force_dv);
-            let local = dq.as_slice().iter().zip(dv.as_slice());
-            for (b, (mq, mv)) in blocks[..acting].iter().zip(local) {
-                if b[0] != NO_SLOT {
-                    // One pass for df/dq and df/dv: their blocks are the same here.
-                    let m = std::array::from_fn(|r| {
-                        std::array::from_fn(|c| wq * mq[r][c] + wv * mv[r][c])
-                    });
-                    values.add_block(b, 1.0, &m);
-                }
-            }
+            let (blocks, weights) = (&blocks[..acting], (at.force_dq, &*dq));
+            add_force_blocks(values, (blocks, blocks), weights, (at.force_dv, &*dv))
         };
         let pairs = self.force_offsets.pairs(fi);
         match self.force_block.as_plain() {
@@ -723,8 +714,10 @@ pub fn add(values: &mut [f64], slot: Slot, value: f64) {
 
 /// Places a force's local Jacobians into `values`: `dq[x][y]` weighted by `wq` into block
 /// x n + y of `blocks_q` and `dv[x][y]` weighted by `wv` into that of `blocks_v`, for its n
-/// particles. The index-3 layout has one block per pair (`blocks_q` and `blocks_v` the same),
-/// the GGL layout one in the position and one in the velocity columns.
+/// particles (as many as the blocks given: the rows of the particles a force acts on come first).
+/// The index-3 layout has one block per pair (`blocks_q` and `blocks_v` the same slice: both
+/// are placed in one pass, wq dq + wv dv, skipping absent blocks), the GGL layout one in the
+/// position and one in the velocity columns.
 #[inline(always)]
 pub fn add_force_blocks<V: Entries + ?Sized>(
     values: &mut V,
@@ -732,6 +725,17 @@ pub fn add_force_blocks<V: Entries + ?Sized>(
     (wq, dq): (f64, &crate::forces::Jacobian),
     (wv, dv): (f64, &crate::forces::Jacobian),
 ) {
+    if std::ptr::eq(blocks_q, blocks_v) {
+        let local = dq.as_slice().iter().zip(dv.as_slice());
+        for (b, (mq, mv)) in blocks_q.iter().zip(local) {
+            if b[0] != NO_SLOT {
+                let m =
+                    std::array::from_fn(|r| std::array::from_fn(|c| wq * mq[r][c] + wv * mv[r][c]));
+                values.add_block(b, 1.0, &m);
+            }
+        }
+        return;
+    }
     let pairs = blocks_q.iter().zip(blocks_v);
     for ((bq, bv), (mq, mv)) in pairs.zip(dq.as_slice().iter().zip(dv.as_slice())) {
         values.add_block(bq, wq, mq);
