@@ -132,31 +132,31 @@ impl LineHydro {
         (base * self.cd, base * std::f64::consts::PI * self.cdax)
     }
 
-    /// The water's flow at the node (none in still water that fills all space).
+    /// The water's flow at the node (none in still water, whose surface, if it has one, is
+    /// the plane z = 0).
     #[inline(always)]
     fn flow(&self, q: &[Vec3], t: f64, gradients: bool) -> Option<Flow> {
         let w = &*self.water;
-        w.needs_flow()
-            .then(|| w.flow(q[self.node.node()], t, gradients))
+        (!w.is_still()).then(|| w.flow(q[self.node.node()], t, gradients))
     }
 
-    /// The wet fraction F and, inside its ramp, its gradient (module documentation).
+    /// The wet fraction F and, inside its ramp, its gradient (module documentation): 1 in
+    /// water without a surface; under a free surface, from the elevation eta above the node
+    /// (0 with a level gradient in still water).
     #[inline(always)]
     fn wet_fraction(&self, z: f64, flow: Option<&Flow>) -> (f64, Option<Vec3>) {
-        match flow {
-            Some(f) if self.water.free_surface => {
-                let s = (f.elevation - z) / self.diameter + 0.5;
-                if s >= 1.0 {
-                    (1.0, None)
-                } else if s <= 0.0 {
-                    (0.0, None)
-                } else {
-                    let [ex, ey] = f.elevation_gradient;
-                    let d = self.diameter;
-                    (s, Some([ex / d, ey / d, -1.0 / d]))
-                }
-            }
-            _ => (1.0, None),
+        if !self.water.free_surface {
+            return (1.0, None);
+        }
+        let (eta, [ex, ey]) = flow.map_or((0.0, [0.0; 2]), |f| (f.elevation, f.elevation_gradient));
+        let s = (eta - z) / self.diameter + 0.5;
+        if s >= 1.0 {
+            (1.0, None)
+        } else if s <= 0.0 {
+            (0.0, None)
+        } else {
+            let d = self.diameter;
+            (s, Some([ex / d, ey / d, -1.0 / d]))
         }
     }
 
@@ -394,6 +394,16 @@ mod tests {
                 fd::check(&f, &q, &v, t);
             }
         }
+        // Still water under its surface z = 0 (a MoorDyn file's water): deep, and a node
+        // partly out of the water (the wet fraction's gradient, with no flow to evaluate).
+        let calm = Water::new(40.0, 9.80665, Current::none(), &[], Stretching::Wheeler).unwrap();
+        for z in [-29.2, -0.3 * 0.09, 0.2 * 0.09] {
+            let q: Vec<Vec3> = q.iter().map(|p| [p[0], p[1], p[2] + z + 29.2]).collect();
+            for tangent in [Some([0, 2]), None] {
+                let f = Force::LineHydro(Box::new(element(tangent, calm.clone())));
+                fd::check(&f, &q, &v, t);
+            }
+        }
         for stretching in [Stretching::Wheeler, Stretching::Vertical] {
             let w = sea(stretching);
             let (eta, _, _) = w.surface(0.1, 0.0, t);
@@ -463,6 +473,27 @@ mod tests {
         for i in 0..3 {
             assert!((half[i] - 0.5 * full[i]).abs() < 1e-12 * full[i].abs().max(1.0));
         }
+    }
+
+    /// Still water with its surface at z = 0 (MoorDyn's): a node at rest a diameter below it
+    /// feels the whole buoyancy rho g V, one at the surface half of it, one half a diameter
+    /// above it nothing; its drag goes with it (half at the surface).
+    #[test]
+    fn still_water_surface_takes_nodes_out_of_the_water() {
+        let calm = Water::new(40.0, 9.80665, Current::none(), &[], Stretching::Wheeler).unwrap();
+        let e = element(Some([0, 2]), calm);
+        let b = 1025.0 * 9.80665 * e.volume();
+        let at = |z: f64| vec![[-1.0, 0.0, z], [0.0, 0.0, z], [1.0, 0.0, z]];
+        let rest = vec![[0.0; 3]; 3];
+        assert_eq!(e.node_force(&at(-0.09), &rest, 0.0), [0.0, 0.0, b]);
+        let half = e.node_force(&at(0.0), &rest, 0.0);
+        assert!((half[2] - 0.5 * b).abs() < 1e-12 * b, "{half:?}");
+        assert_eq!(e.node_force(&at(0.045), &rest, 0.0), [0.0; 3]);
+        // Moving across the line at 1 m/s at the surface: half of 1/2 rho Cd d l u^2.
+        let moving = vec![[0.0; 3], [0.0, 1.0, 0.0], [0.0; 3]];
+        let f = e.node_force(&at(0.0), &moving, 0.0);
+        let drag = 0.5 * 0.5 * 1025.0 * 1.2 * 0.09 * 2.5;
+        assert!((f[1] + drag).abs() < 1e-12 * drag, "{f:?}");
     }
 
     /// Closed forms: at rest in still water only the buoyancy rho g pi d^2/4 l acts (upwards);
