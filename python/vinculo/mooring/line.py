@@ -375,7 +375,10 @@ def _guess(a: np.ndarray, b: np.ndarray, line_type: LineType, length: float,
     # A parabola -4 f u (1 - u) e_z below the chord whose arc length is the line's, its nodes
     # at equal arc lengths: each segment's chord a little shorter than its length, so that
     # the shape holds no tension (a run from the file's shape starts slack, not snapping);
-    # clipped at the seabed. The sag f by bisection on the arc length (increasing in f).
+    # clipped at the seabed. The sag f by bisection on the arc length (increasing in f). A
+    # vertical chord sags sideways (along x) instead: sagging along itself, the line would fold
+    # back on the chord, every node on one vertical, from where no iteration straightens it
+    # (a slack line from a point down to a clump: the statics stopped without converging).
     return _parabola(a, b, length, segments, water)
 
 
@@ -384,9 +387,11 @@ def _parabola(a: np.ndarray, b: np.ndarray, length: float, segments: int,
     """The nodes of :func:`_guess`'s parabola (its comment)."""
     u = np.linspace(0.0, 1.0, 2049)
     chord = b - a
+    vertical = float(np.hypot(chord[0], chord[1])) <= 1e-9 * float(np.linalg.norm(chord))
+    sag_direction = np.array([1.0, 0.0, 0.0] if vertical else [0.0, 0.0, -1.0])
 
     def curve(sag: float) -> tuple[np.ndarray, np.ndarray]:
-        points = a + np.outer(u, chord) - np.outer(4.0 * sag * u * (1.0 - u), [0.0, 0.0, 1.0])
+        points = a + np.outer(u, chord) + np.outer(4.0 * sag * u * (1.0 - u), sag_direction)
         arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0),
                                                               axis=1))])
         return points, arc

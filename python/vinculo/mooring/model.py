@@ -58,10 +58,11 @@ def water(options: FileOptions) -> Any:
 
 def file_water(options: FileOptions) -> Any | None:
     """The water of a file's current (``Currents 1``) and waves (``WaveKin 7``), None for still
-    water (MoorDyn's lines in water that fills all space).
+    water (:func:`still_water`).
 
-    Without waves the water has no free surface (as in still water); with them it has one,
-    with Wheeler's stretching, as MoorDyn's (``docs/theory/ocean.md``).
+    Its free surface is the waves' elevation (the plane z = 0 without waves), with Wheeler's
+    stretching, as MoorDyn's (``docs/theory/ocean.md``): a line's nodes above it carry no
+    buoyancy and no drag.
 
     Arguments:
         options: the options.
@@ -88,7 +89,7 @@ def file_water(options: FileOptions) -> Any | None:
     return _core.Water(float(depth), float(options.gravity), amplitudes, omegas, directions,
                        phases, kind, np.ascontiguousarray(velocities, dtype=float),
                        np.ascontiguousarray(heights, dtype=float), 0.0, "wheeler",
-                       waves is not None, float(options.wave_ramp))
+                       True, float(options.wave_ramp))
 
 
 def seabed(options: FileOptions) -> Any:
@@ -211,7 +212,9 @@ def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, 
         # in the current alone, as MoorDyn's initial condition leaves the waves out.
         still = (file_water(dataclasses.replace(options, waves=None))
                  if options.waves is not None else flowing)
-        system.set_water(still if still is not None else _core_still(options))
+        system.set_water(still if still is not None else still_water(options))
+    else:
+        system.set_water(still_water(options))
     the_water, the_seabed = water(options), seabed(options)
     start = motion.positions(0.0) if motion is not None else None
     points: list[ParticleId] = []
@@ -287,10 +290,21 @@ def _end_masses(model: MoorDynFile) -> dict[int, float]:
     return masses
 
 
-def _core_still(options: FileOptions) -> Any:
-    """Still water that fills all space, as a system's water is before any is given."""
+def still_water(options: FileOptions) -> Any:
+    """Still water below its surface, the plane z = 0, as MoorDyn's: the part of a line above
+    it carries its weight without buoyancy or drag (MoorDyn weighs each segment's submerged
+    fraction; here each node is wet over its diameter about the surface,
+    ``docs/theory/seabed-and-line-loads.md``).
+
+    Arguments:
+        options: the file's options (gravity, depth).
+
+    Returns:
+        A ``vinculo._core.Water``.
+    """
     from vinculo import _core
 
     empty = np.zeros(0)
-    return _core.Water(math.inf, float(options.gravity), empty, empty, empty, empty, "uniform",
-                       np.zeros((1, 3)), empty, 0.0, "wheeler", False, 0.0)
+    depth = options.depth if options.depth > 0.0 else math.inf
+    return _core.Water(float(depth), float(options.gravity), empty, empty, empty, empty,
+                       "uniform", np.zeros((1, 3)), empty, 0.0, "wheeler", True, 0.0)
