@@ -292,9 +292,8 @@ def _end_masses(model: MoorDynFile) -> dict[int, float]:
 
 def still_water(options: FileOptions) -> Any:
     """Still water below its surface, the plane z = 0, as MoorDyn's: the part of a line above
-    it carries its weight without buoyancy or drag (MoorDyn weighs each segment's submerged
-    fraction; here each node is wet over its diameter about the surface,
-    ``docs/theory/seabed-and-line-loads.md``).
+    it carries its weight without buoyancy or drag (a node's wet fraction is the mean of its
+    segments' submerged fractions, as MoorDyn's, ``docs/theory/ocean.md``).
 
     Arguments:
         options: the file's options (gravity, depth).

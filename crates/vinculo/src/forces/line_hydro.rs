@@ -19,9 +19,19 @@
 //!
 //! (MoorDyn-F `Line_GetStateDeriv`: `Dp = 0.25 rhoW Cdn d (l_i + l_{i+1}) |Vp| Vp`,
 //! `Dq = 0.25 rhoW Cdt pi d (l_i + l_{i+1}) |Vq| Vq`; the node length is (l_i + l_{i+1})/2.)
-//! F is the node's wet fraction: 1 in water that fills all space (the default); where the water
-//! has a free surface, F = clamp((eta - z) / d + 1/2, 0, 1) with eta the elevation above the
-//! node, which takes the node out of the water over its diameter.
+//! F is the node's wet fraction: 1 in water that fills all space (the default). Under a free
+//! surface it is MoorDyn's: the mean of the submerged fractions of the node's segments (one for
+//! an end node), each segment's volume shared equally by its two nodes. A segment from z_a to
+//! z_b, taken as a rod of diameter d, spans heights from lo = min(z_a, z_b) - d/2 over
+//! span = |z_a - z_b| + d, and is wet by s = clamp((eta - lo) / span, 0, 1), eta the elevation
+//! above the node (0 in still water; MoorDyn takes the mean of the segment's two nodes'). Inside
+//! the ramp, ds/deta = 1/span, ds/dz = -(1 - s)/span at the segment's lower end and -s/span at
+//! its upper one, and eta's horizontal gradient enters through the node's x and y. A node
+//! without a tangent (no neighbours known) is a horizontal segment: s = (eta - z)/d + 1/2. A
+//! vertical line piercing the surface is then buoyant over its wet length, its nodes crossing
+//! one by one without a jump (with the node's own (eta - z)/d + 1/2, a node lost the buoyancy
+//! of its whole length over its diameter's travel: steps of 1 kN in the top tension of a
+//! jumper heaving through the surface, `tests/mooring/test_lowe_langley.py`).
 //!
 //! Added mass: MoorDyn adds rho V (Ca (I - t t^T) + CaAx t t^T) to the node's mass matrix.
 //! It is split in two: the isotropic part Ca rho V joins the particle's scalar inertia
@@ -140,24 +150,56 @@ impl LineHydro {
         (!w.is_still()).then(|| w.flow(q[self.node.node()], t, gradients))
     }
 
-    /// The wet fraction F and, inside its ramp, its gradient (module documentation): 1 in
-    /// water without a surface; under a free surface, from the elevation eta above the node
-    /// (0 with a level gradient in still water).
+    /// The wet fraction F (module documentation) and, inside a ramp, its gradient with respect
+    /// to the positions of the node's particles (by local index): 1 in water without a
+    /// surface; under a free surface at the elevation eta above the node (0 with a level
+    /// gradient in still water), the mean over the node's segments of their wet fractions.
     #[inline(always)]
-    fn wet_fraction(&self, z: f64, flow: Option<&Flow>) -> (f64, Option<Vec3>) {
+    fn wet_fraction(&self, q: &[Vec3], flow: Option<&Flow>) -> (f64, Option<[Vec3; 3]>) {
         if !self.water.free_surface {
             return (1.0, None);
         }
         let (eta, [ex, ey]) = flow.map_or((0.0, [0.0; 2]), |f| (f.elevation, f.elevation_gradient));
-        let s = (eta - z) / self.diameter + 0.5;
-        if s >= 1.0 {
-            (1.0, None)
-        } else if s <= 0.0 {
-            (0.0, None)
+        let z = q[self.node.node()][2];
+        let half = 0.5 * self.diameter;
+        let others = &self.node.particles()[1..];
+        // A node alone (no tangent) stands for a horizontal piece of line: one segment whose
+        // ends are both at the node.
+        let ends: &[usize] = if others.is_empty() {
+            std::slice::from_ref(&self.node.particles()[0])
         } else {
-            let d = self.diameter;
-            (s, Some([ex / d, ey / d, -1.0 / d]))
+            others
+        };
+        let share = 1.0 / ends.len() as f64;
+        let (mut wet, mut gradient, mut ramp) = (0.0, [[0.0; 3]; 3], false);
+        for (k, &j) in ends.iter().enumerate() {
+            let zj = q[j][2];
+            let (low, span) = (z.min(zj) - half, (z - zj).abs() + 2.0 * half);
+            let s = (eta - low) / span;
+            if s >= 1.0 {
+                wet += share;
+            } else if s > 0.0 {
+                wet += share * s;
+                ramp = true;
+                // ds/deta = 1/span; ds/dz = -(1 - s)/span at the lower end, -s/span at the
+                // upper one (their sum -1/span: the segment lowered as a whole).
+                let (at_node, at_other) = if z <= zj {
+                    (-(1.0 - s) / span, -s / span)
+                } else {
+                    (-s / span, -(1.0 - s) / span)
+                };
+                let g = &mut gradient[0];
+                g[0] += share * ex / span;
+                g[1] += share * ey / span;
+                if others.is_empty() {
+                    g[2] += share * (at_node + at_other);
+                } else {
+                    g[2] += share * at_node;
+                    gradient[k + 1][2] += share * at_other;
+                }
+            }
         }
+        (wet, ramp.then_some(gradient))
     }
 
     /// The loads on the node over its wet fraction (the bracket of the module documentation).
@@ -218,7 +260,7 @@ impl LineHydro {
         tangents: &mut TangentCache,
     ) -> Vec3 {
         let flow = self.flow(q, t, false);
-        let (wet, _) = self.wet_fraction(q[self.node.node()][2], flow.as_ref());
+        let (wet, _) = self.wet_fraction(q, flow.as_ref());
         if wet == 0.0 {
             return [0.0; 3];
         }
@@ -268,11 +310,13 @@ impl LineHydro {
         dv: &mut Jacobian,
     ) {
         let flow = self.flow(q, t, true);
-        let (wet, wet_gradient) = self.wet_fraction(q[self.node.node()][2], flow.as_ref());
+        let (wet, wet_gradient) = self.wet_fraction(q, flow.as_ref());
         if let Some(g) = wet_gradient {
-            // f_w (grad F)^T on the node's own position.
+            // f_w (grad F)^T on the positions of the node and of its neighbours.
             let fw = self.wet_force(q, v, flow.as_ref());
-            dq[0][0] = add_mat(dq[0][0], outer(1.0, fw, g));
+            for (k, gk) in g.iter().enumerate().take(self.node.count) {
+                dq[0][k] = add_mat(dq[0][k], outer(1.0, fw, *gk));
+            }
         }
         if wet == 0.0 {
             return;
@@ -399,7 +443,7 @@ mod tests {
         let calm = Water::new(40.0, 9.80665, Current::none(), &[], Stretching::Wheeler).unwrap();
         for z in [-29.2, -0.3 * 0.09, 0.2 * 0.09] {
             let q: Vec<Vec3> = q.iter().map(|p| [p[0], p[1], p[2] + z + 29.2]).collect();
-            for tangent in [Some([0, 2]), None] {
+            for tangent in [Some([0, 2]), Some([1, 2]), None] {
                 let f = Force::LineHydro(Box::new(element(tangent, calm.clone())));
                 fd::check(&f, &q, &v, t);
             }
@@ -414,7 +458,7 @@ mod tests {
                 for p in q.iter_mut() {
                     p[2] += z + 29.2;
                 }
-                for tangent in [Some([0, 2]), None] {
+                for tangent in [Some([0, 2]), Some([1, 2]), None] {
                     let f = Force::LineHydro(Box::new(element(tangent, w.clone())));
                     fd::check(&f, &q, &v, t);
                 }
