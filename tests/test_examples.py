@@ -351,3 +351,19 @@ def test_floating_buoy(tmp_path):
     assert number_after("heave natural period:", out) == pytest.approx(3.475, abs=1e-3)
     assert number_after("largest relative difference away from resonance:", out) < 0.015
     assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_flexible_jumper(tmp_path):
+    # Lowe and Langley (OMAE 2006): static top force (11.40, 45.71) kN, lower (11.40, 24.04) kN,
+    # given to 0.01 kN; the top tension within 0.46, 0.25 and 0.57 kN of the paper's curves in
+    # surge, sway and heave (measured; tests/mooring/test_lowe_langley.py asserts the same).
+    plot = tmp_path / "flexible_jumper.png"
+    out = run_example("flexible_jumper.py", "--plot", str(plot))
+    for end, paper in (("top", (11.40, 45.71)), ("lower", (11.40, 24.04))):
+        match = re.search(rf"static {end} force: \(([-0-9.]+), ([-0-9.]+)\)", out)
+        assert match, out
+        assert [float(match.group(1)), float(match.group(2))] == pytest.approx(paper, abs=0.01)
+    for motion, bound in (("surge", 0.6), ("sway", 0.35), ("heave", 0.75)):
+        line = next(ln for ln in out.splitlines() if ln.startswith(motion))
+        assert number_after("largest", line) < bound, line
+    assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
