@@ -159,6 +159,25 @@ impl LineHydro {
         if !self.water.free_surface {
             return (1.0, None);
         }
+        // Half a diameter below the surface with its segments (the usual case): all wet.
+        let eta = flow.map_or(0.0, |f| f.elevation);
+        let p = &self.node.particles;
+        let top = p[1..self.node.count]
+            .iter()
+            .fold(q[p[0]][2], |top, &j| top.max(q[j][2]));
+        if top + 0.5 * self.diameter <= eta {
+            return (1.0, None);
+        }
+        self.wet_fraction_near_surface(q, flow)
+    }
+
+    /// [`LineHydro::wet_fraction`] of a node whose segments reach the surface's ramp.
+    #[inline(never)]
+    fn wet_fraction_near_surface(
+        &self,
+        q: &[Vec3],
+        flow: Option<&Flow>,
+    ) -> (f64, Option<[Vec3; 3]>) {
         let (eta, [ex, ey]) = flow.map_or((0.0, [0.0; 2]), |f| (f.elevation, f.elevation_gradient));
         let z = q[self.node.node()][2];
         let half = 0.5 * self.diameter;
