@@ -161,10 +161,9 @@ impl LineHydro {
         }
         // Half a diameter below the surface with its segments (the usual case): all wet.
         let eta = flow.map_or(0.0, |f| f.elevation);
-        let p = &self.node.particles;
-        let top = p[1..self.node.count]
-            .iter()
-            .fold(q[p[0]][2], |top, &j| top.max(q[j][2]));
+        // (The entries past the node's count hold the node itself.)
+        let [i, a, b] = self.node.particles;
+        let top = q[i][2].max(q[a][2]).max(q[b][2]);
         if top + 0.5 * self.diameter <= eta {
             return (1.0, None);
         }

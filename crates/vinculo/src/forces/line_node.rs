@@ -23,7 +23,8 @@ use crate::math::{diag, norm, outer, scale, sub, Mat3, Vec3};
 /// A line node: the particle that carries the loads, and the particles that give its tangent.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LineNode {
-    /// Touched particles: the node first, then the tangent's particles that are not the node.
+    /// Touched particles: the node first, then the tangent's particles that are not the node;
+    /// the entries past `count` hold the node.
     pub particles: [usize; 3],
     /// Number of touched particles (1, 2 or 3).
     pub count: usize,
