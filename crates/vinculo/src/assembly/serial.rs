@@ -33,7 +33,7 @@ impl Layout {
         }
         // The rows of the particles each force acts on (a line node's loads act on the node
         // alone, its neighbours only giving the tangent).
-        let mut tangents = TangentCache::default();
+        let mut tangents = TangentCache::for_configuration();
         let point = (at.q_eval, at.v_eval, at.t_eval);
         for f in system.forces() {
             f.for_each_acting(point, &mut tangents, |p, fp| {

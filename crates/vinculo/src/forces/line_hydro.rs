@@ -278,12 +278,26 @@ impl LineHydro {
         tangents: &mut TangentCache,
     ) -> Vec3 {
         let flow = self.flow(q, t, false);
-        let (wet, _) = self.wet_fraction(q, flow.as_ref());
-        if wet == 0.0 {
-            return [0.0; 3];
+        // Under a free surface the wet fraction, unless every particle of the configuration
+        // lies half a diameter below it (a line deep in the water: wet).
+        if self.water.free_surface {
+            let eta = flow.as_ref().map_or(0.0, |f| f.elevation);
+            let deep = tangents
+                .top(q)
+                .is_some_and(|top| top + 0.5 * self.diameter <= eta);
+            if !deep {
+                let (wet, _) = self.wet_fraction(q, flow.as_ref());
+                if wet < 1.0 {
+                    if wet == 0.0 {
+                        return [0.0; 3];
+                    }
+                    let tangent = tangents.tangent(&self.node, q);
+                    return scale(wet, self.wet_force_with(v, flow.as_ref(), tangent));
+                }
+            }
         }
         let tangent = tangents.tangent(&self.node, q);
-        scale(wet, self.wet_force_with(v, flow.as_ref(), tangent))
+        self.wet_force_with(v, flow.as_ref(), tangent)
     }
 
     /// The axial correction of the node's mass block at positions `q`, C = -e t t^T with

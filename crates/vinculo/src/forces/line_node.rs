@@ -38,13 +38,20 @@ pub struct LineNode {
 /// instead of each computing it (a square root and a division). It is kept under the two
 /// particles it runs between (a tangent depends on them alone), with its unit vector and
 /// 1/|d|; the local indices of a node asking for it are that node's own. A cache lives for one
-/// configuration only (the assembler makes one per residual).
+/// configuration only (the assembler makes one per residual). One made for the whole
+/// configuration ([`TangentCache::for_configuration`]) also keeps the greatest height of its
+/// particles, which tells every node of a line deep under a free surface at once that it is
+/// wet ([`LineHydro`](super::LineHydro)).
 #[derive(Debug, Clone)]
 pub(crate) struct TangentCache {
     /// The particles (a, b) of the last tangent computed ([`NO_KEY`]: none yet).
     key: [usize; 2],
     /// Its unit vector and 1/|d|; None where a and b coincide.
     value: Option<(Vec3, f64)>,
+    /// Whether the cache serves every element of the configuration.
+    whole: bool,
+    /// The greatest height of the configuration's particles (NaN: not yet found).
+    top: f64,
 }
 
 /// The key of an empty [`TangentCache`].
@@ -55,11 +62,35 @@ impl Default for TangentCache {
         TangentCache {
             key: NO_KEY,
             value: None,
+            whole: false,
+            top: f64::NAN,
         }
     }
 }
 
 impl TangentCache {
+    /// A cache for every element of one configuration (the assembler's residual loop).
+    pub(crate) fn for_configuration() -> TangentCache {
+        TangentCache {
+            whole: true,
+            ..TangentCache::default()
+        }
+    }
+
+    /// The greatest height z of the particles at `q`, found once for a cache that serves the
+    /// whole configuration; None for one made for a single element (where finding it would
+    /// cost more than it saves).
+    #[inline(always)]
+    pub(crate) fn top(&mut self, q: &[Vec3]) -> Option<f64> {
+        if !self.whole {
+            return None;
+        }
+        if self.top.is_nan() {
+            self.top = q.iter().fold(f64::NEG_INFINITY, |top, p| top.max(p[2]));
+        }
+        Some(self.top)
+    }
+
     /// The tangent of `node` at `q` ([`LineNode::tangent`]), computed unless it was the last
     /// one asked for.
     #[inline(always)]
