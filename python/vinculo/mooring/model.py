@@ -206,15 +206,13 @@ def build_model(source: str | Path | MoorDynFile, motion: Motion | None = None, 
     options = model.options
     system = System(gravity=(0.0, 0.0, -options.gravity))
     flowing = file_water(options)
-    if flowing is not None:
-        # The lines' and free points' loads in the file's current; its waves join for a
-        # run (:func:`vinculo.mooring.analysis.run`), the equilibrium and its end forces are
-        # in the current alone, as MoorDyn's initial condition leaves the waves out.
-        still = (file_water(dataclasses.replace(options, waves=None))
-                 if options.waves is not None else flowing)
-        system.set_water(still if still is not None else still_water(options))
-    else:
-        system.set_water(still_water(options))
+    # The lines' and free points' loads in the file's current (else still water), under the
+    # surface z = 0; its waves join for a run (:func:`vinculo.mooring.analysis.run`), the
+    # equilibrium and its end forces are in the current alone, as MoorDyn's initial condition
+    # leaves the waves out.
+    current = (file_water(dataclasses.replace(options, waves=None))
+               if options.waves is not None else flowing)
+    system.set_water(current if current is not None else still_water(options))
     the_water, the_seabed = water(options), seabed(options)
     start = motion.positions(0.0) if motion is not None else None
     points: list[ParticleId] = []
