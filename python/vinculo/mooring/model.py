@@ -70,11 +70,17 @@ def file_water(options: FileOptions) -> Any | None:
     Returns:
         A ``vinculo._core.Water``, or None.
     """
+    if options.current is None and options.waves is None:
+        return None
+    return _core_water(options)
+
+
+def _core_water(options: FileOptions) -> Any:
+    """The core's water of a file's current and waves (either may be None), under its free
+    surface (:func:`file_water`)."""
     from vinculo import _core
 
     current, waves = options.current, options.waves
-    if current is None and waves is None:
-        return None
     empty = np.zeros(0)
     if current is not None:
         kind, velocities, heights = "table", current.velocities, current.heights
@@ -299,9 +305,4 @@ def still_water(options: FileOptions) -> Any:
     Returns:
         A ``vinculo._core.Water``.
     """
-    from vinculo import _core
-
-    empty = np.zeros(0)
-    depth = options.depth if options.depth > 0.0 else math.inf
-    return _core.Water(float(depth), float(options.gravity), empty, empty, empty, empty,
-                       "uniform", np.zeros((1, 3)), empty, 0.0, "wheeler", True, 0.0)
+    return _core_water(dataclasses.replace(options, current=None, waves=None))
