@@ -24,6 +24,21 @@
 //! evolution relaxation: mu_{k+1} = mu_k |R_k| / |R_{k-1}|), so that the last steps are
 //! Newton's. The solution does not depend on mu: only the path does.
 //!
+//! Both keep every elastic segment's compliant row, which can push as well as pull, and refuse
+//! an equilibrium in which a segment is compressed: the continuation's damped motion buckles
+//! such a line down under its weight. Where nothing can buckle, the compression stays and the
+//! continuation does not end: a tether longer than the way from its anchor to its float, whose
+//! spare length stands on the anchor held straight by its bending stiffness, or a lander among
+//! MoorDyn's test inputs (three bridles under a surface float stiff in bending). The
+//! solve then runs the continuation again from the initial state with the segments as a run
+//! has them ([`StaticRule`]'s `SLACK_SEGMENTS`): a segment that goes slack in a run
+//! ([`crate::model::System::set_slack`], every MoorDyn line's) carries no tension while it is
+//! shorter than its length, so that the spare length lies slack. That equilibrium is one of the
+//! run's own equations, which stays at rest from it. The first two solves keep the compliant
+//! rows because a line lying on the seabed at its unstretched length in the catenary start
+//! would otherwise leave its nodes without stiffness along it, and Newton's method from that
+//! start would fail.
+//!
 //! The linearised stiffness of the system at a point p, K = -dF/dx_p (F the force of the rest
 //! of the system on p, the other particles in equilibrium), is the Schur complement of the
 //! equilibrium Jacobian on p's rows and columns divided by the rows' scale: with p free,
@@ -45,14 +60,18 @@ pub enum StaticsMethod {
     Newton,
     /// Pseudo-transient continuation, finished by Newton's method.
     Continuation,
+    /// Pseudo-transient continuation with the segments that go slack in a run slack (module
+    /// documentation), finished by Newton's method.
+    SlackContinuation,
 }
 
 impl StaticsMethod {
-    /// "newton" or "continuation".
+    /// "newton", "continuation" or "slack continuation".
     pub fn name(&self) -> &'static str {
         match self {
             StaticsMethod::Newton => "newton",
             StaticsMethod::Continuation => "continuation",
+            StaticsMethod::SlackContinuation => "slack continuation",
         }
     }
 }
@@ -100,24 +119,27 @@ pub struct Statics {
 
 /// The static rule (module documentation): v = 0, inertia row
 /// mu M (q - q_prev) - m g, the mass term mu M (mu = 0: the equilibrium equations).
-pub struct StaticRule<'a> {
+/// `SLACK_SEGMENTS`: whether the segments that go slack in a run do so here (the last
+/// fallback of [`solve_statics`]); false: every segment keeps its compliant row.
+pub struct StaticRule<'a, const SLACK_SEGMENTS: bool = false> {
     /// The pseudo-time coefficient mu (1/s^2); 0 for the equilibrium itself.
     pub mu: f64,
     /// The positions of the previous pseudo-step.
     pub previous: &'a [Vec3],
 }
 
-impl Index3Rule for StaticRule<'_> {
+impl<const SLACK_SEGMENTS: bool> Index3Rule for StaticRule<'_, SLACK_SEGMENTS> {
     const AT_END: bool = true;
     /// No step size makes the equilibrium's residual small: a stiff element far from the origin
     /// (a finely divided line with bending stiffness at depth) puts its round-off above any
     /// tolerance that suits the rest of the model.
     const ROUND_OFF_REACH: f64 = f64::INFINITY;
-    /// The equilibrium keeps every segment's compliant row: a segment lying on the seabed at
-    /// its unstretched length in the first iterate would otherwise leave its nodes without
-    /// stiffness along it, and Newton's method from the catenary start would fail; compressed
-    /// segments are refused (and buckled down by the continuation) on their own.
-    const SLACK: bool = false;
+    /// Without `SLACK_SEGMENTS` the equilibrium keeps every segment's compliant row: a
+    /// segment lying on the seabed at its unstretched length in the first iterate would
+    /// otherwise leave its nodes without stiffness along it, and Newton's method from the
+    /// catenary start would fail; compressed segments are refused (and buckled down by the
+    /// continuation) on their own (module documentation).
+    const SLACK: bool = SLACK_SEGMENTS;
 
     #[inline(always)]
     fn kinematics(&self, _i: usize, q: &Vec3) -> (Vec3, Vec3, Vec3) {
@@ -162,11 +184,11 @@ fn row_scale(system: &System, mass_ref: f64) -> f64 {
 
 /// Runs `f` on the (pseudo-)static problem of parameter `mu` at time `t`, from the positions
 /// `previous` of the last pseudo-step, at the workspace's iterate.
-fn with_static_problem<'p, T>(
+fn with_static_problem<'p, T, const S: bool>(
     system: &System,
     ws: &mut StepWorkspace,
     (t, mu, previous): (f64, f64, &'p [Vec3]),
-    f: impl FnOnce(StepProblem<'_, StaticRule<'p>>, LinearWork<'_>) -> T,
+    f: impl FnOnce(StepProblem<'_, StaticRule<'p, S>>, LinearWork<'_>) -> T,
 ) -> T {
     let sigma = row_scale(system, ws.mass_ref);
     let zero = vec![[0.0; 3]; previous.len()];
@@ -176,28 +198,33 @@ fn with_static_problem<'p, T>(
         t_end: t,
         sigma,
     };
-    let rule = StaticRule { mu, previous };
+    let rule = StaticRule::<S> { mu, previous };
     let (problem, work) = StepProblem::new(system, ws, (&start, point), rule);
     f(problem, work)
 }
 
 /// One Newton solve of the (pseudo-)static equations from the workspace's iterate.
-fn newton_solve(
+fn newton_solve<const S: bool>(
     system: &System,
     ws: &mut StepWorkspace,
     (t, mu, previous): (f64, f64, &[Vec3]),
     options: &NewtonOptions,
 ) -> std::result::Result<newton::NewtonReport, NewtonFailure> {
     ws.matrix.invalidate();
-    with_static_problem(system, ws, (t, mu, previous), |mut problem, work| {
+    with_static_problem::<_, S>(system, ws, (t, mu, previous), |mut problem, work| {
         newton::solve(&mut problem, work, [mu, f64::NAN], options)
     })
 }
 
 /// The largest scaled residual of the equilibrium equations (mu = 0) at the workspace's iterate.
-fn static_residual(system: &System, ws: &mut StepWorkspace, t: f64, previous: &[Vec3]) -> f64 {
+fn static_residual<const S: bool>(
+    system: &System,
+    ws: &mut StepWorkspace,
+    t: f64,
+    previous: &[Vec3],
+) -> f64 {
     let mut r = std::mem::take(&mut ws.r);
-    with_static_problem(system, ws, (t, 0.0, previous), |mut problem, _| {
+    with_static_problem::<_, S>(system, ws, (t, 0.0, previous), |mut problem, _| {
         problem.residual(&mut r)
     });
     let worst = r.iter().fold(
@@ -209,13 +236,14 @@ fn static_residual(system: &System, ws: &mut StepWorkspace, t: f64, previous: &[
 }
 
 /// The static equilibrium of `system` at time `options.t`, from its initial positions
-/// (module documentation): Newton's method, and pseudo-transient continuation when Newton
-/// fails.
+/// (module documentation): Newton's method, pseudo-transient continuation when Newton fails,
+/// and the continuation with slack segments when that does not end.
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for a tolerance that is not > 0, a time that is not finite or
-/// no iteration; [`Error::NewtonFailed`] (with a zero step) when neither converges within
-/// `options.max_iterations` iterations.
+/// no iteration; [`Error::NewtonFailed`] (with a zero step) when none converges: Newton's
+/// method and the first continuation within `options.max_iterations` iterations in all, the
+/// continuation with slack segments within as many of its own.
 pub fn solve_statics(system: &System, options: &StaticsOptions) -> Result<Statics> {
     crate::error::positive("statics tolerance", options.tolerance)?;
     crate::error::finite("statics time t", options.t)?;
@@ -239,11 +267,12 @@ pub fn solve_statics(system: &System, options: &StaticsOptions) -> Result<Static
         max_iterations: 25.min(options.max_iterations),
         jacobian_reuse: JacobianReuse::Never,
     };
+    let start = (&q0[..], &lambda0[..]);
     ws.state.q.clone_from(&q0);
     ws.state.lambda.clone_from(&lambda0);
     let mut used = 0;
     let first = if options.newton_first {
-        newton_solve(system, &mut ws, (t, 0.0, &q0), &newton)
+        newton_solve::<false>(system, &mut ws, (t, 0.0, &q0), &newton)
     } else {
         Err(NewtonFailure::NotConverged {
             iterations: 0,
@@ -261,9 +290,63 @@ pub fn solve_statics(system: &System, options: &StaticsOptions) -> Result<Static
         Err(NewtonFailure::NotConverged { iterations, .. }) => used += iterations,
         Err(NewtonFailure::Singular(_)) => used += 1,
     }
-    // Pseudo-transient continuation from the initial state.
-    ws.state.q.clone_from(&q0);
-    ws.state.lambda.clone_from(&lambda0);
+    let budget = options.max_iterations.saturating_sub(used);
+    if let Ok(report) = continuation::<false>(system, &mut ws, (t, start), &newton, budget) {
+        let mut report = report;
+        report.iterations += used;
+        return Ok(finish(&ws, report, StaticsMethod::Continuation, t));
+    }
+    used = options.max_iterations;
+    let budget = options.max_iterations;
+    match continuation::<true>(system, &mut ws, (t, start), &newton, budget) {
+        Ok(report) => {
+            let mut report = report;
+            report.iterations += used;
+            Ok(finish(&ws, report, StaticsMethod::SlackContinuation, t))
+        }
+        Err(iterations) => {
+            let previous = ws.state.q.clone();
+            let residual = static_residual::<true>(system, &mut ws, t, &previous);
+            let worst =
+                ws.r.iter()
+                    .enumerate()
+                    .fold(
+                        (0.0f64, 0),
+                        |(m, k), (i, x)| if x.abs() > m { (x.abs(), i) } else { (m, k) },
+                    )
+                    .1;
+            Err(Error::NewtonFailed {
+                t,
+                dt: 0.0,
+                iterations: used + iterations,
+                residual,
+                equation: format!(
+                    "{} (static equilibrium: Newton, pseudo-transient continuation, and the \
+                     continuation with slack segments)",
+                    ws.layout.equation_name(system, worst)
+                ),
+            })
+        }
+    }
+}
+
+/// Pseudo-transient continuation (module documentation) from the positions and multipliers
+/// `start`, then Newton's method on the equilibrium itself, within `budget` iterations; with
+/// `S` the segments that go slack in a run do so (the rows of [`StaticRule`]). The equilibrium
+/// is left in the workspace; on failure the iterations made (the workspace holds the last
+/// pseudo-step's positions).
+fn continuation<const S: bool>(
+    system: &System,
+    ws: &mut StepWorkspace,
+    (t, (q0, lambda0)): (f64, (&[Vec3], &[f64])),
+    newton: &NewtonOptions,
+    budget: usize,
+) -> std::result::Result<newton::NewtonReport, usize> {
+    ws.state.q.clear();
+    ws.state.q.extend_from_slice(q0);
+    ws.state.lambda.clear();
+    ws.state.lambda.extend_from_slice(lambda0);
+    let mut used = 0;
     let l = system.length_scale();
     let g = crate::math::norm(system.gravity()).max(1e-12);
     // mu0: the inverse square of the time a fall through the model's length takes, ten times
@@ -283,19 +366,18 @@ pub fn solve_statics(system: &System, options: &StaticsOptions) -> Result<Static
     let step_options = NewtonOptions {
         max_iterations: 12,
         tolerance: 1e3 * newton.tolerance,
-        ..newton
+        ..*newton
     };
     let mut previous = ws.state.q.clone();
     let mut lambda_previous = ws.state.lambda.clone();
-    let mut residual_previous = static_residual(system, &mut ws, t, &previous);
-    while used < options.max_iterations {
-        let attempt = newton_solve(system, &mut ws, (t, mu, &previous), &step_options);
-        match attempt {
+    let mut residual_previous = static_residual::<S>(system, ws, t, &previous);
+    while used < budget {
+        match newton_solve::<S>(system, ws, (t, mu, &previous), &step_options) {
             Ok(report) => {
                 used += report.iterations;
                 previous.clone_from(&ws.state.q);
                 lambda_previous.clone_from(&ws.state.lambda);
-                let residual = static_residual(system, &mut ws, t, &previous);
+                let residual = static_residual::<S>(system, ws, t, &previous);
                 // Switched evolution relaxation (at most a tenfold decrease per step, at least
                 // a halving after a converged pseudo-step: the slow modes of a line, a
                 // pendulum's g / l, would take mu / omega^2 pseudo-steps otherwise), kept
@@ -309,14 +391,14 @@ pub fn solve_statics(system: &System, options: &StaticsOptions) -> Result<Static
                 if close && !compressed(system, &ws.state.lambda) {
                     // Close: Newton on the equilibrium itself.
                     let remaining = NewtonOptions {
-                        max_iterations: 50.min(options.max_iterations.saturating_sub(used).max(1)),
-                        ..newton
+                        max_iterations: 50.min(budget.saturating_sub(used).max(1)),
+                        ..*newton
                     };
-                    match newton_solve(system, &mut ws, (t, 0.0, &previous), &remaining) {
+                    match newton_solve::<S>(system, ws, (t, 0.0, &previous), &remaining) {
                         Ok(report) if !compressed(system, &ws.state.lambda) => {
                             let mut report = report;
                             report.iterations += used;
-                            return Ok(finish(&ws, report, StaticsMethod::Continuation, t));
+                            return Ok(report);
                         }
                         Ok(report) => used += report.iterations,
                         Err(NewtonFailure::NotConverged { iterations, .. }) => {
@@ -344,25 +426,8 @@ pub fn solve_statics(system: &System, options: &StaticsOptions) -> Result<Static
             }
         }
     }
-    let residual = static_residual(system, &mut ws, t, &previous);
-    let worst =
-        ws.r.iter()
-            .enumerate()
-            .fold(
-                (0.0f64, 0),
-                |(m, k), (i, x)| if x.abs() > m { (x.abs(), i) } else { (m, k) },
-            )
-            .1;
-    Err(Error::NewtonFailed {
-        t,
-        dt: 0.0,
-        iterations: used,
-        residual,
-        equation: format!(
-            "{} (static equilibrium: Newton and pseudo-transient continuation)",
-            ws.layout.equation_name(system, worst)
-        ),
-    })
+    ws.state.q.clone_from(&previous);
+    Err(used)
 }
 
 /// True when an elastic segment (a line's) carries a compression beyond round-off.
@@ -481,7 +546,10 @@ pub fn point_stiffness(system: &System, statics: &Statics, particle: usize) -> R
         t_end: t,
         sigma,
     };
-    let rule = StaticRule {
+    // The rows of a run: a segment that goes slack and is shorter than its length (an
+    // equilibrium of the continuation with slack segments) adds no stiffness; every segment of
+    // the other equilibria is stretched, where the two rows are the same.
+    let rule = StaticRule::<true> {
         mu: 0.0,
         previous: &statics.positions,
     };

@@ -26,6 +26,22 @@ def _horizontal(points: np.ndarray, origin: np.ndarray) -> np.ndarray:
     return offsets @ heading
 
 
+#: The least width of a shape's horizontal axis, as a share of its height: a vertical line (a
+#: float's tether) keeps a readable axis instead of one spread over the round-off of its nodes'
+#: horizontal positions.
+LEAST_WIDTH = 0.2
+
+
+def _widen(ax: Any, horizontal: np.ndarray, heights: np.ndarray) -> None:
+    """Widen ``ax``'s horizontal axis about the shapes' middle to at least
+    :data:`LEAST_WIDTH` of their height."""
+    low, high = float(horizontal.min()), float(horizontal.max())
+    least = LEAST_WIDTH * float(heights.max() - heights.min())
+    if high - low < least:
+        middle = 0.5 * (low + high)
+        ax.set_xlim(middle - 0.5 * least, middle + 0.5 * least)
+
+
 def plot_shapes(run: Any, path: str | Path, snapshots: int = 6) -> Path:
     """The lines' shapes at a few times of a run, each in the vertical plane of its ends.
 
@@ -47,10 +63,13 @@ def plot_shapes(run: Any, path: str | Path, snapshots: int = 6) -> Path:
     for ax, line, row in zip(axes, lines, run.model.file.lines, strict=True):
         nodes = np.asarray(line.nodes, dtype=int)
         origin = positions[0, nodes[0]]
+        reach = []
         for colour, i in zip(colours, picks, strict=True):
             shape = positions[i, nodes]
-            ax.plot(_horizontal(shape, origin), shape[:, 2], "-", color=colour, lw=1.2,
+            reach.append(_horizontal(shape, origin))
+            ax.plot(reach[-1], shape[:, 2], "-", color=colour, lw=1.2,
                     label=f"t = {times[i]:.3g} s")
+        _widen(ax, np.concatenate(reach), positions[picks][:, nodes, 2])
         if run.model.file.options.seafloor is None:
             ax.axhline(run.model.seabed_z, color="saddlebrown", lw=1.0, label="seabed")
         else:

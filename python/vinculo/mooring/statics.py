@@ -5,8 +5,12 @@ every free particle is in equilibrium at rest: Newton's method on the equilibriu
 their analytic Jacobian (the assembly of a time step with the mass terms dropped), and, when it
 fails (slack lines, lines lying on the seabed), pseudo-transient continuation: damped implicit
 pseudo-steps whose damping decreases as the residual does, finished by Newton's method
-(``docs/theory/moorings.md``). The result does not depend on any time step. Friction, which
-depends on the sliding velocity, is zero at rest, as in MoorDyn's initial conditions.
+(``docs/theory/moorings.md``). Both keep every segment able to push, and refuse an equilibrium
+with a compressed segment (the continuation buckles such a line down); where it cannot buckle
+(spare tether standing on its anchor, stiff in bending), the continuation runs again with the
+segments slack while shorter than their length, as in a run. The result does not depend on any
+time step. Friction, which depends on the sliding velocity, is zero at rest, as in MoorDyn's
+initial conditions.
 
 :func:`point_stiffness` gives the 3x3 linearised stiffness ``K = -dF/dx`` at a point from the
 same analytic Jacobian (its Schur complement on the point), the other particles staying in
@@ -43,7 +47,9 @@ class Statics:
         multipliers: ``(constraints,)`` multipliers; an elastic segment's is its tension (N).
         residual: the final scaled residual (m).
         iterations: the Newton iterations made in all.
-        method: ``"newton"``, or ``"continuation"`` when Newton's method alone failed.
+        method: ``"newton"``, ``"continuation"`` when Newton's method alone failed, or
+            ``"slack continuation"`` when the continuation with every segment able to push did
+            not end (the module documentation).
         t: the time at which it holds (the laws of winches and prescribed points at ``t``).
     """
 
@@ -72,7 +78,8 @@ def solve_statics(system: Any, *, tolerance: float = 1e-9, max_iterations: int =
         tolerance: on the scaled residual and increment, relative to the model's length scale.
             Where the residual's own round-off is larger (a stiff bending line far from the
             origin), Newton stops at that round-off once its increments stop shrinking.
-        max_iterations: the largest number of Newton iterations in all.
+        max_iterations: the largest number of Newton iterations of Newton's method and the
+            continuation in all, and of the continuation with slack segments.
         t: the time at which the laws (winches, prescribed points) are evaluated.
         newton_first: try Newton's method first (False: the continuation at once).
         apply: make the equilibrium the system's initial state (at rest).
@@ -81,7 +88,7 @@ def solve_statics(system: Any, *, tolerance: float = 1e-9, max_iterations: int =
         The :class:`Statics`.
 
     Raises:
-        ConvergenceError: when neither Newton's method nor the continuation converges.
+        ConvergenceError: when neither Newton's method nor either continuation converges.
         InvalidInputError: for a tolerance or iteration count out of range.
     """
     positions, multipliers, residual, iterations, method = _core.solve_statics(
