@@ -121,6 +121,17 @@ def _line_of(text: str, needle: str) -> int:
         ("0             writeLog", "2             Currents", "Currents", "only steady currents"),
         ("0             writeLog", "0.3           fooBar  ", "fooBar", "unknown option"),
         ("1.0e-4        dtM", "-1.0e-4       dtM", "dtM", "must be > 0"),
+        # MoorDyn v1's layouts (MoorDyn's docs/inputs.rst), whose columns read as v2's would go
+        # to the wrong fields (MoorDyn-C v2 rejects them too).
+        ("TypeName  Diam   Mass/m  EA     BA/-zeta  EI  Cd   Ca   CdAx  CaAx",
+         "Name Diam MassDen EA BA/-zeta Can Cat Cdn Cdt", "LINE TYPES", "Cd = Cdn"),
+        ("ID  Attachment  X       Y    Z      Mass  Volume  CdA  Ca",
+         "Node Type X Y Z M V FX FY FZ CdA CA", "POINTS", "without FX FY FZ"),
+        ("ID  LineType  AttachA  AttachB  UnstrLen  NumSegs  LineOutputs",
+         "Line LineType UnstrLen NumSegs NodeAnch NodeFair Outputs", "LINES",
+         "the ends before the length"),
+        ("TypeName  Diam   Mass/m  EA     BA/-zeta  EI  Cd   Ca   CdAx  CaAx",
+         "1 NTypes", "NTypes", "count line"),
     ],
 )
 def test_a_bad_file_names_the_file_line_and_field(tmp_path, old, new, field, words):

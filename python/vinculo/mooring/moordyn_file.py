@@ -343,6 +343,47 @@ def _split_sections(path: str, text: str) -> Iterator[tuple[str, _Line, list[_Li
     yield kind, header, body
 
 
+# MoorDyn v1's table layouts, told by their column names, and what v2's are instead (MoorDyn's
+# docs/inputs.rst, "The V1 Input File"; MoorDyn-C v2 does not read them either).
+_V1_LAYOUTS = {
+    "line_types": (lambda names: {"CAN", "CDN"} <= names and "EI" not in names,
+                   "LINE TYPES: Name Diam MassDen EA BA/-zeta Can Cat Cdn Cdt",
+                   "TypeName Diam Mass/m EA BA/-zeta EI Cd Ca CdAx CaAx (EI 0 for none, "
+                   "Cd = Cdn, Ca = Can, CdAx = Cdt, CaAx = Cat)"),
+    "points": (lambda names: "FX" in names,
+               "POINTS: Node Type X Y Z M V FX FY FZ CdA CA",
+               "ID Attachment X Y Z Mass Volume CdA Ca (without FX FY FZ; Connect is Free, "
+               "Vessel is Coupled)"),
+    "lines": (lambda names: "NODEANCH" in names or "NODEFAIR" in names,
+              "LINES: Line LineType UnstrLen NumSegs NodeAnch NodeFair",
+              "ID LineType AttachA AttachB UnstrLen NumSegs (the ends before the length)"),
+}
+
+
+# FAST 8's count lines at the top of its MoorDyn v1 tables.
+_V1_COUNTS = {"NTYPES", "NCONNECTS", "NLINES", "NPOINTS", "NNODES"}
+
+
+def _reject_v1_layout(path: str, kind: str, body: list[_Line]) -> None:
+    """A MooringFileError when the table's column names are MoorDyn v1's, whose columns lie in
+    another order (read as v2's, the numbers would go to the wrong fields)."""
+    lines = [ln for ln in body if ln.text.strip()]
+    if kind not in _V1_LAYOUTS or not lines:
+        return
+    first = lines[0].text.split()
+    if len(first) >= 2 and _is_number(first[0]) and first[1].upper() in _V1_COUNTS:
+        # FAST 8's MoorDyn v1: a count line before the column names.
+        raise _error(path, lines[0].number, first[1],
+                     f"MoorDyn v1's count line ({first[1]}, FAST 8's layout); vinculo reads "
+                     f"MoorDyn v2 files, as MoorDyn v2 does: remove it", lines[0].text.strip())
+    names = {word.upper() for word in first}
+    matches, v1, v2 = _V1_LAYOUTS[kind]
+    if matches(names):
+        raise _error(path, lines[0].number, v1.split(":")[0],
+                     f"MoorDyn v1's columns ({v1}); vinculo reads MoorDyn v2 files, as "
+                     f"MoorDyn v2 does: write the columns {v2}", lines[0].text.strip())
+
+
 def _table_rows(body: list[_Line]) -> list[tuple[_Line, list[str]]]:
     """The entries of a table section: after the column-name and unit lines, the non-blank
     lines split into fields."""
@@ -685,6 +726,7 @@ def parse_moordyn(text: str, path: str | Path = "<text>") -> MoorDynFile:
                          f"a second {header.text.strip('- ')} section (the first is on line "
                          f"{seen[kind]})", header.text)
         seen[kind] = header.number
+        _reject_v1_layout(name, kind, body)
         if kind in _UNSUPPORTED_SECTIONS:
             rows = _table_rows(body)
             if rows:
