@@ -85,3 +85,12 @@ def test_the_shape_of_a_vertical_line_is_drawn_on_a_readable_axis():
     # The axis spans a fifth of the line's height about it, not its round-off.
     assert high - low == pytest.approx(LEAST_WIDTH * np.ptp(nodes[:, 2]), rel=1e-12)
     assert low < reach.min() and reach.max() < high
+
+
+def test_the_command_lists_the_slack_segments(tmp_path, capsys):
+    from vinculo.cli import main
+
+    # The tether's spare length: its two lowest segments (the first test), and nothing else.
+    assert main(["mooring", "statics", str(FILE), "--output", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "spare length lying slack): line 1: 2\n" in out

@@ -104,6 +104,24 @@ class MooringStatics:
                          f"{e.laid_length:>10.4g}")
         return "\n".join(lines)
 
+    def slack_segments(self) -> dict[int, int]:
+        """The segments without tension, shorter than their length (a line's spare length,
+        which the statics lays slack as a run does: ``vinculo.mooring.statics``).
+
+        Returns:
+            The number of such segments of each line that has some, by line id.
+        """
+        positions = np.asarray(self.model.statics.positions, dtype=float)
+        slack = {}
+        for row, line in zip(self.model.file.lines, self.model.lines, strict=True):
+            tension = line.tensions(self.model.statics)[0]
+            chords = np.linalg.norm(np.diff(positions[line.nodes], axis=0), axis=1)
+            count = int(np.sum((tension == 0.0) & (chords < line.unstretched_length
+                                                   / len(line.segments))))
+            if count:
+                slack[row.id] = count
+        return slack
+
     def to_csv(self, path: str | Path) -> Path:
         """Write ``statics.csv``: the columns :data:`STATICS_COLUMNS`, two rows per line.
 

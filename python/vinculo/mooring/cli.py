@@ -142,6 +142,11 @@ def _statics(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     result = statics(model)
     print(f"{args.file}: {len(model.lines)} lines, {len(model.points)} points; static "
           f"equilibrium in {result.cpu_time:.3g} s", flush=True)
+    slack = result.slack_segments()
+    if slack:
+        listed = ", ".join(f"line {k}: {n}" for k, n in slack.items())
+        print(f"segments without tension, shorter than their length (spare length lying "
+              f"slack): {listed}", flush=True)
     print(result.table(), flush=True)
     path = result.to_csv(folder / "statics.csv")
     print(f"results: {path}", flush=True)
