@@ -33,7 +33,7 @@ import importlib
 import types
 from typing import Any
 
-from vinculo.mooring.analysis import MooringRun, MooringStatics, run
+from vinculo.mooring.analysis import MooringRun, MooringStatics, StepCheck, check_step, run
 from vinculo.mooring.analysis import statics as _statics
 from vinculo.mooring.catenary import (
     CatenarySolution,
@@ -99,9 +99,11 @@ __all__ = [
     "Motion",
     "Seafloor",
     "SlopeCatenarySolution",
+    "StepCheck",
     "StiffnessCurve",
     "WaveComponents",
     "build_model",
+    "check_step",
     "format_moordyn",
     "parse_moordyn",
     "read_current_profile",

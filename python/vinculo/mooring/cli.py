@@ -4,7 +4,7 @@ Usage::
 
     vinculo mooring statics FILE [--output DIR]
     vinculo mooring run FILE [--motion FILE.csv] --t-end T [--dt DT] [--output-every S]
-                        [--start statics|file]
+                        [--start statics|file] [--check-step]
                         [--output DIR] [--no-plots] [--no-progress]
 
 ``statics`` prints each line's end tensions and laid length and writes ``DIR/statics.csv``
@@ -13,7 +13,9 @@ end B; ``fx fy fz`` the force the line exerts on the end point). ``run`` starts 
 equilibrium, moves the Vessel/Coupled points by the motion file (``time``, then ``x, y, z`` of
 each coupled point in file order) and writes ``DIR/tensions.csv``, ``DIR/run.nc``, the plots
 ``DIR/shapes.png`` and ``DIR/tensions.png``, and, when the file has an OUTPUTS section,
-``DIR/channels.csv`` (its channels over time, :mod:`vinculo.mooring.channels`).
+``DIR/channels.csv`` (its channels over time, :mod:`vinculo.mooring.channels`); with
+``--check-step`` it runs again at half the step and prints how much the end tensions change, an
+estimate of the run's time-step error (:func:`vinculo.mooring.analysis.check_step`).
 """
 
 from __future__ import annotations
@@ -117,6 +119,9 @@ def add_mooring_parser(commands: Any) -> None:
                      help="the initial state: the static equilibrium (default), or the file's "
                      "point positions and the lines' initial shapes at rest (MoorDyn with "
                      "TmaxIC 0)")
+    run.add_argument("--check-step", action="store_true",
+                     help="run again at half the step and print how much the end tensions "
+                     "change: an estimate of the run's time-step error (twice the CPU time)")
     run.add_argument("--no-plots", action="store_true", help="do not draw the plots")
     run.add_argument("--no-progress", action="store_true", help="do not draw a progress bar")
     run.set_defaults(handler=_run)
@@ -175,6 +180,11 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
         print(f"line {row.id}: end B tension {tensions[:, k, 1].min():.6g} to "
               f"{tensions[:, k, 1].max():.6g} N, end A {tensions[:, k, 0].min():.6g} to "
               f"{tensions[:, k, 0].max():.6g} N", flush=True)
+    if args.check_step:
+        from vinculo.mooring.analysis import check_step
+
+        check = check_step(result, model, motion, start=args.start)
+        print(check.summary(), flush=True)
     print(f"results: {', '.join(str(p) for p in result.files.values())}", file=sys.stdout,
           flush=True)
     return 0
