@@ -20,7 +20,7 @@ def test_the_change_when_the_step_halves_is_about_the_error(case, dt):
     model = bench.CASES[case](20)
     motion = bench.motion_for(model)
     result = run(model, motion, 20.0, dt=dt, plots=False)
-    check = check_step(result, model, motion)
+    check = check_step(result)
     reference = run(model, motion, 20.0, dt=dt / 16, plots=False, t_eval=result.times)
     error = np.abs(result.end_tensions - reference.end_tensions).max()
     # Measured: 1.04 (hanging chain) and 1.35 (chain on the seabed, with its touchdowns).

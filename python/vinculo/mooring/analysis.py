@@ -404,8 +404,7 @@ class StepCheck:
                 f"(a smaller --dt makes it smaller)")
 
 
-def check_step(result: MooringRun, path: str | Path | MoorDynFile,
-               motion: Motion | str | Path | None, **options: Any) -> StepCheck:
+def check_step(result: MooringRun, **options: Any) -> StepCheck:
     """Run the same mooring again at half the step of ``result``, stored at its times, and
     compare the end tensions: the change estimates the time-step error of ``result``.
 
@@ -421,17 +420,15 @@ def check_step(result: MooringRun, path: str | Path | MoorDynFile,
     20.3 %: the snaps' peaks come a little early or late) and 1.16 at 0.01 s (3.8 %, 4.4 %).
 
     Arguments:
-        result: the run to check (:func:`run`).
-        path: its MoorDyn file (or content).
-        motion: its motion.
+        result: the run to check (:func:`run`): its file and motion are run again.
         **options: its other options of :func:`run` (``start``, run options; not ``dt``,
             ``output``).
 
     Returns:
         The check.
     """
-    half = run(path, motion, float(result.times[-1]), dt=result.dt / 2.0, plots=False,
-               t_eval=result.times, **options)
+    half = run(result.model.file, result.model.motion, float(result.times[-1]),
+               dt=result.dt / 2.0, plots=False, t_eval=result.times, **options)
     before, after = result.end_tensions, half.end_tensions
     if before.shape != after.shape:
         raise InvalidInputError(

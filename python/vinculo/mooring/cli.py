@@ -183,7 +183,7 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     if args.check_step:
         from vinculo.mooring.analysis import check_step
 
-        check = check_step(result, model, motion, start=args.start)
+        check = check_step(result, start=args.start)
         print(check.summary(), flush=True)
     print(f"results: {', '.join(str(p) for p in result.files.values())}", file=sys.stdout,
           flush=True)
