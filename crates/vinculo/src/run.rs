@@ -1226,6 +1226,10 @@ impl Simulation<'_> {
         // Whether this attempt is full Newton's, after the attempts that reuse a matrix failed
         // (module documentation).
         let mut full_retry = false;
+        let full_newton = NewtonOptions {
+            jacobian_reuse: JacobianReuse::Never,
+            ..self.newton
+        };
         loop {
             // Predictor: the rule's own step end with the accelerations extrapolated linearly
             // (a fixed step of the last step's size), else constant-acceleration extrapolation;
@@ -1290,11 +1294,11 @@ impl Simulation<'_> {
             }
             let start = StepStart::new(c.t, &c.q, &c.v, h_try);
             let stabilized = self.stabilized.as_mut();
-            let full = NewtonOptions {
-                jacobian_reuse: JacobianReuse::Never,
-                ..self.newton
+            let newton = if full_retry {
+                &full_newton
+            } else {
+                &self.newton
             };
-            let newton = if full_retry { &full } else { &self.newton };
             let attempt = scheme.step(system, ws, stabilized, start, &mut c.rule, newton);
             self.sol.factorisations = ws.matrix.factorisations;
             self.sol.residual_evaluations = ws.matrix.residuals;

@@ -291,16 +291,15 @@ pub fn solve_statics(system: &System, options: &StaticsOptions) -> Result<Static
         Err(NewtonFailure::Singular(_)) => used += 1,
     }
     let budget = options.max_iterations.saturating_sub(used);
-    if let Ok(report) = continuation::<false>(system, &mut ws, (t, start), &newton, budget) {
-        let mut report = report;
-        report.iterations += used;
-        return Ok(finish(&ws, report, StaticsMethod::Continuation, t));
+    match continuation::<false>(system, &mut ws, (t, start), &newton, budget) {
+        Ok(mut report) => {
+            report.iterations += used;
+            return Ok(finish(&ws, report, StaticsMethod::Continuation, t));
+        }
+        Err(spent) => used += spent,
     }
-    used = options.max_iterations;
-    let budget = options.max_iterations;
-    match continuation::<true>(system, &mut ws, (t, start), &newton, budget) {
-        Ok(report) => {
-            let mut report = report;
+    match continuation::<true>(system, &mut ws, (t, start), &newton, options.max_iterations) {
+        Ok(mut report) => {
             report.iterations += used;
             Ok(finish(&ws, report, StaticsMethod::SlackContinuation, t))
         }
