@@ -227,12 +227,9 @@ fn static_residual<const S: bool>(
     with_static_problem::<_, S>(system, ws, (t, 0.0, previous), |mut problem, _| {
         problem.residual(&mut r)
     });
-    let worst = r.iter().fold(
-        0.0f64,
-        |m, x| if x.is_nan() { f64::NAN } else { m.max(x.abs()) },
-    );
+    let largest = newton::inf_norm(&r);
     ws.r = r;
-    worst
+    largest
 }
 
 /// The static equilibrium of `system` at time `options.t`, from its initial positions
@@ -306,14 +303,7 @@ pub fn solve_statics(system: &System, options: &StaticsOptions) -> Result<Static
         Err(iterations) => {
             let previous = ws.state.q.clone();
             let residual = static_residual::<true>(system, &mut ws, t, &previous);
-            let worst =
-                ws.r.iter()
-                    .enumerate()
-                    .fold(
-                        (0.0f64, 0),
-                        |(m, k), (i, x)| if x.abs() > m { (x.abs(), i) } else { (m, k) },
-                    )
-                    .1;
+            let worst = newton::worst_entry(&ws.r);
             Err(Error::NewtonFailed {
                 t,
                 dt: 0.0,

@@ -330,7 +330,7 @@ const PARALLEL_NORM_FROM: usize = 1 << 20;
 
 /// The infinity norm of `x`, NaN if any entry is NaN: chunks on rayon's pool for long vectors
 /// (the same number: the largest entry does not depend on the order).
-fn inf_norm(x: &[f64]) -> f64 {
+pub(crate) fn inf_norm(x: &[f64]) -> f64 {
     if x.len() < PARALLEL_NORM_FROM {
         return inf_norm_serial(x);
     }
@@ -384,7 +384,7 @@ fn inf_norm_serial(x: &[f64]) -> f64 {
 }
 
 /// The index of the entry of `x` of largest magnitude (the first NaN, if any).
-fn worst_entry(x: &[f64]) -> usize {
+pub(crate) fn worst_entry(x: &[f64]) -> usize {
     let mut m = 0.0;
     let mut k = 0;
     for (i, v) in x.iter().enumerate() {
