@@ -13,11 +13,13 @@ For each case and number of segments, both codes run the same MoorDyn file:
   saved once: :func:`vinculo.mooring.peer.moordyn_initial_state`): the range of its stable
   steps (no blow-up) by bisection on ``dtM`` from the axial-wave estimate ``l / sqrt(EA / m)``
   of a segment of length ``l``, a reference run at an eighth of it, its largest stable step
-  by bisection (tensions within 5 % of the reference), and a run at 0.9 of that step, whose
-  end-tension error against the reference is MoorDyn's accuracy. These runs call MoorDyn's
-  Step at every step, so that the fairlead follows the motion exactly (as vinculo's does).
-  MoorDyn's CPU time is that of the same steps with a call every 0.01 s, without the Python
-  call at each step;
+  by bisection (tensions within 5 % of the reference), and a run at 0.9 of that step (the
+  largest step at most that which divides the output interval, so that every output time
+  ends a step), whose end-tension error against the reference is MoorDyn's accuracy. These
+  runs call MoorDyn's Step at every step, so that the fairlead follows the motion as closely
+  as MoorDyn's coupling allows (a coupled point moves at a constant velocity through a step:
+  here the chord of the motion over it). MoorDyn's CPU time is that of the same steps with a
+  call every output interval, without the Python call at each step;
 - vinculo (implicit): a reference run at a small step, then the largest step of a list whose
   end-tension error against that reference is within MoorDyn's accuracy (or 0.1 % of the peak
   tension, whichever is larger): equal accuracy in end tension.
@@ -48,7 +50,8 @@ import dataclasses
 import math
 import sys
 import tempfile
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -64,7 +67,7 @@ from vinculo.mooring.moordyn_file import (
     MoorDynFile,
 )
 from vinculo.mooring.motion import Motion
-from vinculo.mooring.peer import PeerRun
+from vinculo.mooring.peer import PeerError, PeerRun
 
 if TYPE_CHECKING:
     from vinculo.mooring.analysis import MooringRun
@@ -218,11 +221,123 @@ def _relative(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.nanmax(np.abs(a - b)) / scale) if scale > 0 else math.inf
 
 
+def _relative_by_end(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
+    """:func:`_relative` of end-segment tensions ``(times, lines, 2)`` at ends A and B apart
+    (the largest over the lines), both relative to the peak of ``b`` over both ends."""
+    if a.shape != b.shape:
+        return math.inf, math.inf
+    scale = float(np.nanmax(np.abs(b)))
+    if not scale > 0:
+        return math.inf, math.inf
+    ends = np.nanmax(np.abs(a - b), axis=(0, 1)) / scale
+    return float(ends[0]), float(ends[1])
+
+
 def _on(times: np.ndarray, values: np.ndarray, grid: np.ndarray) -> np.ndarray:
     """``values`` (times, ...) interpolated onto ``grid``."""
     flat = values.reshape(values.shape[0], -1)
     out = np.column_stack([np.interp(grid, times, flat[:, k]) for k in range(flat.shape[1])])
     return out.reshape((grid.size, *values.shape[1:]))
+
+
+@dataclass(frozen=True)
+class MoorDynRun:
+    """MoorDyn at one step on one case (:meth:`MoorDynSession.measure`).
+
+    Arguments:
+        step: the step MoorDyn took (s): the largest at most the one asked that divides the
+            output interval (:func:`vinculo.mooring.peer.run_moordyn`).
+        cpu_time: the least CPU time of :data:`REPEATS` timed runs (s).
+        error: the largest end-tension difference from the reference, relative to the peak
+            reference tension (the force on the end points, as the benchmark's table).
+        segment_errors: the same of the end-segment tensions at ends A and B apart.
+    """
+
+    step: float
+    cpu_time: float
+    error: float
+    segment_errors: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class MoorDynSession:
+    """MoorDyn set up on one case (:func:`moordyn_session`).
+
+    Arguments:
+        run: ``run(step, exact)``: a run from the saved initial state at the step, MoorDyn
+            called at each of its steps (``exact``, the fairlead following the motion exactly)
+            or once an output interval with the same steps (the timed runs: no Python call at
+            each step).
+        stable_step: MoorDyn's largest stable step (s).
+        reference: the small-step reference run.
+    """
+
+    run: Callable[[float, bool], PeerRun]
+    stable_step: float
+    reference: PeerRun
+
+    def measure(self, step: float) -> MoorDynRun:
+        """MoorDyn's accuracy and CPU time at ``step`` (the timed runs take the steps of the
+        accuracy run, called once an output interval: the Python call at each step, about
+        5 us, would otherwise count against MoorDyn, half its time at 20 segments)."""
+        exact = self.run(step, True)
+        if exact.error is not None:
+            raise PeerError(f"MoorDyn at {step:.3g} s steps: {exact.error}")
+        timed = [self.run(step, False) for _ in range(REPEATS)]
+        failed = [r.error for r in timed if r.error is not None]
+        if failed:
+            raise PeerError(f"MoorDyn's timed run at {step:.3g} s steps: {failed[0]}")
+        return MoorDynRun(
+            step=exact.time_step, cpu_time=min(r.cpu_time for r in timed),
+            error=_relative(exact.end_tensions, self.reference.end_tensions),
+            segment_errors=_relative_by_end(exact.segment_tensions,
+                                            self.reference.segment_tensions))
+
+
+@contextmanager
+def moordyn_session(model: MoorDynFile, motion: Motion, t_end: float, dt_output: float,
+                    reference_share: float = 1 / 8) -> Iterator[MoorDynSession]:
+    """MoorDyn set up on one case: its initial state, its largest stable step and a reference.
+
+    MoorDyn's initial condition is solved once (a dynamic relaxation at half the axial-wave
+    step, minutes at 1,000 segments) and starts every run; the stable range is found without a
+    reference (no blow-up), the reference is run at ``reference_share`` of it, and the largest
+    stable step is the largest that keeps the end tensions within 5 % of the reference's.
+
+    Arguments:
+        model: the case.
+        motion: the fairlead motion.
+        t_end: the simulated time (s).
+        dt_output: the output interval (s).
+        reference_share: the reference's step as a share of the no-blow-up step.
+
+    Yields:
+        The session, valid inside the ``with`` block (the initial state lives in a temporary
+        folder).
+    """
+    from vinculo.mooring.peer import largest_stable_step, moordyn_initial_state, run_moordyn
+
+    estimate = wave_step(model)
+    with tempfile.TemporaryDirectory(prefix="vinculo-bench-") as folder:
+        state = moordyn_initial_state(model, motion, Path(folder) / "initial.state",
+                                      time_step=estimate / 2)
+
+        def moordyn(step: float, exact: bool) -> PeerRun:
+            return run_moordyn(model, motion, t_end, dt_output=dt_output, time_step=step,
+                               coupling_step=step if exact else dt_output,
+                               initial_state=state)
+
+        rough, _ = largest_stable_step(model, motion, t_end, low=estimate / 2, high=estimate,
+                                       ratio=1.5, dt_output=dt_output, initial_state=state)
+        # The accuracy runs call MoorDyn at each of its steps, so that the fairlead follows the
+        # motion as closely as MoorDyn's coupling allows: at the chord velocity through each
+        # step (peer.run_moordyn: a call every 0.01 s moves it at one velocity through several
+        # steps, whose jumps change the tensions by about 1 %).
+        reference = moordyn(rough * reference_share, exact=True)
+        stable, _ = largest_stable_step(model, motion, t_end, reference, low=rough / 2,
+                                        high=rough * 1.5, dt_output=dt_output,
+                                        exact_motion=True, initial_state=state)
+        yield MoorDynSession(run=moordyn, stable_step=stable, reference=reference)
 
 
 def bench_moordyn(model: MoorDynFile, motion: Motion, t_end: float,
@@ -238,39 +353,13 @@ def bench_moordyn(model: MoorDynFile, motion: Motion, t_end: float,
     Returns:
         ``(row, times, reference end tensions)``.
     """
-    from vinculo.mooring.peer import largest_stable_step, moordyn_initial_state, run_moordyn
-
     dt_output = OUTPUT_INTERVAL if dt_output is None else dt_output
-    estimate = wave_step(model)
-    with tempfile.TemporaryDirectory(prefix="vinculo-bench-") as folder:
-        # MoorDyn's initial condition once (a dynamic relaxation at half the axial-wave step,
-        # minutes at 1,000 segments), the start of every run below.
-        state = moordyn_initial_state(model, motion, Path(folder) / "initial.state",
-                                      time_step=estimate / 2)
-
-        def moordyn(step: float, exact: bool) -> PeerRun:
-            return run_moordyn(model, motion, t_end, dt_output=dt_output, time_step=step,
-                               coupling_step=step if exact else None, initial_state=state)
-
-        # The stable range without a reference (no blow-up), then the reference at an eighth
-        # of it, then the largest step that keeps the tensions within 5 % of the reference.
-        rough, _ = largest_stable_step(model, motion, t_end, low=estimate / 2, high=estimate,
-                                       ratio=1.5, dt_output=dt_output, initial_state=state)
-        # The accuracy runs call MoorDyn at each of its steps, so that the fairlead follows the
-        # motion exactly as vinculo's does (peer.run_moordyn: a call every 0.01 s moves it at a
-        # piecewise-constant velocity, whose jumps change the tensions by about 1 %).
-        reference = moordyn(rough / 8, exact=True)
-        stable, _ = largest_stable_step(model, motion, t_end, reference, low=rough / 2,
-                                        high=rough * 1.5, dt_output=dt_output,
-                                        exact_motion=True, initial_state=state)
-        step = 0.9 * stable
-        error = _relative(moordyn(step, exact=True).end_tensions, reference.end_tensions)
-        # The CPU time of the same steps with a call every 0.01 s: the Python call at each
-        # step (about 5 us) would otherwise count against MoorDyn (half its time at 20
-        # segments).
-        cpu = min(moordyn(step, exact=False).cpu_time for _ in range(REPEATS))
-    row = BenchRow(case="", segments=model.lines[0].segments, code="moordyn", step=step,
-                   cpu_time=cpu, t_end=t_end, error=error, stable_step=stable)
+    with moordyn_session(model, motion, t_end, dt_output) as session:
+        measured = session.measure(0.9 * session.stable_step)
+        reference = session.reference
+    row = BenchRow(case="", segments=model.lines[0].segments, code="moordyn",
+                   step=measured.step, cpu_time=measured.cpu_time, t_end=t_end,
+                   error=measured.error, stable_step=session.stable_step)
     return row, reference.times, reference.segment_tensions
 
 
@@ -321,6 +410,20 @@ def vinculo_run(model: MoorDynFile, motion: Motion, t_end: float, dt: float,
     return run(model, motion, t_end, dt=dt, plots=False, t_eval=grid)
 
 
+def vinculo_tensions(model: MoorDynFile, motion: Motion, t_end: float, dt: float,
+                     grid: np.ndarray, repeats: int = 1) -> tuple[np.ndarray, float]:
+    """vinculo's end-segment tensions on one case at the step ``dt``, interpolated onto
+    ``grid``, and the least CPU time of ``repeats`` runs (s).
+
+    Raises:
+        ConvergenceError: when the step is too large for Newton to converge.
+    """
+    result = vinculo_run(model, motion, t_end, dt)
+    cpu = min([result.cpu_time] + [vinculo_run(model, motion, t_end, dt).cpu_time
+                                   for _ in range(repeats - 1)])
+    return _on(result.times, result.segment_tensions, grid), cpu
+
+
 def bench_vinculo(model: MoorDynFile, motion: Motion, t_end: float, target: float,
                   grid: np.ndarray, steps: Sequence[float] = STEPS,
                   ) -> tuple[BenchRow, np.ndarray]:
@@ -338,10 +441,7 @@ def bench_vinculo(model: MoorDynFile, motion: Motion, t_end: float, target: floa
         ``(row, end-segment tensions on the grid at the chosen step)``.
     """
     def tensions(dt: float, repeats: int = 1) -> tuple[np.ndarray, float]:
-        result = vinculo_run(model, motion, t_end, dt)
-        cpu = min([result.cpu_time] + [vinculo_run(model, motion, t_end, dt).cpu_time
-                                       for _ in range(repeats - 1)])
-        return _on(result.times, result.segment_tensions, grid), cpu
+        return vinculo_tensions(model, motion, t_end, dt, grid, repeats)
 
     reference, _ = tensions(min(steps) / 4)
     chosen = None
@@ -534,6 +634,9 @@ def main(argv: Sequence[str] | None = None) -> int:
                         help="instead: the CPU time of one step of each code on each case, "
                         "vinculo's at the step DT (s), or at MoorDyn's step with "
                         "'--per-step moordyn'")
+    parser.add_argument("--work-precision", action="store_true",
+                        help="instead: CPU time against end-tension error of both codes over "
+                        "a range of steps on each case (vinculo.mooring.work_precision)")
     parser.add_argument("--output", "-o", type=Path, default=Path("output") / "mooring-bench")
     args = parser.parse_args(argv)
     per_step_dt = None
@@ -546,25 +649,31 @@ def main(argv: Sequence[str] | None = None) -> int:
             parser.error(f"--per-step {args.per_step!r}: give a step > 0 s or 'moordyn'")
     args.output.mkdir(parents=True, exist_ok=True)
     segment_list = [int(s) for s in args.segments.split(",") if s.strip()]
+    cases = [c.strip() for c in args.cases.split(",") if c.strip()]
+    unknown = [c for c in cases if c not in CASES]
+    if unknown:
+        parser.error(f"--cases: {', '.join(map(repr, unknown))} not among {', '.join(CASES)}")
     if args.scaling is not None:
         print("| case | segments | step (s) | vinculo real-time factor |\n"
               "| --- | ---: | ---: | ---: |")
-        for name in [c.strip() for c in args.cases.split(",") if c.strip()]:
+        for name in cases:
             for n, factor in scaling(name, segment_list, args.scaling, args.t_end):
                 print(f"| {name} | {n} | {args.scaling:g} | {factor:.3g} |", flush=True)
         return 0
+    if args.work_precision:
+        return _work_precision_main(cases, segment_list, args.t_end, args.output)
     if args.per_step is not None:
         print("| case | segments | MoorDyn step (s) | MoorDyn (us a step) | vinculo step (s) | "
               "vinculo (us a step) | vinculo / MoorDyn |\n"
               "| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
-        for name in [c.strip() for c in args.cases.split(",") if c.strip()]:
+        for name in cases:
             for n in segment_list:
                 step, moordyn, dt, vinculo = per_step(name, n, per_step_dt, args.t_end)
                 print(f"| {name} | {n} | {step:.3g} | {1e6 * moordyn:.1f} | {dt:.3g} | "
                       f"{1e6 * vinculo:.1f} | {vinculo / moordyn:.2f} |", flush=True)
         return 0
     rows: list[BenchRow] = []
-    for name in [c.strip() for c in args.cases.split(",") if c.strip()]:
+    for name in cases:
         for segments in segment_list:
             new = bench_case(name, segments, args.t_end, with_vinculo=not args.moordyn_only)
             rows += new
@@ -575,6 +684,29 @@ def main(argv: Sequence[str] | None = None) -> int:
     write_rows(rows, args.output / "bench.csv")
     (args.output / "bench.md").write_text(table(rows) + "\n", encoding="utf-8")
     print(table(rows))
+    return 0
+
+
+def _work_precision_main(cases: Sequence[str], segments: Sequence[int], t_end: float,
+                         output: Path) -> int:
+    """``--work-precision``: the points, case by case, then the table, CSV and plot."""
+    from vinculo.mooring import work_precision as wp
+
+    points: list[wp.WorkPoint] = []
+    for name in cases:
+        for n in segments:
+            new = wp.work_precision(name, n, t_end)
+            points += new
+            for p in new:
+                print(f"{p.case:8s} N={p.segments:<5d} {p.code:8s} step {p.step:.3g} s "
+                      f"CPU {p.cpu_time:.3g} s error {p.error:.1e} (anchor {p.error_end_a:.1e}, "
+                      f"fairlead {p.error_end_b:.1e})", flush=True)
+            # Written after each case, so that an interrupted run keeps the cases done.
+            wp.write_points(points, output / "work-precision.csv")
+    (output / "work-precision.md").write_text(wp.table(points) + "\n", encoding="utf-8")
+    image = wp.plot(points, output / "work-precision.png")
+    print(wp.table(points))
+    print(f"wrote {output / 'work-precision.csv'}, {output / 'work-precision.md'}, {image}")
     return 0
 
 

@@ -146,6 +146,22 @@ class PeerRun:
         return np.linalg.norm(self.end_forces, axis=-1)
 
 
+#: How much larger than the step MoorDyn is asked to take its file's dtM is written: MoorDyn's
+#: Step takes steps of dtM until less than dtM of the call is left, then one step of the rest,
+#: so a call of k steps computed in floating point could end with a step of 1e-19 s, or one of
+#: a millionth of dtM where the call is a hair longer than k dtM. With dtM a billionth larger,
+#: a call of k steps takes k steps, the last shorter by k billionths of a step.
+_STEP_MARGIN = 1e-9
+
+
+def _dividing_step(time_step: float, dt_output: float) -> tuple[float, int]:
+    """The largest step at most ``time_step`` that divides ``dt_output``, and how many of it
+    make ``dt_output``: every output time is then the end of a MoorDyn step, and a call of
+    whole steps takes exactly those steps (:data:`_STEP_MARGIN`)."""
+    steps = max(1, math.ceil(dt_output / time_step - 1e-9))
+    return dt_output / steps, steps
+
+
 def _model_and_file(source: str | Path | MoorDynFile, folder: Path,
                     time_step: float | None) -> tuple[MoorDynFile, Path]:
     """The model, and a copy of its file in ``folder`` (with ``dtM`` replaced if asked)."""
@@ -198,7 +214,11 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
             chain, calls every 0.01 s change the fairlead tension by 0.9 % of its peak
             (1.7 % with the motion's velocity at the call's start), calls at every step (the
             coupling step equal to ``time_step``) follow the motion exactly.
-        time_step: MoorDyn's time step dtM (s; default: the file's).
+        time_step: MoorDyn's time step dtM (s; default: the file's); the run takes the
+            largest step at most this that divides ``dt_output`` (``PeerRun.time_step``), so
+            that every output time ends a step, and calls MoorDyn with whole numbers of steps
+            (a call at every step when ``coupling_step`` is the step asked), which it then takes
+            exactly.
         store_shapes: also store every line's node positions at each output time.
         initial_state: a state file of :func:`moordyn_initial_state` for the same file and
             motion to start from (None: MoorDyn's own initial-condition solve).
@@ -215,12 +235,30 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
     if not (math.isfinite(t_end) and t_end > 0.0 and dt_output > 0.0):
         raise InvalidInputError(f"run_moordyn: t_end = {t_end!r} and dt_output = {dt_output!r} "
                                 f"must be positive", name="t_end", value=t_end)
+    steps_per_output = None
+    if time_step is not None:
+        if not (math.isfinite(time_step) and time_step > 0.0):
+            raise InvalidInputError(f"run_moordyn: time_step = {time_step!r}: give a step > 0 s",
+                                    name="time_step", value=time_step)
+        time_step, steps_per_output = _dividing_step(float(time_step), dt_output)
     with tempfile.TemporaryDirectory(prefix="vinculo-moordyn-") as folder:
-        model, path = _model_and_file(source, Path(folder), time_step)
-        dtm = model.options.time_step if model.options.time_step is not None else 1e-3
-        coupling = float(coupling_step or min(dt_output, max(COUPLING_STEP, dtm)))
-        per_output = max(1, round(dt_output / coupling))
-        coupling = dt_output / per_output
+        model, path = _model_and_file(
+            source, Path(folder),
+            None if time_step is None else time_step * (1.0 + _STEP_MARGIN))
+        if steps_per_output is None:
+            dtm = model.options.time_step if model.options.time_step is not None else 1e-3
+            coupling = float(coupling_step or min(dt_output, max(COUPLING_STEP, dtm)))
+            per_output = max(1, round(dt_output / coupling))
+            coupling = dt_output / per_output
+            steps_per_call = math.ceil(coupling / dtm - 1e-9)
+        else:
+            dtm = time_step
+            wanted = float(coupling_step or min(dt_output, max(COUPLING_STEP, dtm)))
+            steps_per_call = max(k for k in range(1, steps_per_output + 1)
+                                 if steps_per_output % k == 0
+                                 and k * dtm <= wanted * (1.0 + 1e-9))
+            per_output = steps_per_output // steps_per_call
+            coupling = dt_output / per_output
         coupled = model.coupled_points()
         if motion is None:
             motion = Motion.still([p.position for p in coupled])
@@ -297,7 +335,7 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
                         break
             finally:
                 md.Close(system)
-    steps = (times.size - 1) * per_output * math.ceil(coupling / dtm - 1e-9)
+    steps = (times.size - 1) * per_output * steps_per_call
     return PeerRun(times=times, end_forces=forces, segment_tensions=segment,
                    node_positions=shapes, time_step=dtm,
                    coupling_step=coupling, cpu_time=cpu, initial_cpu_time=initial_cpu,
@@ -354,7 +392,9 @@ def moordyn_initial_state(source: str | Path | MoorDynFile, motion: Motion | Non
             None: the file's positions, at rest).
         path: the state file to write.
         time_step: MoorDyn's time step dtM for the solve (s; default: the file's); its
-            dynamic relaxation needs a stable one.
+            dynamic relaxation needs a stable one. Written as :func:`run_moordyn` writes a
+            step that divides its output interval (:data:`_STEP_MARGIN`), so that a run at
+            such a step from its own solve and one from this state are the same.
 
     Returns:
         ``path``. The end forces at t = 0 go beside it, into ``<path>.forces.npz`` (MoorDyn
@@ -366,7 +406,9 @@ def moordyn_initial_state(source: str | Path | MoorDynFile, motion: Motion | Non
     md = _moordyn()
     path = Path(path).resolve()
     with tempfile.TemporaryDirectory(prefix="vinculo-moordyn-") as folder:
-        model, file = _model_and_file(source, Path(folder), time_step)
+        model, file = _model_and_file(
+            source, Path(folder),
+            None if time_step is None else time_step * (1.0 + _STEP_MARGIN))
         coupled = model.coupled_points()
         if motion is None:
             motion = Motion.still([p.position for p in coupled])
