@@ -85,3 +85,14 @@ def test_bad_arguments():
         wp.work_precision("sea", 20, 10.0)
     with pytest.raises(ValueError, match="segments 0"):
         wp.work_precision("hanging", 0, 10.0)
+
+
+def test_the_front_is_the_points_no_other_beats_in_both_cpu_and_error():
+    # Reference: the definition (a point is on the front when no other point is both cheaper
+    # and more accurate), on points made for the test.
+    def point(cpu, error):
+        return wp.WorkPoint("chain", 20, "vinculo", 0.01, cpu, error, error, error)
+
+    a, b, c, d = point(1.0, 1e-6), point(0.5, 1e-4), point(0.6, 1e-3), point(0.1, 1e-2)
+    # c costs more than b and is less accurate: beaten.
+    assert wp.pareto_front([c, d, a, b]) == [a, b, d]

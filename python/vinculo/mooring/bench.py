@@ -13,13 +13,12 @@ For each case and number of segments, both codes run the same MoorDyn file:
   saved once: :func:`vinculo.mooring.peer.moordyn_initial_state`): the range of its stable
   steps (no blow-up) by bisection on ``dtM`` from the axial-wave estimate ``l / sqrt(EA / m)``
   of a segment of length ``l``, a reference run at an eighth of it, its largest stable step
-  by bisection (tensions within 5 % of the reference), and a run at 0.9 of that step (the
-  largest step at most that which divides the output interval, so that every output time
-  ends a step), whose end-tension error against the reference is MoorDyn's accuracy. These
-  runs call MoorDyn's Step at every step, so that the fairlead follows the motion as closely
-  as MoorDyn's coupling allows (a coupled point moves at a constant velocity through a step:
-  here the chord of the motion over it). MoorDyn's CPU time is that of the same steps with a
-  call every output interval, without the Python call at each step;
+  by bisection (tensions within 5 % of the reference), and a run at 0.9 of that step (made
+  to divide 0.01 s: :func:`call_step`), whose end-tension error against the reference is
+  MoorDyn's accuracy. These runs call MoorDyn's Step at every step, so that the fairlead
+  follows the motion as closely as MoorDyn's coupling allows (a coupled point moves at a
+  constant velocity through a step: here the chord of the motion over it). MoorDyn's CPU time
+  is that of the same steps with a call every 0.01 s, without the Python call at each step;
 - vinculo (implicit): a reference run at a small step, then the largest step of a list whose
   end-tension error against that reference is within MoorDyn's accuracy (or 0.1 % of the peak
   tension, whichever is larger): equal accuracy in end tension.
@@ -67,7 +66,7 @@ from vinculo.mooring.moordyn_file import (
     MoorDynFile,
 )
 from vinculo.mooring.motion import Motion
-from vinculo.mooring.peer import PeerError, PeerRun
+from vinculo.mooring.peer import COUPLING_STEP, PeerError, PeerRun
 
 if TYPE_CHECKING:
     from vinculo.mooring.analysis import MooringRun
@@ -240,6 +239,19 @@ def _on(times: np.ndarray, values: np.ndarray, grid: np.ndarray) -> np.ndarray:
     return out.reshape((grid.size, *values.shape[1:]))
 
 
+def call_step(step: float) -> float:
+    """The step MoorDyn takes in the benchmark for the step ``step`` asked: the largest at most
+    ``step`` that divides :data:`vinculo.mooring.peer.COUPLING_STEP` (0.01 s; ``step`` itself
+    when longer), so that its timed runs, called every 0.01 s, take the very steps of its
+    accuracy runs, called at every step. The step is smaller than asked by less than one part
+    in the number of steps in 0.01 s (0.9 of MoorDyn's largest stable step on the chain on the
+    seabed at 20 segments, 5.26 ms, becomes 5.0 ms; on the hanging chain at 100 segments,
+    0.398 ms becomes 0.385 ms)."""
+    if step >= COUPLING_STEP:
+        return step
+    return COUPLING_STEP / math.ceil(COUPLING_STEP / step - 1e-9)
+
+
 @dataclass(frozen=True)
 class MoorDynRun:
     """MoorDyn at one step on one case (:meth:`MoorDynSession.measure`).
@@ -264,10 +276,10 @@ class MoorDynSession:
     """MoorDyn set up on one case (:func:`moordyn_session`).
 
     Arguments:
-        run: ``run(step, exact)``: a run from the saved initial state at the step, MoorDyn
-            called at each of its steps (``exact``, the fairlead following the motion exactly)
-            or once an output interval with the same steps (the timed runs: no Python call at
-            each step).
+        run: ``run(step, exact)``: a run from the saved initial state at the step
+            (:func:`call_step`), MoorDyn called at each of its steps (``exact``, the fairlead
+            following the motion as closely as MoorDyn's coupling allows) or every 0.01 s with
+            the same steps (the timed runs: no Python call at each step).
         stable_step: MoorDyn's largest stable step (s).
         reference: the small-step reference run.
     """
@@ -277,9 +289,9 @@ class MoorDynSession:
     reference: PeerRun
 
     def measure(self, step: float) -> MoorDynRun:
-        """MoorDyn's accuracy and CPU time at ``step`` (the timed runs take the steps of the
-        accuracy run, called once an output interval: the Python call at each step, about
-        5 us, would otherwise count against MoorDyn, half its time at 20 segments)."""
+        """MoorDyn's accuracy and CPU time at ``step`` (:func:`call_step`; the timed runs take
+        the steps of the accuracy run, called every 0.01 s: a call at each step would count
+        the call's own cost against MoorDyn's steps)."""
         exact = self.run(step, True)
         if exact.error is not None:
             raise PeerError(f"MoorDyn at {step:.3g} s steps: {exact.error}")
@@ -323,8 +335,9 @@ def moordyn_session(model: MoorDynFile, motion: Motion, t_end: float, dt_output:
                                       time_step=estimate / 2)
 
         def moordyn(step: float, exact: bool) -> PeerRun:
+            step = call_step(step)
             return run_moordyn(model, motion, t_end, dt_output=dt_output, time_step=step,
-                               coupling_step=step if exact else dt_output,
+                               coupling_step=step if exact else max(step, COUPLING_STEP),
                                initial_state=state)
 
         rough, _ = largest_stable_step(model, motion, t_end, low=estimate / 2, high=estimate,
@@ -600,13 +613,18 @@ def per_step(name: str, segments: int, dt: float | None, t_end: float
     with tempfile.TemporaryDirectory(prefix="vinculo-bench-") as folder:
         state = moordyn_initial_state(model, motion, Path(folder) / "initial.state",
                                       time_step=step)
-        moordyn = min(run_moordyn(model, motion, t_end, dt_output=OUTPUT_INTERVAL, time_step=step,
-                                  coupling_step=None, initial_state=state).cpu_time
-                      for _ in range(REPEATS))
+        # Called every 0.01 s with whole steps, as the benchmark's timed runs (call_step); the
+        # time a step is that of the steps MoorDyn took.
+        step = call_step(step)
+        timed = [run_moordyn(model, motion, t_end, dt_output=OUTPUT_INTERVAL, time_step=step,
+                             coupling_step=max(step, COUPLING_STEP), initial_state=state)
+                 for _ in range(REPEATS)]
+    step = timed[0].time_step
+    moordyn = min(r.cpu_time / r.steps for r in timed)
     dt = step if dt is None else dt
     runs = [vinculo_run(model, motion, t_end, dt, every=OUTPUT_INTERVAL) for _ in range(REPEATS)]
     vinculo = min(r.cpu_time / r.solution.steps_taken for r in runs)
-    return step, moordyn / round(t_end / step), dt, vinculo
+    return step, moordyn, dt, vinculo
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -211,9 +211,13 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
             coupled points at a constant velocity over each call (here the chord velocity, so
             that they reach the motion's position at the call's end), so the velocity jumps
             from one call to the next and the axial dashpots feel the jumps: on the hanging
-            chain, calls every 0.01 s change the fairlead tension by 0.9 % of its peak
-            (1.7 % with the motion's velocity at the call's start), calls at every step (the
-            coupling step equal to ``time_step``) follow the motion exactly.
+            chain (20 segments, 0.2 ms steps), calls every 0.01 s change the fairlead
+            segment's tension by 0.8 % of its peak against calls at every step, calls every
+            0.1 s by 3.5 % (9 % at the anchor). Calls at every step (the coupling step equal
+            to ``time_step``) follow the motion as closely as MoorDyn allows: at the chord
+            velocity through each step, half a step's change of velocity from the motion's at
+            the step's start, which makes MoorDyn's tensions first order in its step under a
+            moving fairlead (the work-precision benchmark, :mod:`vinculo.mooring.work_precision`).
         time_step: MoorDyn's time step dtM (s; default: the file's); the run takes the
             largest step at most this that divides ``dt_output`` (``PeerRun.time_step``), so
             that every output time ends a step, and calls MoorDyn with whole numbers of steps

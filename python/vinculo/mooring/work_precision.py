@@ -50,7 +50,7 @@ from vinculo.mooring.bench import (
 )
 
 __all__ = ["MOORDYN_HALVINGS", "MOORDYN_REFERENCE_SHARE", "EqualAccuracy", "WorkPoint",
-           "equal_accuracy", "plot", "table", "work_precision", "write_points"]
+           "equal_accuracy", "pareto_front", "plot", "table", "work_precision", "write_points"]
 
 #: MoorDyn's points: 0.9 of its largest stable step, then this many halvings of it.
 MOORDYN_HALVINGS = 2
@@ -220,8 +220,26 @@ def write_points(points: Sequence[WorkPoint], path: str | Path) -> Path:
     return path
 
 
+def pareto_front(points: Sequence[WorkPoint]) -> list[WorkPoint]:
+    """The points no other point beats in both CPU time and error, most accurate first: a
+    code's best cost at each accuracy.
+
+    Arguments:
+        points: one code's points on one case.
+
+    Returns:
+        The front, by increasing error (and decreasing CPU time).
+    """
+    front: list[WorkPoint] = []
+    for p in sorted(points, key=lambda p: (p.cpu_time, p.error)):
+        if not front or p.error < front[-1].error:
+            front.append(p)
+    return sorted(front, key=lambda p: p.error)
+
+
 def plot(points: Sequence[WorkPoint], path: str | Path) -> Path:
-    """CPU time against error, one panel per case and number of segments, both codes.
+    """CPU time against error, one panel per case and number of segments, both codes: each
+    code's front (:func:`pareto_front`) as a line, its other points faint.
 
     Arguments:
         points: the points of :func:`work_precision`.
@@ -241,22 +259,26 @@ def plot(points: Sequence[WorkPoint], path: str | Path) -> Path:
     fig, axes = plt.subplots(rows, columns, figsize=(4.6 * columns, 3.9 * rows), squeeze=False)
     for ax, (case, segments) in zip(axes.flat, panels, strict=False):
         for code, colour, marker in (("moordyn", "tab:orange", "s"), ("vinculo", "tab:blue", "o")):
-            own = sorted((p for p in points if (p.case, p.segments, p.code)
-                          == (case, segments, code)), key=lambda p: p.step)
+            own = [p for p in points if (p.case, p.segments, p.code) == (case, segments, code)]
             if not own:
                 continue
-            ax.loglog([p.error for p in own], [p.cpu_time for p in own], marker=marker,
-                      color=colour, label="MoorDyn (RK2)" if code == "moordyn"
-                      else "vinculo (trapezoidal)")
-            for p in own:
-                label = f"{p.step:.2g} s" + (" (largest stable)" if p.largest_stable else "")
-                ax.annotate(label, (p.error, p.cpu_time), textcoords="offset points",
-                            xytext=(4, 3), fontsize=7, color=colour)
+            front = pareto_front(own)
+            label = "MoorDyn (RK2)" if code == "moordyn" else "vinculo (trapezoidal)"
+            ax.loglog([p.error for p in front], [p.cpu_time for p in front], marker=marker,
+                      color=colour, label=label)
+            rest = [p for p in own if p not in front]
+            ax.loglog([p.error for p in rest], [p.cpu_time for p in rest], linestyle="none",
+                      marker=marker, color=colour, alpha=0.3)
+            for p in front:
+                text = f"{p.step:.2g} s" + (" (largest stable)" if p.largest_stable else "")
+                ax.annotate(text, (p.error, p.cpu_time), textcoords="offset points",
+                            xytext=(5, -9 if code == "moordyn" else 3), fontsize=7,
+                            color=colour)
         ax.set_title(f"{case}, {segments} segments", fontsize=10)
         ax.set_xlabel("end-tension error (relative to the peak)")
         ax.set_ylabel("CPU time of the run (s)")
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8, loc="upper right")
+        ax.legend(fontsize=8, loc="lower left")
     for ax in list(axes.flat)[len(panels):]:
         ax.set_visible(False)
     fig.suptitle("Work against precision: each code's error against its own small-step "
