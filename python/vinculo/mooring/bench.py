@@ -576,8 +576,22 @@ def write_rows(rows: Sequence[BenchRow], path: str | Path) -> Path:
     Returns:
         The path written.
     """
-    path = Path(path)
     names = [f.name for f in dataclasses.fields(BenchRow)] + ["real_time_factor"]
+    return write_csv(rows, names, path)
+
+
+def write_csv(rows: Sequence[object], names: Sequence[str], path: str | Path) -> Path:
+    """Write ``rows`` as CSV, a column per attribute in ``names`` (the header).
+
+    Arguments:
+        rows: the rows (dataclass instances).
+        names: the attributes to write, in order.
+        path: the CSV file.
+
+    Returns:
+        The path written.
+    """
+    path = Path(path)
     with path.open("w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
         writer.writerow(names)

@@ -30,7 +30,6 @@ least as accurate (no interpolation between vinculo's steps: the ratio is never 
 
 from __future__ import annotations
 
-import csv
 import dataclasses
 import math
 from collections.abc import Sequence
@@ -47,6 +46,7 @@ from vinculo.mooring.bench import (
     moordyn_session,
     motion_for,
     vinculo_tensions,
+    write_csv,
 )
 
 __all__ = ["MOORDYN_HALVINGS", "MOORDYN_REFERENCE_SHARE", "EqualAccuracy", "WorkPoint",
@@ -210,14 +210,7 @@ def write_points(points: Sequence[WorkPoint], path: str | Path) -> Path:
     Returns:
         The path written.
     """
-    path = Path(path)
-    names = [f.name for f in dataclasses.fields(WorkPoint)]
-    with path.open("w", newline="", encoding="utf-8") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(names)
-        for point in points:
-            writer.writerow([getattr(point, n) for n in names])
-    return path
+    return write_csv(points, [f.name for f in dataclasses.fields(WorkPoint)], path)
 
 
 def pareto_front(points: Sequence[WorkPoint]) -> list[WorkPoint]:
