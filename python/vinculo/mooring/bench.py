@@ -257,8 +257,8 @@ class MoorDynRun:
     """MoorDyn at one step on one case (:meth:`MoorDynSession.measure`).
 
     Arguments:
-        step: the step MoorDyn took (s): the largest at most the one asked that divides the
-            output interval (:func:`vinculo.mooring.peer.run_moordyn`).
+        step: the step MoorDyn took (s): the largest at most the one asked that divides
+            0.01 s (:func:`call_step`).
         cpu_time: the least CPU time of :data:`REPEATS` timed runs (s).
         error: the largest end-tension difference from the reference, relative to the peak
             reference tension (the force on the end points, as the benchmark's table).
