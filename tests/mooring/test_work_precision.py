@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from vinculo.errors import InvalidInputError
 from vinculo.mooring import work_precision as wp
 
 pytest.importorskip("moordyn")
@@ -81,9 +82,9 @@ def test_the_outputs(hanging, tmp_path):
 
 
 def test_bad_arguments():
-    with pytest.raises(ValueError, match="case 'sea'"):
+    with pytest.raises(InvalidInputError, match="case 'sea'"):
         wp.work_precision("sea", 20, 10.0)
-    with pytest.raises(ValueError, match="segments 0"):
+    with pytest.raises(InvalidInputError, match="segments 0"):
         wp.work_precision("hanging", 0, 10.0)
 
 

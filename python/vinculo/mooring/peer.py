@@ -218,7 +218,9 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
             velocity through each step, half a step's change of velocity from the motion's at
             the step's start, which makes MoorDyn's tensions first order in its step under a
             moving fairlead (the work-precision benchmark, :mod:`vinculo.mooring.work_precision`).
-        time_step: MoorDyn's time step dtM (s; default: the file's); the run takes the
+        time_step: MoorDyn's time step dtM (s; default: the file's, run as the file says, as
+            MoorDyn itself would: a call that is not a whole number of its steps ends with a
+            shorter one, as in a coupled simulation with that file); given, the run takes the
             largest step at most this that divides ``dt_output`` (``PeerRun.time_step``), so
             that every output time ends a step, and calls MoorDyn with whole numbers of steps
             (a call at every step when ``coupling_step`` is the step asked), which it then takes

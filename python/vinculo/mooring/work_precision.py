@@ -36,11 +36,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from vinculo.errors import ConvergenceError
-from vinculo.mooring import bench
+from vinculo.errors import ConvergenceError, InvalidInputError
 from vinculo.mooring.bench import (
     CASES,
     OUTPUT_INTERVAL,
+    REPEATS,
     STEPS,
     _relative_by_end,
     moordyn_session,
@@ -104,11 +104,17 @@ def work_precision(name: str, segments: int, t_end: float, *,
 
     Returns:
         MoorDyn's points, largest step first, then vinculo's.
+
+    Raises:
+        InvalidInputError: for an unknown case or fewer than one segment.
+        PeerError: when MoorDyn is not installed, or blows up at one of its points.
     """
     if name not in CASES:
-        raise ValueError(f"case {name!r}: not one of {', '.join(CASES)}")
+        raise InvalidInputError(f"case {name!r}: not one of {', '.join(CASES)}", name="name",
+                                value=name)
     if segments < 1:
-        raise ValueError(f"segments {segments}: give a number of segments >= 1")
+        raise InvalidInputError(f"segments {segments}: give a number of segments >= 1",
+                                name="segments", value=segments)
     model = CASES[name](segments)
     motion = motion_for(model)
     points = []
@@ -126,7 +132,7 @@ def work_precision(name: str, segments: int, t_end: float, *,
     for dt in sorted(steps, reverse=True):
         try:
             values, cpu = vinculo_tensions(model, motion, t_end, dt, grid,
-                                           repeats=bench.REPEATS)
+                                           repeats=REPEATS)
         except ConvergenceError:
             continue
         a, b = _relative_by_end(values, reference)
