@@ -58,11 +58,11 @@ mod tests {
 
     #[test]
     fn derivatives_match_finite_differences() {
-        let c = Constraint::FixedCoordinate(FixedCoordinate {
+        let c = Constraint::FixedCoordinate(Box::new(FixedCoordinate {
             particles: [0],
             axis: 2,
             value: Law::sine(0.1, 2.0, 0.3, 1.0, 0.0, 0.0).unwrap(),
-        });
+        }));
         fd::check(&c, &[[0.1, 0.2, 1.05]], &[[0.4, 0.0, -0.3]], 0.2);
     }
 }

@@ -34,7 +34,6 @@ use crate::assembly::{
     ResidualTerms, MIN_TASK,
 };
 use crate::math::Vec3;
-use crate::model::Particle;
 use crate::model::System;
 
 /// One index-3 step's nonlinear problem, for the rule step `R`.
@@ -44,8 +43,10 @@ pub struct StepProblem<'a, R: Index3Rule> {
     buffers: &'a mut StepBuffers,
     scales: &'a [f64],
     inertia: &'a [f64],
+    mass: &'a [f64],
     axial: &'a AxialAddedMass,
     parallel: Option<&'a mut ParallelAssembly>,
+    reads_velocities: bool,
     point: StepPoint,
     rule: R,
 }
@@ -71,8 +72,10 @@ impl<'a, R: Index3Rule> StepProblem<'a, R> {
             buffers: &mut ws.state,
             scales: &ws.scales,
             inertia: &ws.inertia,
+            mass: &ws.mass,
             axial: &ws.axial_added_mass,
             parallel: ws.parallel.as_mut(),
+            reads_velocities: ws.reads_velocities,
             point,
             rule,
         };
@@ -107,13 +110,20 @@ impl<'a, R: Index3Rule> StepProblem<'a, R> {
                 .enumerate()
                 .with_min_len(MIN_TASK)
                 .for_each(|(i, (q, v))| *v = rule.kinematics(i, q).0);
-        } else {
+        } else if self.reads_velocities {
             b.q.par_iter()
                 .zip(b.v.par_iter_mut())
                 .zip(b.q_eval.par_iter_mut().zip(b.v_eval.par_iter_mut()))
                 .enumerate()
                 .with_min_len(MIN_TASK)
                 .for_each(|(i, ((q, v), (qe, ve)))| (*v, *qe, *ve) = rule.kinematics(i, q));
+        } else {
+            // No element reads the evaluation point's velocities (`StepWorkspace::reads_velocities`).
+            b.q.par_iter()
+                .zip(b.v.par_iter_mut().zip(b.q_eval.par_iter_mut()))
+                .enumerate()
+                .with_min_len(MIN_TASK)
+                .for_each(|(i, (q, (v, qe)))| (*v, *qe, _) = rule.kinematics(i, q));
         }
     }
 
@@ -152,14 +162,14 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
             slack: R::SLACK,
         };
         let (system, layout, inertia) = (self.system, self.layout, self.inertia);
-        let (particles, g) = (system.particles(), system.gravity());
+        let g = system.gravity();
         let row = Rows {
             rule,
             sigma: point.sigma,
             q: &b.q,
             v: &b.v,
             inertia,
-            particles,
+            mass: self.mass,
             g,
         };
         match self.parallel.as_deref_mut() {
@@ -290,18 +300,17 @@ struct Rows<'b, R> {
     q: &'b [Vec3],
     v: &'b [Vec3],
     inertia: &'b [f64],
-    particles: &'b [Particle],
+    mass: &'b [f64],
     g: Vec3,
 }
 
 impl<R: Index3Rule> InertiaRows for Rows<'_, R> {
     #[inline(always)]
     fn rows(&self, i: usize) -> Vec3 {
-        let mass = self.particles[i].mass;
         let (q, v) = (&self.q[i], &self.v[i]);
         let row = self
             .rule
-            .inertia_row(i, q, v, self.inertia[i], mass, &self.g);
+            .inertia_row(i, q, v, self.inertia[i], self.mass[i], &self.g);
         row.map(|x| self.sigma * x)
     }
 }

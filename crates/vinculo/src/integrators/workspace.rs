@@ -54,6 +54,10 @@ pub struct StepWorkspace {
     /// Inertia of each particle's translation: its mass plus any added mass of fluid elements
     /// (the diagonal of M, constant over the run). Gravity acts on the mass alone.
     pub inertia: Vec<f64>,
+    /// Each particle's mass, on which gravity acts: the residual's rows read it from this
+    /// compact copy rather than from the particles' records (64 bytes each, of which the mass
+    /// is 8; the swinging chain of 10^5 particles: see `docs/guide/benchmarks.md`).
+    pub mass: Vec<f64>,
     /// The axial correction of the line nodes' added mass (CaAx != Ca), added to the mass
     /// blocks at each step's evaluation point (`assembly/axial_added_mass.rs`).
     pub axial_added_mass: AxialAddedMass,
@@ -62,6 +66,12 @@ pub struct StepWorkspace {
     /// Colouring and buffers of parallel assembly, when the model is large enough for it to
     /// pay (see [`StepWorkspace::assemble_in_parallel_from`]); `None`: serial assembly.
     pub parallel: Option<ParallelAssembly>,
+    /// Whether any element reads the velocities of the evaluation point (a force, a damped
+    /// segment, a user group): without one, a rule with an evaluation point of its own
+    /// (the trapezoidal rule) does not write them on rayon's pool, a third of the writes of
+    /// its kinematics at each residual (the swinging chain of 10^6 particles: see
+    /// `docs/guide/benchmarks.md`).
+    pub reads_velocities: bool,
 }
 
 /// Per-particle arrays of a step.
@@ -189,9 +199,15 @@ impl StepWorkspace {
             scales: system.constraints().iter().map(|c| c.scale()).collect(),
             mass_ref,
             inertia: system.inertia(),
+            mass: system.particles().iter().map(|p| p.mass).collect(),
             axial_added_mass: AxialAddedMass::new(system),
             layout,
             parallel: None,
+            reads_velocities: !system.forces().is_empty()
+                || system.constraints().iter().any(|c| {
+                    c.damped_segment().is_some()
+                        || matches!(c, crate::constraints::Constraint::User(_))
+                }),
         }
     }
 

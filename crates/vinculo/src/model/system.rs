@@ -303,11 +303,11 @@ impl System {
             });
         }
         let value = value.unwrap_or(Law::Constant(self.particles[i].position[axis]));
-        self.push_constraint(Constraint::FixedCoordinate(FixedCoordinate {
+        self.push_constraint(Constraint::FixedCoordinate(Box::new(FixedCoordinate {
             particles: [i],
             axis,
             value,
-        }))
+        })))
     }
 
     /// q_b[axis] - q_a[axis] = value(t) (`None`: the current difference): three at zero make
