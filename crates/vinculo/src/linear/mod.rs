@@ -11,6 +11,8 @@ pub use dense_lu::DenseLu;
 pub use sparse_lu::SparseLu;
 pub use tree_elimination::{TreeElimination, TWO_SIDED_FROM};
 
+use rayon::prelude::*;
+
 use crate::assembly::{Pattern, Storage};
 
 /// Why a factorisation failed.
@@ -96,13 +98,13 @@ pub fn assemble_and_factor(
     mut assemble: impl FnMut(&mut [f64]),
 ) -> Result<(), Singular> {
     if !solver.in_place() {
-        values.fill(0.0);
+        zero(values);
         assemble(values);
         return solver.factor(values);
     }
     let mut fill = |solver: &mut dyn LinearSolver| {
         let store = solver.storage().expect("a solver in place has a storage");
-        store.fill(0.0);
+        zero(store);
         assemble(store);
     };
     fill(solver);
@@ -111,6 +113,24 @@ pub fn assemble_and_factor(
         solver.factor_stored_by_fallback()?;
     }
     Ok(())
+}
+
+/// Length of a matrix storage from which [`zero`] runs on rayon's pool: 2^22 entries (32 MB),
+/// far beyond the caches, where waking the pool costs nothing next to the pass. Measured on the
+/// 10^6-particle swinging chain (320 MB of storage, 14 factorisations in 13 steps): 0.445 s of
+/// zeroing on one thread, 0.236 s on two, 4 % of its steps' time.
+pub const PARALLEL_ZERO_FROM: usize = 1 << 22;
+
+/// Sets every entry of a matrix storage to zero: on rayon's pool from [`PARALLEL_ZERO_FROM`]
+/// entries on.
+pub fn zero(values: &mut [f64]) {
+    if values.len() < PARALLEL_ZERO_FROM {
+        values.fill(0.0);
+    } else {
+        values
+            .par_chunks_mut(1 << 16)
+            .for_each(|chunk| chunk.fill(0.0));
+    }
 }
 
 /// Which solver a sparse pattern gets.
@@ -153,6 +173,17 @@ pub fn for_pattern(pattern: &Pattern) -> Box<dyn LinearSolver> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A storage long enough to be zeroed on the pool is zeroed in every entry, the chunks'
+    /// seams and the short last chunk included.
+    #[test]
+    fn a_long_storage_is_zeroed_everywhere() {
+        let mut values: Vec<f64> = (0..PARALLEL_ZERO_FROM + 3)
+            .map(|i| i as f64 + 1.0)
+            .collect();
+        zero(&mut values);
+        assert!(values.iter().all(|&x| x == 0.0));
+    }
 
     /// A 5x5 saddle-point matrix with a zero diagonal block, like the KKT systems solved here.
     fn kkt() -> (Vec<(usize, usize, f64)>, Vec<f64>) {
