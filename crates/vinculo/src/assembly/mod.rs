@@ -22,6 +22,9 @@ use crate::model::System;
 /// Marks an absent unknown (a fixed particle has no coordinates among the unknowns).
 pub const NONE: usize = usize::MAX;
 
+/// Unknowns [`Layout::unknowns_distance`] scans between its tests of the distance so far.
+pub const DISTANCE_CHUNK: usize = 256;
+
 /// Position of a matrix entry in the value array. 32 bits: the slot tables are the largest
 /// per-element arrays of a model (a chain link has 45 slots), and four billion entries is far
 /// beyond any model that fits in memory.
@@ -522,8 +525,12 @@ impl Layout {
     }
 
     /// The largest distance of a scaled unknown ([`Layout::scaled_unknowns`]) of `q` and
-    /// `lambda` from `x` when none is farther than `cap`, else infinity: the scan stops at the
-    /// first one beyond `cap` (in a model in motion, the first) or not a number.
+    /// `lambda` from `x` when none is farther than `cap`, else infinity (also when one is not a
+    /// number). The scan goes by chunks of [`DISTANCE_CHUNK`] unknowns, each without a branch
+    /// that ends it, and stops after the first chunk that holds one beyond `cap` (in a model in
+    /// motion, the first): a model at rest is scanned whole, and a loop that could end at every
+    /// unknown took as long as a residual evaluation (13.7 % of a step of the hanging chain of
+    /// 10^4 particles, generalised-alpha at 1 ms).
     pub fn unknowns_distance(
         &self,
         (q, lambda): (&[crate::math::Vec3], &[f64]),
@@ -535,20 +542,45 @@ impl Layout {
         if x.len() != m3 + lambda.len() {
             return f64::INFINITY;
         }
+        let (x_q, x_lambda) = x.split_at(m3);
         let mut far = 0.0f64;
-        // Takes in one unknown's distance; false when it is beyond `cap` or not a number
-        // (`e <= cap` is false for NaN), which ends the scan.
-        let mut within = |e: f64| {
-            far = far.max(e);
-            e <= cap
+        // A chunk's largest distance and whether one was beyond `cap` (`e <= cap` is false for
+        // NaN); four running maxima, so that the multipliers' pass is vectorised.
+        let mut take = |far_chunk: [f64; 4], beyond: bool| {
+            far = far_chunk.iter().fold(far, |m, &e| m.max(e));
+            !beyond
         };
-        for (qi, &d) in q.iter().zip(&self.dof) {
-            if d != NONE && !(0..3).all(|k| within((qi[k] - x[d + k]).abs())) {
+        for (qc, dc) in q
+            .chunks(DISTANCE_CHUNK)
+            .zip(self.dof.chunks(DISTANCE_CHUNK))
+        {
+            let (mut m, mut beyond) = ([0.0f64; 4], false);
+            for (qi, &d) in qc.iter().zip(dc) {
+                if d != NONE {
+                    let xi: &[f64; 3] = x_q[d..d + 3].try_into().expect("3 unknowns a particle");
+                    for k in 0..3 {
+                        let e = (qi[k] - xi[k]).abs();
+                        m[k] = if e > m[k] { e } else { m[k] };
+                        beyond |= !(e <= cap);
+                    }
+                }
+            }
+            if !take(m, beyond) {
                 return f64::INFINITY;
             }
         }
-        for ((l, s), xk) in lambda.iter().zip(scales).zip(&x[m3..]) {
-            if !within((l * sigma / s - xk).abs()) {
+        let chunks = lambda
+            .chunks(DISTANCE_CHUNK)
+            .zip(scales.chunks(DISTANCE_CHUNK))
+            .zip(x_lambda.chunks(DISTANCE_CHUNK));
+        for ((lc, sc), xc) in chunks {
+            let (mut m, mut beyond) = ([0.0f64; 4], false);
+            for (j, ((l, s), xk)) in lc.iter().zip(sc).zip(xc).enumerate() {
+                let e = (l * sigma / s - xk).abs();
+                m[j % 4] = if e > m[j % 4] { e } else { m[j % 4] };
+                beyond |= !(e <= cap);
+            }
+            if !take(m, beyond) {
                 return f64::INFINITY;
             }
         }
@@ -753,5 +785,70 @@ pub fn add_block(values: &mut [f64], b: &Block, s: f64, m: &crate::math::Mat3) {
         for c in 0..3 {
             values[b[3 * r + c] as usize] += s * m[r][c];
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrators::fixtures::chain;
+    use crate::math::Vec3;
+
+    /// The largest distance of the scaled unknowns of `(q, lambda)` from `x`, by a plain scan
+    /// of every unknown (NaN where one is NaN).
+    fn scanned(layout: &Layout, (q, lambda): (&[Vec3], &[f64]), scales: &[f64], x: &[f64]) -> f64 {
+        let mut at = vec![0.0; x.len()];
+        layout.scaled_unknowns(q, lambda, scales, 0.3, &mut at);
+        at.iter()
+            .zip(x)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, |m, e| {
+                if m.is_nan() || e.is_nan() {
+                    f64::NAN
+                } else {
+                    m.max(e)
+                }
+            })
+    }
+
+    /// The distance of a model's unknowns from a point (the kept matrix's), serial and on the
+    /// pool: the largest over every unknown when none is beyond the cap, infinity when one is,
+    /// however far into the scan, or when one is not a number. A chain of 1,000 links behind a
+    /// fixed particle spans several chunks of the serial scan.
+    #[test]
+    fn unknowns_distance_is_the_largest_within_the_cap_else_infinite() {
+        let s = chain(1000);
+        let layout = Layout::new(&s, 0);
+        let q = s.initial_positions();
+        let m = layout.constraints;
+        let mut lambda: Vec<f64> = (0..m).map(|c| 1.0 + c as f64).collect();
+        let scales: Vec<f64> = (0..m).map(|c| 2.0 + 0.5 * c as f64).collect();
+        let mut x = vec![0.0; layout.unknowns()];
+        layout.scaled_unknowns(&q, &lambda, &scales, 0.3, &mut x);
+        for (i, xi) in x.iter_mut().enumerate() {
+            *xi += 1e-9 * ((i * 7919) % 13) as f64;
+        }
+        let distance = |q: &[Vec3], lambda: &[f64], x: &[f64], cap: f64| {
+            let serial = layout.unknowns_distance((q, lambda), (&scales, 0.3), x, cap);
+            let parallel = layout.unknowns_distance_parallel((q, lambda), (&scales, 0.3), x, cap);
+            assert_eq!(serial.to_bits(), parallel.to_bits(), "serial and parallel");
+            serial
+        };
+        let largest = scanned(&layout, (&q, &lambda), &scales, &x);
+        assert!(largest > 1e-8 && largest < 1.3e-8, "{largest}");
+        assert_eq!(distance(&q, &lambda, &x, 1e-6), largest);
+        assert_eq!(distance(&q, &lambda, &x, 1.1e-8), f64::INFINITY);
+        // One unknown beyond the cap, the last multiplier's, and then the last particle's.
+        let last = x.len() - 1;
+        x[last] += 1e-3;
+        assert_eq!(distance(&q, &lambda, &x, 1e-6), f64::INFINITY);
+        x[last] -= 1e-3;
+        let mut moved = q.clone();
+        moved[1000][2] += 1e-3;
+        assert_eq!(distance(&moved, &lambda, &x, 1e-6), f64::INFINITY);
+        // A multiplier that is not a number.
+        lambda[500] = f64::NAN;
+        assert!(scanned(&layout, (&q, &lambda), &scales, &x).is_nan());
+        assert_eq!(distance(&q, &lambda, &x, 1e-6), f64::INFINITY);
     }
 }
