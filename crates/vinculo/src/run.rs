@@ -1640,7 +1640,8 @@ impl Simulation<'_> {
             sol.status = Err(e);
             return Next::Stop;
         }
-        if let Some(e) = self.guard.and_then(|g| g.check(system, &c.q, &c.v, c.t, h)) {
+        let guarded = self.guard.as_ref();
+        if let Some(e) = guarded.and_then(|g| g.check(system, &ws.mass, (&c.q, &c.v), (c.t, h))) {
             sol.status = Err(e);
             return Next::Stop;
         }

@@ -96,11 +96,14 @@ impl RuleState {
     fn predict(&mut self, k: &AlphaCoefficients, start: &StepStart) {
         let (h, q_n, v_n) = (start.h, start.q_n, start.v_n);
         let (hh, half) = (h * h, 0.5 - k.beta);
-        for i in 0..q_n.len() {
-            let a_n = self.algorithmic[i];
+        // Zipped, without an index into each array (a pass that the bounds checks of five
+        // indexed arrays kept from vectorising).
+        let known = q_n.iter().zip(v_n).zip(&self.algorithmic);
+        let predicted = self.predicted_q.iter_mut().zip(self.predicted_v.iter_mut());
+        for ((p, w), ((q_n, v_n), a_n)) in predicted.zip(known) {
             for x in 0..3 {
-                self.predicted_q[i][x] = q_n[i][x] + h * v_n[i][x] + hh * half * a_n[x];
-                self.predicted_v[i][x] = v_n[i][x] + h * (1.0 - k.gamma) * a_n[x];
+                p[x] = q_n[x] + h * v_n[x] + hh * half * a_n[x];
+                w[x] = v_n[x] + h * (1.0 - k.gamma) * a_n[x];
             }
         }
     }
@@ -256,13 +259,17 @@ impl TimeRule for GeneralizedAlpha {
     /// qdd_{n+1} and a_{n+1} from q_{n+1} and the step's predictors.
     fn advance(&self, state: &mut RuleState, h: f64, q: &[Vec3]) {
         let known = Predictors::new(&self.coefficients(), h);
-        for i in 0..q.len() {
-            let (a, _) = known.kinematics(&q[i], &state.predicted_q[i], &state.predicted_v[i]);
+        let predicted = state.predicted_q.iter().zip(&state.predicted_v);
+        let carried = state
+            .acceleration
+            .iter_mut()
+            .zip(state.algorithmic.iter_mut());
+        for ((qdd, a_n), (q, (p, w))) in carried.zip(q.iter().zip(predicted)) {
+            let (a, _) = known.kinematics(q, p, w);
             for x in 0..3 {
-                state.acceleration[i][x] = known.c_a * a[x] + known.c_m * state.algorithmic[i][x]
-                    - known.c_f * state.acceleration[i][x];
+                qdd[x] = known.c_a * a[x] + known.c_m * a_n[x] - known.c_f * qdd[x];
             }
-            state.algorithmic[i] = a;
+            *a_n = a;
         }
     }
 
