@@ -544,8 +544,8 @@ impl Layout {
         }
         let (x_q, x_lambda) = x.split_at(m3);
         let mut far = 0.0f64;
-        // A chunk's largest distance and whether one was beyond `cap` (`e <= cap` is false for
-        // NaN); four running maxima, so that the multipliers' pass is vectorised.
+        // A chunk's largest distance and whether one was beyond `cap` or not a number; four
+        // running maxima, so that the multipliers' pass is vectorised.
         let mut take = |far_chunk: [f64; 4], beyond: bool| {
             far = far_chunk.iter().fold(far, |m, &e| m.max(e));
             !beyond
@@ -561,7 +561,7 @@ impl Layout {
                     for k in 0..3 {
                         let e = (qi[k] - xi[k]).abs();
                         m[k] = if e > m[k] { e } else { m[k] };
-                        beyond |= !(e <= cap);
+                        beyond |= e > cap || e.is_nan();
                     }
                 }
             }
@@ -578,7 +578,7 @@ impl Layout {
             for (j, ((l, s), xk)) in lc.iter().zip(sc).zip(xc).enumerate() {
                 let e = (l * sigma / s - xk).abs();
                 m[j % 4] = if e > m[j % 4] { e } else { m[j % 4] };
-                beyond |= !(e <= cap);
+                beyond |= e > cap || e.is_nan();
             }
             if !take(m, beyond) {
                 return f64::INFINITY;
