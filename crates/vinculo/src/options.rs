@@ -95,10 +95,18 @@ impl Default for SimulationOptions {
 /// The assembly alone (`benches/kernels.rs`, `assembly`) is 20-27 % faster from 100,000 on, but
 /// it was a quarter to a half of a step and the rest (the linear solve above all) serial,
 /// while the residual's per-element buffers and the threads' wake-ups cost a share of the gain.
+/// On a machine whose memory serves one thread less well (an Intel Xeon at 2.6 GHz under KVM,
+/// where a swinging chain of 10^6 takes 0.38 s a step against 0.20 s on the machine of the
+/// figures above), 100,000 with [`crate::linear::TWO_SIDED_FROM`] at 100,000 too
+/// (`python -m vinculo.bench.scaling swinging --sizes 100000,200000 --repeat 2`, builds
+/// alternated): a step of the swinging chain of 10^5 particles 64 -> 48.5 ms, of 2 x 10^5
+/// 101 -> 76.5 ms, of the hanging chain 9.7-11.5 -> 7.7-8.7 ms and 24-27 -> 20.5-21 ms; at
+/// 60,000 the parallel step was 7 to 16 % faster still, at 30,000 the hanging chain's 12 %
+/// slower.
 /// Where the assembly is parallel, so are the Newton loop's passes over the unknowns; a chain
 /// of [`crate::linear::TWO_SIDED_FROM`] particles or more is also solved from both ends on two
 /// threads, whatever this option says (`RAYON_NUM_THREADS=1` keeps a run on one thread).
-pub const PARALLEL_FROM: usize = 300_000;
+pub const PARALLEL_FROM: usize = 100_000;
 
 /// Receives progress and may stop a run.
 pub trait Observer {

@@ -76,8 +76,10 @@ macro_rules! toward_leaf {
 /// faster at 300,000 particles (0.074-0.079 against 0.085-0.087 s), the same at 100,000, 6 to
 /// 30 % slower at 3,000 to 30,000 (waking the second thread at every factorisation and solve
 /// costs more than it saves while the chain's storage fits in the caches, and the residual
-/// leaves it asleep below [`crate::options::PARALLEL_FROM`]).
-pub const TWO_SIDED_FROM: usize = 200_000;
+/// leaves it asleep below [`crate::options::PARALLEL_FROM`]). Lowered from 200,000 to 100,000
+/// with that threshold (measured there: a step of the swinging chain of 10^5 particles 24 %
+/// faster with both on a machine whose memory serves one thread less well).
+pub const TWO_SIDED_FROM: usize = 100_000;
 
 /// Share of the blocks the leaf side takes: half, both sides taking about as long a block
 /// (0.6 measured the same on the 10^6-particle chain).
