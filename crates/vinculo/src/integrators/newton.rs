@@ -538,9 +538,9 @@ pub fn solve(
             apart = problem.distance_from(&matrix.point, options.tolerance / REUSED_ERROR_SHARE);
             fresh = apart <= options.tolerance;
         }
-        solver.solve_in_place(r);
+        let solved = solver.solve_in_place_with_norm(r);
         increment_before = increment;
-        increment = inf_norm(r);
+        increment = solved;
         stale_iterations += 1;
         solves_with_matrix += 1;
         refresh = match policy {

@@ -30,6 +30,13 @@ pub trait LinearSolver: Send {
     fn factor(&mut self, values: &[f64]) -> Result<(), Singular>;
     /// Overwrites `rhs` with the solution of A x = rhs, using the last factorisation.
     fn solve_in_place(&mut self, rhs: &mut [f64]);
+    /// [`LinearSolver::solve_in_place`], returning the infinity norm of the solution (NaN if an
+    /// entry is NaN), which Newton's method asks of every increment: a solver that writes the
+    /// solution back in a pass of its own takes the norm in that pass instead of another.
+    fn solve_in_place_with_norm(&mut self, rhs: &mut [f64]) -> f64 {
+        self.solve_in_place(rhs);
+        crate::integrators::newton::inf_norm(rhs)
+    }
     /// Short name, for statistics.
     fn name(&self) -> &'static str;
     /// Factorisations that a solver specialised to a structure handed to the general sparse LU

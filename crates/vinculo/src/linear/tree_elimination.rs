@@ -1362,38 +1362,11 @@ impl LinearSolver for TreeElimination {
     }
 
     fn solve_in_place(&mut self, rhs: &mut [f64]) {
-        assert!(self.factored, "solve before a successful factorisation");
-        if self.on_fallback {
-            let lu = self.fallback.as_mut().expect("the fallback factorised");
-            lu.solve_in_place(rhs);
-            return;
-        }
-        if self.blocks() == 1 {
-            // One block (a single particle and its conditions, as a pendulum's bob): its
-            // factors' solve alone, without the sweeps' bookkeeping (a third of a step's
-            // instructions on the pendulum went to it).
-            self.solve_single_block(rhs);
-            return;
-        }
-        if self.separator > 0 {
-            self.solve_two_sided(rhs);
-            return;
-        }
-        let mut z = std::mem::take(&mut self.z);
-        for (z, &u) in z.iter_mut().zip(&self.unknowns) {
-            *z = rhs[u as usize];
-        }
-        let n = self.blocks();
-        match self.uniform {
-            3 => self.sweeps_explicit::<3>(&mut z, n),
-            4 => self.sweeps_explicit::<4>(&mut z, n),
-            5 => self.sweeps_explicit::<5>(&mut z, n),
-            _ => self.sweeps(&mut z),
-        }
-        for (z, &u) in z.iter().zip(&self.unknowns) {
-            rhs[u as usize] = *z;
-        }
-        self.z = z;
+        self.solve_and_measure(rhs, false);
+    }
+
+    fn solve_in_place_with_norm(&mut self, rhs: &mut [f64]) -> f64 {
+        self.solve_and_measure(rhs, true)
     }
 
     fn name(&self) -> &'static str {
@@ -1449,6 +1422,84 @@ impl LinearSolver for TreeElimination {
         self.on_fallback = false;
         self.factored = true;
         true
+    }
+}
+
+impl TreeElimination {
+    /// The solve in place, and the infinity norm of the solution when `measure` (NaN where an
+    /// entry is NaN; else 0), taken as the solution is put back in the right-hand side's order.
+    fn solve_and_measure(&mut self, rhs: &mut [f64], measure: bool) -> f64 {
+        assert!(self.factored, "solve before a successful factorisation");
+        let norm_of = |rhs: &[f64]| {
+            if measure {
+                crate::integrators::newton::inf_norm(rhs)
+            } else {
+                0.0
+            }
+        };
+        if self.on_fallback {
+            let lu = self.fallback.as_mut().expect("the fallback factorised");
+            lu.solve_in_place(rhs);
+            return norm_of(rhs);
+        }
+        if self.blocks() == 1 {
+            // One block (a single particle and its conditions, as a pendulum's bob): its
+            // factors' solve alone, without the sweeps' bookkeeping (a third of a step's
+            // instructions on the pendulum went to it).
+            self.solve_single_block(rhs);
+            return norm_of(rhs);
+        }
+        if self.separator > 0 {
+            return self.solve_two_sided(rhs, measure);
+        }
+        let mut z = std::mem::take(&mut self.z);
+        for (z, &u) in z.iter_mut().zip(&self.unknowns) {
+            *z = rhs[u as usize];
+        }
+        let n = self.blocks();
+        match self.uniform {
+            3 => self.sweeps_explicit::<3>(&mut z, n),
+            4 => self.sweeps_explicit::<4>(&mut z, n),
+            5 => self.sweeps_explicit::<5>(&mut z, n),
+            _ => self.sweeps(&mut z),
+        }
+        let norm = scatter(&z, &self.unknowns, rhs, measure);
+        self.z = z;
+        norm
+    }
+}
+
+/// Puts `z` (in the blocks' order) back into `rhs` at `unknowns`, and returns the infinity norm
+/// of `z` when `measure` (NaN where an entry is NaN; else 0): four running maxima and a NaN flag,
+/// as [`crate::integrators::newton::inf_norm`], in the same pass.
+pub(super) fn scatter(z: &[f64], unknowns: &[u32], rhs: &mut [f64], measure: bool) -> f64 {
+    if !measure {
+        for (z, &u) in z.iter().zip(unknowns) {
+            rhs[u as usize] = *z;
+        }
+        return 0.0;
+    }
+    let (mut m, mut nan) = ([0.0f64; 4], false);
+    let quads = z.chunks_exact(4).zip(unknowns.chunks_exact(4));
+    for (z, u) in quads {
+        for l in 0..4 {
+            rhs[u[l] as usize] = z[l];
+            let a = z[l].abs();
+            m[l] = if a > m[l] { a } else { m[l] };
+            nan |= a.is_nan();
+        }
+    }
+    let rest = z.len() - z.len() % 4;
+    for (l, (x, &u)) in z[rest..].iter().zip(&unknowns[rest..]).enumerate() {
+        rhs[u as usize] = *x;
+        let a = x.abs();
+        m[l] = if a > m[l] { a } else { m[l] };
+        nan |= a.is_nan();
+    }
+    if nan {
+        f64::NAN
+    } else {
+        m[0].max(m[1]).max(m[2].max(m[3]))
     }
 }
 
@@ -1785,7 +1836,21 @@ mod tests {
         solver.factor(values).unwrap();
         let mut x = b.to_vec();
         solver.solve_in_place(&mut x);
+        assert_measured(solver, b, &x);
         x
+    }
+
+    /// The solve that also measures its solution gives the same solution, bit for bit, and its
+    /// infinity norm (the largest entry does not depend on the order it is taken in), and NaN
+    /// for a right-hand side with a NaN.
+    fn assert_measured(solver: &mut dyn LinearSolver, b: &[f64], x: &[f64]) {
+        let mut y = b.to_vec();
+        let norm = solver.solve_in_place_with_norm(&mut y);
+        assert_eq!(x, &y[..]);
+        assert_eq!(norm, crate::integrators::newton::inf_norm(x));
+        let mut y = b.to_vec();
+        y[b.len() / 2] = f64::NAN;
+        assert!(solver.solve_in_place_with_norm(&mut y).is_nan());
     }
 
     /// Tree elimination and faer's general sparse LU give the same solution (to 1e-12 relative)
@@ -1931,6 +1996,7 @@ mod tests {
                             assert_eq!(tree.factor_stored().unwrap(), Stored::Factorised);
                             let mut x = b.clone();
                             tree.solve_in_place(&mut x);
+                            assert_measured(&mut tree, &b, &x);
                             x
                         }
                     };

@@ -117,7 +117,10 @@ impl TreeElimination {
     /// Solves in place after [`TreeElimination::eliminate_two_sided`]: the right-hand side
     /// gathered into the blocks' order, the sweeps, and the result put back, each on rayon's
     /// pool.
-    pub(super) fn solve_two_sided(&mut self, rhs: &mut [f64]) {
+    /// With `measure`, also returns the infinity norm of the solution (NaN where an entry is
+    /// NaN), each chunk's taken as the pass that puts the result back writes it (else 0): a
+    /// pass of its own over the 32 MB of the 10^6-particle chain's unknowns took 2.5 ms.
+    pub(super) fn solve_two_sided(&mut self, rhs: &mut [f64], measure: bool) -> f64 {
         const CHUNK: usize = 1 << 15;
         let mut z = std::mem::take(&mut self.z);
         z.par_chunks_mut(CHUNK)
@@ -128,14 +131,43 @@ impl TreeElimination {
                 }
             });
         self.sweeps_two_sided(&mut z);
-        rhs.par_chunks_mut(CHUNK)
+        let norm = rhs
+            .par_chunks_mut(CHUNK)
             .zip(self.local_of.par_chunks(CHUNK))
-            .for_each(|(rhs, local)| {
-                for (r, &i) in rhs.iter_mut().zip(local) {
-                    *r = z[i as usize];
+            .map(|(rhs, local)| {
+                if !measure {
+                    for (r, &i) in rhs.iter_mut().zip(local) {
+                        *r = z[i as usize];
+                    }
+                    return 0.0;
                 }
-            });
+                let (mut m, mut nan) = ([0.0f64; 4], false);
+                for (r, i) in rhs.chunks_mut(4).zip(local.chunks(4)) {
+                    for (l, (r, &i)) in r.iter_mut().zip(i).enumerate() {
+                        *r = z[i as usize];
+                        let a = r.abs();
+                        m[l] = if a > m[l] { a } else { m[l] };
+                        nan |= a.is_nan();
+                    }
+                }
+                if nan {
+                    f64::NAN
+                } else {
+                    m[0].max(m[1]).max(m[2].max(m[3]))
+                }
+            })
+            .reduce(
+                || 0.0,
+                |a, b| {
+                    if a.is_nan() || b.is_nan() {
+                        f64::NAN
+                    } else {
+                        a.max(b)
+                    }
+                },
+            );
         self.z = z;
+        norm
     }
 
     /// The separator of a chain of blocks eliminated from both ends, or 0: the chain must be
