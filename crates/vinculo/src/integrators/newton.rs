@@ -334,16 +334,49 @@ pub(crate) fn inf_norm(x: &[f64]) -> f64 {
     if x.len() < PARALLEL_NORM_FROM {
         return inf_norm_serial(x);
     }
-    x.par_chunks(1 << 16).map(inf_norm_serial).reduce(
-        || 0.0,
-        |a, b| {
-            if a.is_nan() || b.is_nan() {
-                f64::NAN
-            } else {
-                a.max(b)
-            }
-        },
-    )
+    x.par_chunks(1 << 16)
+        .map(inf_norm_serial)
+        .reduce(|| 0.0, larger_norm)
+}
+
+/// The norm of two parts from their infinity norms: the larger, NaN if either is.
+pub(crate) fn larger_norm(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
+}
+
+/// The infinity norm of values taken one at a time, in four lanes (four independent running
+/// maxima and a NaN flag, with no early exit) so that a pass that takes four consecutive
+/// values a lane each turns into vector instructions: [`inf_norm`], and the tree elimination's
+/// solve as it writes its result.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct LargestMagnitude {
+    lanes: [f64; 4],
+    nan: bool,
+}
+
+impl LargestMagnitude {
+    /// Takes `x` into lane `lane` (0 to 3).
+    #[inline(always)]
+    pub(crate) fn take(&mut self, lane: usize, x: f64) {
+        let a = x.abs();
+        let m = &mut self.lanes[lane];
+        *m = if a > *m { a } else { *m };
+        self.nan |= a.is_nan();
+    }
+
+    /// The largest magnitude taken, NaN if a value was NaN.
+    pub(crate) fn norm(&self) -> f64 {
+        let m = &self.lanes;
+        if self.nan {
+            f64::NAN
+        } else {
+            m[0].max(m[1]).max(m[2].max(m[3]))
+        }
+    }
 }
 
 /// [`inf_norm`] on this thread. Four independent running maxima and a NaN flag, with no early
@@ -360,27 +393,18 @@ fn inf_norm_serial(x: &[f64]) -> f64 {
         }
         return if nan { f64::NAN } else { m };
     }
-    let mut m = [0.0f64; 4];
-    let mut nan = false;
+    let mut largest = LargestMagnitude::default();
     let chunks = x.chunks_exact(4);
     let rest = chunks.remainder();
     for c in chunks {
-        for l in 0..4 {
-            let a = c[l].abs();
-            m[l] = if a > m[l] { a } else { m[l] };
-            nan |= a.is_nan();
+        for (l, &v) in c.iter().enumerate() {
+            largest.take(l, v);
         }
     }
-    for (l, v) in rest.iter().enumerate() {
-        let a = v.abs();
-        m[l] = if a > m[l] { a } else { m[l] };
-        nan |= a.is_nan();
+    for (l, &v) in rest.iter().enumerate() {
+        largest.take(l, v);
     }
-    if nan {
-        f64::NAN
-    } else {
-        m[0].max(m[1]).max(m[2].max(m[3]))
-    }
+    largest.norm()
 }
 
 /// The index of the entry of `x` of largest magnitude (the first NaN, if any).

@@ -147,6 +147,7 @@ pub use two_sided::TWO_SIDED_FROM;
 use super::block_slots::{BlockSlots, ABSENT};
 use super::{LinearSolver, Singular, SparseLu, Stored};
 use crate::assembly::{Pattern, Storage};
+use crate::integrators::newton::LargestMagnitude;
 
 /// Smallest pivot of a block that the elimination accepts, relative to the sum of the
 /// magnitudes of the terms it was computed from (the block's entry and the products the
@@ -1470,8 +1471,7 @@ impl TreeElimination {
 }
 
 /// Puts `z` (in the blocks' order) back into `rhs` at `unknowns`, and returns the infinity norm
-/// of `z` when `measure` (NaN where an entry is NaN; else 0): four running maxima and a NaN flag,
-/// as [`crate::integrators::newton::inf_norm`], in the same pass.
+/// of `z` when `measure` (NaN where an entry is NaN; else 0), taken in the same pass.
 pub(super) fn scatter(z: &[f64], unknowns: &[u32], rhs: &mut [f64], measure: bool) -> f64 {
     if !measure {
         for (z, &u) in z.iter().zip(unknowns) {
@@ -1479,28 +1479,14 @@ pub(super) fn scatter(z: &[f64], unknowns: &[u32], rhs: &mut [f64], measure: boo
         }
         return 0.0;
     }
-    let (mut m, mut nan) = ([0.0f64; 4], false);
-    let quads = z.chunks_exact(4).zip(unknowns.chunks_exact(4));
-    for (z, u) in quads {
-        for l in 0..4 {
-            rhs[u[l] as usize] = z[l];
-            let a = z[l].abs();
-            m[l] = if a > m[l] { a } else { m[l] };
-            nan |= a.is_nan();
+    let mut largest = LargestMagnitude::default();
+    for (z, u) in z.chunks(4).zip(unknowns.chunks(4)) {
+        for (l, (&x, &u)) in z.iter().zip(u).enumerate() {
+            rhs[u as usize] = x;
+            largest.take(l, x);
         }
     }
-    let rest = z.len() - z.len() % 4;
-    for (l, (x, &u)) in z[rest..].iter().zip(&unknowns[rest..]).enumerate() {
-        rhs[u as usize] = *x;
-        let a = x.abs();
-        m[l] = if a > m[l] { a } else { m[l] };
-        nan |= a.is_nan();
-    }
-    if nan {
-        f64::NAN
-    } else {
-        m[0].max(m[1]).max(m[2].max(m[3]))
-    }
+    largest.norm()
 }
 
 impl TreeElimination {

@@ -51,6 +51,8 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
+use crate::integrators::newton::{larger_norm, LargestMagnitude};
+
 use super::{invert_in_place, lu_in_place, solve_block, Factors, TreeElimination, MAX_BLOCK};
 
 /// `$self.$method(b, nb, nc, args..)` for block `$b` of the root side, of `nb` unknowns, and its
@@ -141,31 +143,16 @@ impl TreeElimination {
                     }
                     return 0.0;
                 }
-                let (mut m, mut nan) = ([0.0f64; 4], false);
+                let mut largest = LargestMagnitude::default();
                 for (r, i) in rhs.chunks_mut(4).zip(local.chunks(4)) {
                     for (l, (r, &i)) in r.iter_mut().zip(i).enumerate() {
                         *r = z[i as usize];
-                        let a = r.abs();
-                        m[l] = if a > m[l] { a } else { m[l] };
-                        nan |= a.is_nan();
+                        largest.take(l, *r);
                     }
                 }
-                if nan {
-                    f64::NAN
-                } else {
-                    m[0].max(m[1]).max(m[2].max(m[3]))
-                }
+                largest.norm()
             })
-            .reduce(
-                || 0.0,
-                |a, b| {
-                    if a.is_nan() || b.is_nan() {
-                        f64::NAN
-                    } else {
-                        a.max(b)
-                    }
-                },
-            );
+            .reduce(|| 0.0, larger_norm);
         self.z = z;
         norm
     }
