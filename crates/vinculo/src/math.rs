@@ -95,3 +95,43 @@ pub fn scale_mat(s: f64, a: Mat3) -> Mat3 {
 pub fn is_finite(a: Vec3) -> bool {
     a.iter().all(|x| x.is_finite())
 }
+
+/// The norm of two parts from their infinity norms: the larger, NaN if either is.
+pub fn larger_norm(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
+}
+
+/// The infinity norm of values taken one at a time, in four lanes (four independent running
+/// maxima and a NaN flag, with no early exit) so that a pass that takes four consecutive
+/// values a lane each turns into vector instructions: Newton's norms, the tree elimination's
+/// solve as it writes its result, the distance of an iterate from a kept matrix's point.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct LargestMagnitude {
+    lanes: [f64; 4],
+    nan: bool,
+}
+
+impl LargestMagnitude {
+    /// Takes `x` into lane `lane` (0 to 3).
+    #[inline(always)]
+    pub fn take(&mut self, lane: usize, x: f64) {
+        let a = x.abs();
+        let m = &mut self.lanes[lane];
+        *m = if a > *m { a } else { *m };
+        self.nan |= a.is_nan();
+    }
+
+    /// The largest magnitude taken, NaN if a value was NaN.
+    pub fn norm(&self) -> f64 {
+        let m = &self.lanes;
+        if self.nan {
+            f64::NAN
+        } else {
+            m[0].max(m[1]).max(m[2].max(m[3]))
+        }
+    }
+}

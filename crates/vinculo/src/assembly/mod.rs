@@ -17,6 +17,7 @@ pub use parallel::{JacobianTerms, ParallelAssembly, ResidualTerms, MIN_TASK};
 pub use pattern::{EntryIndex, Pattern, Storage};
 pub use slot_table::SlotTable;
 
+use crate::math::LargestMagnitude;
 use crate::model::System;
 
 /// Marks an absent unknown (a fixed particle has no coordinates among the unknowns).
@@ -544,28 +545,26 @@ impl Layout {
         }
         let (x_q, x_lambda) = x.split_at(m3);
         let mut far = 0.0f64;
-        // A chunk's largest distance and whether one was beyond `cap` or not a number; four
-        // running maxima, so that the multipliers' pass is vectorised.
-        let mut take = |far_chunk: [f64; 4], beyond: bool| {
-            far = far_chunk.iter().fold(far, |m, &e| m.max(e));
-            !beyond
+        // Each chunk's largest distance; the scan ends at a chunk beyond `cap` or not a number.
+        let mut within = |chunk: LargestMagnitude| {
+            let near = chunk.norm();
+            far = far.max(near);
+            near <= cap
         };
         for (qc, dc) in q
             .chunks(DISTANCE_CHUNK)
             .zip(self.dof.chunks(DISTANCE_CHUNK))
         {
-            let (mut m, mut beyond) = ([0.0f64; 4], false);
+            let mut largest = LargestMagnitude::default();
             for (qi, &d) in qc.iter().zip(dc) {
                 if d != NONE {
                     let xi: &[f64; 3] = x_q[d..d + 3].try_into().expect("3 unknowns a particle");
                     for k in 0..3 {
-                        let e = (qi[k] - xi[k]).abs();
-                        m[k] = if e > m[k] { e } else { m[k] };
-                        beyond |= e > cap || e.is_nan();
+                        largest.take(k, qi[k] - xi[k]);
                     }
                 }
             }
-            if !take(m, beyond) {
+            if !within(largest) {
                 return f64::INFINITY;
             }
         }
@@ -574,13 +573,11 @@ impl Layout {
             .zip(scales.chunks(DISTANCE_CHUNK))
             .zip(x_lambda.chunks(DISTANCE_CHUNK));
         for ((lc, sc), xc) in chunks {
-            let (mut m, mut beyond) = ([0.0f64; 4], false);
+            let mut largest = LargestMagnitude::default();
             for (j, ((l, s), xk)) in lc.iter().zip(sc).zip(xc).enumerate() {
-                let e = (l * sigma / s - xk).abs();
-                m[j % 4] = if e > m[j % 4] { e } else { m[j % 4] };
-                beyond |= e > cap || e.is_nan();
+                largest.take(j % 4, l * sigma / s - xk);
             }
-            if !take(m, beyond) {
+            if !within(largest) {
                 return f64::INFINITY;
             }
         }

@@ -101,6 +101,8 @@
 
 use rayon::prelude::*;
 
+use crate::math::{larger_norm, LargestMagnitude};
+
 use crate::linear::{assemble_and_factor, LinearSolver, Singular};
 
 /// Options of the Newton loop.
@@ -337,46 +339,6 @@ pub(crate) fn inf_norm(x: &[f64]) -> f64 {
     x.par_chunks(1 << 16)
         .map(inf_norm_serial)
         .reduce(|| 0.0, larger_norm)
-}
-
-/// The norm of two parts from their infinity norms: the larger, NaN if either is.
-pub(crate) fn larger_norm(a: f64, b: f64) -> f64 {
-    if a.is_nan() || b.is_nan() {
-        f64::NAN
-    } else {
-        a.max(b)
-    }
-}
-
-/// The infinity norm of values taken one at a time, in four lanes (four independent running
-/// maxima and a NaN flag, with no early exit) so that a pass that takes four consecutive
-/// values a lane each turns into vector instructions: [`inf_norm`], and the tree elimination's
-/// solve as it writes its result.
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct LargestMagnitude {
-    lanes: [f64; 4],
-    nan: bool,
-}
-
-impl LargestMagnitude {
-    /// Takes `x` into lane `lane` (0 to 3).
-    #[inline(always)]
-    pub(crate) fn take(&mut self, lane: usize, x: f64) {
-        let a = x.abs();
-        let m = &mut self.lanes[lane];
-        *m = if a > *m { a } else { *m };
-        self.nan |= a.is_nan();
-    }
-
-    /// The largest magnitude taken, NaN if a value was NaN.
-    pub(crate) fn norm(&self) -> f64 {
-        let m = &self.lanes;
-        if self.nan {
-            f64::NAN
-        } else {
-            m[0].max(m[1]).max(m[2].max(m[3]))
-        }
-    }
 }
 
 /// [`inf_norm`] on this thread. Four independent running maxima and a NaN flag, with no early

@@ -147,7 +147,7 @@ pub use two_sided::TWO_SIDED_FROM;
 use super::block_slots::{BlockSlots, ABSENT};
 use super::{LinearSolver, Singular, SparseLu, Stored};
 use crate::assembly::{Pattern, Storage};
-use crate::integrators::newton::LargestMagnitude;
+use crate::math::LargestMagnitude;
 
 /// Smallest pivot of a block that the elimination accepts, relative to the sum of the
 /// magnitudes of the terms it was computed from (the block's entry and the products the

@@ -51,7 +51,7 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
-use crate::integrators::newton::{larger_norm, LargestMagnitude};
+use crate::math::{larger_norm, LargestMagnitude};
 
 use super::{invert_in_place, lu_in_place, solve_block, Factors, TreeElimination, MAX_BLOCK};
 
