@@ -332,6 +332,7 @@ const PARALLEL_NORM_FROM: usize = 1 << 20;
 
 /// The infinity norm of `x`, NaN if any entry is NaN: chunks on rayon's pool for long vectors
 /// (the same number: the largest entry does not depend on the order).
+#[inline]
 pub(crate) fn inf_norm(x: &[f64]) -> f64 {
     if x.len() < PARALLEL_NORM_FROM {
         return inf_norm_serial(x);
@@ -343,6 +344,7 @@ pub(crate) fn inf_norm(x: &[f64]) -> f64 {
 
 /// [`inf_norm`] on this thread. Four independent running maxima and a NaN flag, with no early
 /// exit, so that the compiler turns the pass into vector instructions.
+#[inline]
 fn inf_norm_serial(x: &[f64]) -> f64 {
     if x.len() < 8 {
         // A small system (a pendulum's four unknowns): one running maximum, without the
