@@ -799,13 +799,7 @@ mod tests {
         at.iter()
             .zip(x)
             .map(|(a, b)| (a - b).abs())
-            .fold(0.0, |m, e| {
-                if m.is_nan() || e.is_nan() {
-                    f64::NAN
-                } else {
-                    m.max(e)
-                }
-            })
+            .fold(0.0, crate::math::larger_norm)
     }
 
     /// The distance of a model's unknowns from a point (the kept matrix's), serial and on the

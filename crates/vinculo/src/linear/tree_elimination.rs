@@ -1472,7 +1472,7 @@ impl TreeElimination {
 
 /// Puts `z` (in the blocks' order) back into `rhs` at `unknowns`, and returns the infinity norm
 /// of `z` when `measure` (NaN where an entry is NaN; else 0), taken in the same pass.
-pub(super) fn scatter(z: &[f64], unknowns: &[u32], rhs: &mut [f64], measure: bool) -> f64 {
+fn scatter(z: &[f64], unknowns: &[u32], rhs: &mut [f64], measure: bool) -> f64 {
     if !measure {
         for (z, &u) in z.iter().zip(unknowns) {
             rhs[u as usize] = *z;
