@@ -65,6 +65,10 @@ pub struct Layout {
     pub force_offsets: ElementOffsets,
     /// Per force and ordered pair (a, b) of its particles: the block of its Jacobian.
     pub force_block: SlotTable<9>,
+    /// Where the slots were moved ([`Layout::move_slots`]): the pattern's entry of slot s is
+    /// assembled at `moved_to[s]`, in a solver's own storage (empty: at s, in the pattern's
+    /// value array; or moved after the pattern's structure was released).
+    pub moved_to: Vec<Slot>,
 }
 
 impl Layout {
@@ -202,18 +206,18 @@ impl Layout {
             constraint_diagonal,
             force_offsets,
             force_block: force_block.into(),
+            moved_to: Vec::new(),
         }
     }
 
     /// Moves every slot of the tables to `map[slot]`: the matrix is then assembled into another
     /// array, where the pattern's entry of slot s lies at `map[s]` (a solver's own storage, see
-    /// [`crate::linear::TreeElimination::assemble_in_place`]). The pattern's structure must have
-    /// been released: it no longer describes where the values are.
+    /// [`crate::linear::TreeElimination::assemble_in_place`]). A pattern whose structure is
+    /// kept keeps the map too ([`Layout::moved_to`]), to find its entries there.
     pub fn move_slots(&mut self, map: &[Slot]) {
-        assert!(
-            self.pattern.is_released(),
-            "the slots move only once the pattern's structure is released"
-        );
+        if !self.pattern.is_released() {
+            self.moved_to = map.to_vec();
+        }
         let moved = |s: &mut Slot| {
             if *s != NO_SLOT {
                 *s = map[*s as usize];

@@ -127,6 +127,50 @@ impl<'a, R: Index3Rule> StepProblem<'a, R> {
         }
     }
 
+    /// Assembles the scaled Jacobian at the current iterate into `values` (zeroed by the
+    /// caller), at the layout's slots.
+    fn assemble_jacobian(&self, values: &mut [f64]) {
+        let b = &*self.buffers;
+        let (q_eval, v_eval) = Self::eval_point(b);
+        let rule = &self.rule;
+        let point = self.point;
+        let (force_dq, force_dv, hessian) = rule.weights(point.sigma);
+        let terms = JacobianTerms {
+            q_eval,
+            v_eval,
+            t_eval: point.t_eval,
+            q_end: &b.q,
+            t_end: point.t_end,
+            force_dq,
+            force_dv,
+            hessian,
+            sigma: point.sigma,
+            lambda: &b.lambda,
+            scales: self.scales,
+            end_weight: -rule.weights(point.sigma).2 / point.sigma,
+            start_phi: &b.start_phi,
+            slack: R::SLACK,
+        };
+        let inertia = self.inertia;
+        let mass = |i: usize| rule.mass_diagonal(point.sigma, inertia[i]);
+        match self.parallel.as_deref() {
+            Some(parallel) => parallel.jacobian(self.system, self.layout, &terms, values, mass),
+            None => self.layout.jacobian(self.system, &terms, values, mass),
+        }
+        if !self.axial.is_empty() {
+            let layout = self.layout;
+            let diagonal = |i| layout.particle_block.get(i);
+            let force_row = |k, n, f: &mut BlockVisit| {
+                let pairs = layout.force_offsets.pairs(k);
+                layout.force_block.with(k, pairs.start..pairs.start + n, f)
+            };
+            let weights = (q_eval, rule.mass_diagonal(point.sigma, 1.0), force_dq);
+            let qdd = |i: usize| acceleration(rule, b, i);
+            self.axial
+                .add_jacobian(values, (diagonal, force_row), weights, qdd);
+        }
+    }
+
     /// Positions and velocities of the evaluation point in the buffers `b`.
     fn eval_point(b: &StepBuffers) -> (&[Vec3], &[Vec3]) {
         if R::AT_END {
@@ -186,45 +230,7 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
     }
 
     fn jacobian(&mut self, values: &mut [f64]) {
-        let b = &*self.buffers;
-        let (q_eval, v_eval) = Self::eval_point(b);
-        let rule = &self.rule;
-        let point = self.point;
-        let (force_dq, force_dv, hessian) = rule.weights(point.sigma);
-        let terms = JacobianTerms {
-            q_eval,
-            v_eval,
-            t_eval: point.t_eval,
-            q_end: &b.q,
-            t_end: point.t_end,
-            force_dq,
-            force_dv,
-            hessian,
-            sigma: point.sigma,
-            lambda: &b.lambda,
-            scales: self.scales,
-            end_weight: -rule.weights(point.sigma).2 / point.sigma,
-            start_phi: &b.start_phi,
-            slack: R::SLACK,
-        };
-        let inertia = self.inertia;
-        let mass = |i: usize| rule.mass_diagonal(point.sigma, inertia[i]);
-        match self.parallel.as_deref() {
-            Some(parallel) => parallel.jacobian(self.system, self.layout, &terms, values, mass),
-            None => self.layout.jacobian(self.system, &terms, values, mass),
-        }
-        if !self.axial.is_empty() {
-            let layout = self.layout;
-            let diagonal = |i| layout.particle_block.get(i);
-            let force_row = |k, n, f: &mut BlockVisit| {
-                let pairs = layout.force_offsets.pairs(k);
-                layout.force_block.with(k, pairs.start..pairs.start + n, f)
-            };
-            let weights = (q_eval, rule.mass_diagonal(point.sigma, 1.0), force_dq);
-            let qdd = |i: usize| acceleration(rule, b, i);
-            self.axial
-                .add_jacobian(values, (diagonal, force_row), weights, qdd);
-        }
+        self.assemble_jacobian(values);
     }
 
     fn update(&mut self, dx: &[f64]) {
@@ -240,12 +246,34 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
     }
 
     /// `ROUND_OFF_ULPS eps max_i sum_j |J_ij| |x_j|` over the scaled unknowns: positions (m) and
-    /// multipliers `lambda sigma / s` (0 when the pattern's structure was released).
+    /// multipliers `lambda sigma / s`, with J the matrix `values` in the pattern's order; a
+    /// matrix assembled into the solver's storage (which holds its factors by now) is assembled
+    /// again at the iterate, into an array of its own read through [`Layout::moved_to`] (0 when
+    /// the pattern's structure was released).
     fn round_off(&self, values: &[f64]) -> f64 {
-        let pattern = &self.layout.pattern;
-        if pattern.is_released() || values.len() != pattern.nnz() {
+        let (pattern, moved) = (&self.layout.pattern, &self.layout.moved_to);
+        if pattern.is_released() {
             return 0.0;
         }
+        let again;
+        let matrix: &[f64] = if !moved.is_empty() {
+            let len = moved.iter().max().map_or(0, |&s| s as usize + 1);
+            let mut assembled = vec![0.0; len];
+            self.assemble_jacobian(&mut assembled);
+            again = assembled;
+            &again
+        } else if values.len() == pattern.nnz() {
+            values
+        } else {
+            return 0.0;
+        };
+        let at = |k: usize| {
+            if moved.is_empty() {
+                k
+            } else {
+                moved[k] as usize
+            }
+        };
         let b = &*self.buffers;
         let mut x = vec![0.0; pattern.n];
         let (scales, sigma) = (self.scales, self.point.sigma);
@@ -253,12 +281,11 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
             .scaled_unknowns(&b.q, &b.lambda, scales, sigma, &mut x);
         let mut rows = vec![0.0f64; pattern.n];
         for (row, col, k) in pattern.entries() {
-            rows[row] += values[k].abs() * x[col].abs();
+            rows[row] += matrix[at(k)].abs() * x[col].abs();
         }
         let largest = rows.iter().fold(0.0f64, |m, r| m.max(*r));
         super::newton::ROUND_OFF_ULPS * f64::EPSILON * largest
     }
-
     fn round_off_reach(&self) -> f64 {
         R::ROUND_OFF_REACH
     }
@@ -350,6 +377,14 @@ mod tests {
     use crate::integrators::{GeneralizedAlpha, GeneralizedTrapezoidal};
     use crate::linear::SparseSolver;
 
+    /// A workspace whose matrix is assembled in the pattern's order (read by its entries, as
+    /// the checks below do), with the sparse solver `solver`.
+    fn gathered(s: &System, dense_limit: usize, solver: SparseSolver) -> StepWorkspace {
+        super::super::workspace::tests::in_pattern_order(|| {
+            StepWorkspace::with_solver(s, dense_limit, solver)
+        })
+    }
+
     /// The residual and Jacobian of a step of `rule` (h = 0.01 from t_n = 0.3) at the
     /// workspace's iterate.
     /// The parallel assembly of `rule`'s step gives the serial one's residual and Jacobian at a
@@ -357,7 +392,7 @@ mod tests {
     fn assert_parallel_assembly_is_serial<T: TimeRule + Copy>(s: &System, rule: T) {
         let q_n = s.initial_positions();
         let run = |parallel: bool| {
-            let mut ws = StepWorkspace::new(s, 48);
+            let mut ws = gathered(s, 48, SparseSolver::Auto);
             if parallel {
                 ws.assemble_in_parallel_from(s, 0);
             }
@@ -425,6 +460,43 @@ mod tests {
         state
     }
 
+    /// A tree's matrix assembled into the elimination's storage (the default, with the
+    /// pattern's structure kept) gives the round-off of the residual that the same matrix in
+    /// the pattern's order gives, bit for bit (the same sums of the same entries, read through
+    /// `Layout::moved_to`), and not zero: a line in water and a chain at a wiggled iterate.
+    #[test]
+    fn round_off_reads_a_matrix_assembled_in_place() {
+        for (name, s) in [("line in water", line_in_water()), ("chain", chain(40))] {
+            let (q_n, v_n) = (s.initial_positions(), s.initial_velocities());
+            let round_off = |mut ws: StepWorkspace| {
+                wiggled_iterate(&mut ws, &q_n);
+                let mut state = alpha_state(q_n.len());
+                let rule = GeneralizedAlpha { rho_inf: 0.6 };
+                let (mut problem, work) =
+                    problem_at(rule, &s, &mut ws, &mut state, start(&q_n, &v_n));
+                problem.residual(work.r);
+                let jacobian = |values: &mut [f64]| problem.jacobian(values);
+                crate::linear::assemble_and_factor(work.solver, work.values, jacobian).unwrap();
+                problem.round_off(work.values)
+            };
+            let ws = StepWorkspace::new(&s, 48);
+            assert!(
+                ws.solver.in_place() && !ws.layout.moved_to.is_empty(),
+                "{name}"
+            );
+            let (in_place, gathered) = (
+                round_off(ws),
+                round_off(gathered(&s, 48, SparseSolver::Auto)),
+            );
+            assert!(in_place > 0.0, "{name}");
+            assert_eq!(
+                in_place.to_bits(),
+                gathered.to_bits(),
+                "{name}: {in_place:e} {gathered:e}"
+            );
+        }
+    }
+
     /// Parallel assembly (forced by a zero threshold) gives the serial residual and Jacobian,
     /// on a chain and a cloth large enough to be split among threads, on the system with
     /// every constraint and force kind and on a line in water (whose node elements the serial
@@ -441,7 +513,7 @@ mod tests {
         ] {
             let q_n = s.initial_positions();
             let run = |parallel: bool, trapezoidal: bool| {
-                let mut ws = StepWorkspace::new(&s, 48);
+                let mut ws = gathered(&s, 48, SparseSolver::Auto);
                 if parallel {
                     ws.assemble_in_parallel_from(&s, 0);
                     let colours = ws.parallel.as_ref().unwrap().constraint_colours();
@@ -535,7 +607,7 @@ mod tests {
         let (q_n, v_n) = (s.initial_positions(), s.initial_velocities());
         for &(dense_limit, solver) in solvers {
             let workspace = || {
-                let mut ws = StepWorkspace::with_solver(s, dense_limit, solver);
+                let mut ws = gathered(s, dense_limit, solver);
                 perturbed_iterate(&mut ws, &q_n);
                 ws.state.lambda.truncate(multipliers);
                 ws
@@ -656,7 +728,7 @@ mod tests {
         let q_n = s.initial_positions();
         for dense_limit in [0, 1000] {
             let workspace = || {
-                let mut ws = StepWorkspace::with_solver(&s, dense_limit, SparseSolver::SparseLu);
+                let mut ws = gathered(&s, dense_limit, SparseSolver::SparseLu);
                 perturbed_iterate(&mut ws, &q_n);
                 ws
             };
@@ -697,7 +769,7 @@ mod tests {
         ];
         for (dense_limit, solver) in solvers {
             let workspace = || {
-                let mut ws = StepWorkspace::with_solver(&s, dense_limit, solver);
+                let mut ws = gathered(&s, dense_limit, solver);
                 perturbed_iterate(&mut ws, &q_n);
                 ws
             };
