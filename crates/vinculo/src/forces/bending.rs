@@ -46,6 +46,7 @@ impl Bending {
         std::array::from_fn(|k| q[a][k] - 2.0 * q[b][k] + q[c][k])
     }
 
+    #[inline]
     pub(crate) fn force(&self, q: &[Vec3], _v: &[Vec3], _t: f64) -> [Vec3; 3] {
         let d = self.difference(q);
         WEIGHTS.map(|w| scale(-self.stiffness * w, d))

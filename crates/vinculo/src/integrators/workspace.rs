@@ -146,14 +146,21 @@ impl StepWorkspace {
                     if let Some(from) = two_sided_override() {
                         tree.two_sided_from(from);
                     }
-                    // Trees are assembled into the elimination's own storage, whose layout is
-                    // the blocks': no matrix in the pattern's order is kept nor gathered from
-                    // at each factorisation (a step of a swinging chain of 1,000 particles
-                    // 256-260 -> 218-223 us, of 10^4 3.32-3.35 -> 2.92-2.95 ms). A large
-                    // pattern's structure is released first; a small one's is kept, to read
-                    // the matrix by its entries where it is needed (`Layout::moved_to`).
-                    if in_place {
-                        if layout.pattern.nnz() > above {
+                    // Chains whose blocks couple with their parent alone are assembled into
+                    // the elimination's own storage, whose layout is the blocks': no matrix in
+                    // the pattern's order is kept nor gathered from at each factorisation (a
+                    // step of a swinging chain of 1,000 particles 235-238 -> 204-209 us, of
+                    // 10^4 3.06-3.09 -> 2.68-2.72 ms). Trees with fill (a line's bending)
+                    // keep the matrix in the pattern's order below the release threshold:
+                    // held, it gives Newton's round-off floor, which a matrix factorised in
+                    // place has to assemble again (a cable of 1,000 segments at 0.1 s steps,
+                    // at its floor at every step, took 0.49 s in place against 0.39-0.40 s).
+                    // A large pattern's structure is released first; a small one's is kept,
+                    // to read the matrix by its entries where it is needed
+                    // (`Layout::moved_to`).
+                    let large = layout.pattern.nnz() > above;
+                    if in_place && (large || tree.coupled_ancestors() <= 1) {
+                        if large {
                             layout.pattern.release_structure();
                         }
                         layout.move_slots(&tree.assemble_in_place());
