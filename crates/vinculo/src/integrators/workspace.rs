@@ -150,11 +150,13 @@ impl StepWorkspace {
                     // the elimination's own storage, whose layout is the blocks': no matrix in
                     // the pattern's order is kept nor gathered from at each factorisation (a
                     // step of a swinging chain of 1,000 particles 235-238 -> 204-209 us, of
-                    // 10^4 3.06-3.09 -> 2.68-2.72 ms). Trees with fill (a line's bending)
-                    // keep the matrix in the pattern's order below the release threshold:
-                    // held, it gives Newton's round-off floor, which a matrix factorised in
-                    // place has to assemble again (a cable of 1,000 segments at 0.1 s steps,
-                    // at its floor at every step, took 0.49 s in place against 0.39-0.40 s).
+                    // 10^4 3.06-3.09 -> 2.68-2.72 ms, of 10^5 42-43 -> 27 ms: its elimination
+                    // from both ends gathered every block on one thread first). Trees with
+                    // fill (a line's bending) keep the matrix in the pattern's order below the
+                    // release threshold: held, it gives Newton's round-off floor, which a
+                    // matrix factorised in place has to assemble again (a cable of 1,000
+                    // segments at 0.1 s steps, at its floor at every step, took 0.49 s in
+                    // place against 0.39-0.40 s).
                     // A large pattern's structure is released first; a small one's is kept,
                     // to read the matrix by its entries where it is needed
                     // (`Layout::moved_to`).
