@@ -286,6 +286,7 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
         let largest = rows.iter().fold(0.0f64, |m, r| m.max(*r));
         super::newton::ROUND_OFF_ULPS * f64::EPSILON * largest
     }
+
     fn round_off_reach(&self) -> f64 {
         R::ROUND_OFF_REACH
     }
@@ -460,7 +461,7 @@ mod tests {
         state
     }
 
-    /// A tree's matrix assembled into the elimination's storage (the default, with the
+    /// A chain's matrix assembled into the elimination's storage (the default, with the
     /// pattern's structure kept) gives the round-off of the residual that the same matrix in
     /// the pattern's order gives, bit for bit (the same sums of the same entries, read through
     /// `Layout::moved_to`), and not zero: a line in water and a chain at a wiggled iterate.

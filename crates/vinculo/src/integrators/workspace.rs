@@ -13,9 +13,9 @@ use super::newton::IterationMatrix;
 /// slot tables' periodic runs compressed ([`Layout::compress_slots`]).
 pub const RELEASE_PATTERN_ABOVE: usize = 1 << 22;
 
-/// The release threshold, and whether tree eliminations are assembled in place (at every size;
-/// tests set them for a thread, to run small models as large ones or to keep the matrix in the
-/// pattern's order).
+/// The release threshold, and whether tree eliminations are assembled in place (chains at every
+/// size, the other trees above the threshold; tests set them for a thread, to run small models
+/// as large ones or to keep the matrix in the pattern's order).
 fn assembly_settings() -> (usize, bool) {
     #[cfg(test)]
     if let Some(set) = tests::RELEASE.with(|r| r.get()) {
@@ -156,10 +156,9 @@ impl StepWorkspace {
                     // release threshold: held, it gives Newton's round-off floor, which a
                     // matrix factorised in place has to assemble again (a cable of 1,000
                     // segments at 0.1 s steps, at its floor at every step, took 0.49 s in
-                    // place against 0.39-0.40 s).
-                    // A large pattern's structure is released first; a small one's is kept,
-                    // to read the matrix by its entries where it is needed
-                    // (`Layout::moved_to`).
+                    // place against 0.39-0.40 s). A large pattern's structure is released
+                    // first; a small one's is kept, to read the matrix by its entries where it
+                    // is needed (`Layout::moved_to`).
                     let large = layout.pattern.nnz() > above;
                     if in_place && (large || tree.coupled_ancestors() <= 1) {
                         if large {
