@@ -290,7 +290,8 @@ impl Layout {
         let n = f.particles().len();
         dq.reset(n);
         dv.reset(n);
-        f.add_jacobian(at.q_eval, at.v_eval, at.t_eval, dq, dv);
+        let point = &at.point;
+        f.add_jacobian(point.q_eval, point.v_eval, point.t_eval, dq, dv);
         // The rows of the particles the force acts on come first (x-major blocks); the others
         // are zero (a line node's neighbours) and have no slots.
         let acting = f.acting() * n;
@@ -320,30 +321,33 @@ impl Layout {
         ),
         at: &JacobianTerms<'_>,
     ) {
-        let s = at.scales[c];
-        let w = at.hessian * at.lambda[c];
+        let point = &at.point;
+        let s = point.scales[c];
+        let w = at.hessian * point.lambda[c];
         // A compliant row (`docs/theory/moorings.md`) weights Phi(q_end) by w = dq_e/dq, the
         // Hessian term's weight over -sigma, and has its compliance in its own column,
         // d(s c lambda)/d(lambda sigma / s).
         let row = if con.is_compliant() {
-            let compliance = con.compliance_at(at.t_eval, at.lambda[c]);
-            values.add(self.constraint_diagonal[c], s * s * compliance / at.sigma);
+            let compliance = con.compliance_at(point.t_eval, point.lambda[c]);
+            let diagonal = s * s * compliance / point.sigma;
+            values.add(self.constraint_diagonal[c], diagonal);
             if at.is_slack(con, c) {
                 0.0
             } else {
-                s * (-at.hessian / at.sigma)
+                s * (-at.hessian / point.sigma)
             }
         } else {
             s
         };
-        con.with_hessian_and_gradient((at.q_eval, at.t_eval), w, buffer, |hess, grad_eval| {
+        let eval = (point.q_eval, point.t_eval);
+        con.with_hessian_and_gradient(eval, w, buffer, |hess, grad_eval| {
             // A damped segment's damping force (`constraints/elastic_distance.rs`) has its
             // derivatives in the same four blocks as the Hessian term.
             let damped;
             let hess = match con.damped_segment() {
                 Some(segment) => {
                     let weights = (at.force_dq, at.force_dv);
-                    let mut blocks = segment.damping_blocks(at.q_eval, at.v_eval, weights);
+                    let mut blocks = segment.damping_blocks(point.q_eval, point.v_eval, weights);
                     for (b, h) in blocks.iter_mut().zip(hess) {
                         *b = crate::math::add_mat(*b, *h);
                     }
@@ -352,11 +356,11 @@ impl Layout {
                 }
                 None => hess,
             };
-            if at.same_point() {
+            if point.same_point() {
                 let grads = (grad_eval, grad_eval);
                 self.add_constraint_blocks_weighted(values, (c, hess), (s, row), grads);
             } else {
-                con.with_gradient(at.q_end, at.t_end, |grad_end| {
+                con.with_gradient(point.q_end, point.t_end, |grad_end| {
                     let grads = (grad_eval, grad_end);
                     self.add_constraint_blocks_weighted(values, (c, hess), (s, row), grads);
                 });

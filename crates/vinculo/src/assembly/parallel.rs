@@ -100,37 +100,18 @@ pub struct ResidualTerms<'a> {
     pub slack: bool,
 }
 
-/// Where and with which weights one step's Jacobian is evaluated (besides the mass block).
+/// Where and with which weights one step's Jacobian is evaluated (besides the mass block): at
+/// the residual's point, with the weights of the forces' and constraints' derivatives.
 pub struct JacobianTerms<'a> {
-    /// Positions at which forces, Hessians and the -Phi_q^T columns are evaluated.
-    pub q_eval: &'a [Vec3],
-    /// Velocities of the evaluation point.
-    pub v_eval: &'a [Vec3],
-    /// Time of the evaluation point.
-    pub t_eval: f64,
-    /// Positions of the Phi_q rows (the step's end).
-    pub q_end: &'a [Vec3],
-    /// Time of the Phi_q rows.
-    pub t_end: f64,
+    /// The point and scales of the residual whose Jacobian this is: forces, Hessians and the
+    /// -Phi_q^T columns at its evaluation point, the Phi_q rows at the step's end.
+    pub point: ResidualTerms<'a>,
     /// Weight of df/dq.
     pub force_dq: f64,
     /// Weight of df/dv.
     pub force_dv: f64,
     /// Weight of lambda_k d2Phi_k/dq2.
     pub hessian: f64,
-    /// Scale of the dynamics rows (the multipliers' unknowns are lambda sigma / s).
-    pub sigma: f64,
-    /// Multipliers.
-    pub lambda: &'a [f64],
-    /// Scale of each constraint row.
-    pub scales: &'a [f64],
-    /// w = dq_e/dq, as in [`ResidualTerms`].
-    pub end_weight: f64,
-    /// Phi_k(q_n, t_n) of each compliant constraint at the step's start, as in
-    /// [`ResidualTerms`].
-    pub start_phi: &'a [f64],
-    /// As in [`ResidualTerms`].
-    pub slack: bool,
 }
 
 /// The stretch measure of compliant constraint `c`'s row, w Phi(q_end, t_end) + (1 - w)
@@ -190,19 +171,15 @@ impl JacobianTerms<'_> {
     /// True when compliant constraint `c` (`con`) is a slack segment shorter than its length
     /// at this iterate: its row then does not depend on the positions ([`ResidualTerms::row`]).
     pub fn is_slack(&self, con: &crate::constraints::Constraint, c: usize) -> bool {
-        self.slack
+        let at = &self.point;
+        at.slack
             && con.can_slack()
             && stretch_row(
-                self.end_weight,
-                self.start_phi,
+                at.end_weight,
+                at.start_phi,
                 c,
-                con.residual(self.q_end, self.t_end),
+                con.residual(at.q_end, at.t_end),
             ) > 0.0
-    }
-
-    /// True when the Phi_q rows are evaluated where the -Phi_q^T columns are.
-    pub fn same_point(&self) -> bool {
-        std::ptr::eq(self.q_eval, self.q_end) && self.t_eval.to_bits() == self.t_end.to_bits()
     }
 }
 

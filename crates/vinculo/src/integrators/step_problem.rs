@@ -131,25 +131,15 @@ impl<'a, R: Index3Rule> StepProblem<'a, R> {
     /// caller), at the layout's slots.
     fn assemble_jacobian(&self, values: &mut [f64]) {
         let b = &*self.buffers;
-        let (q_eval, v_eval) = Self::eval_point(b);
+        let (q_eval, _) = Self::eval_point(b);
         let rule = &self.rule;
         let point = self.point;
         let (force_dq, force_dv, hessian) = rule.weights(point.sigma);
         let terms = JacobianTerms {
-            q_eval,
-            v_eval,
-            t_eval: point.t_eval,
-            q_end: &b.q,
-            t_end: point.t_end,
+            point: Self::residual_terms(b, (rule, point), self.scales),
             force_dq,
             force_dv,
             hessian,
-            sigma: point.sigma,
-            lambda: &b.lambda,
-            scales: self.scales,
-            end_weight: -rule.weights(point.sigma).2 / point.sigma,
-            start_phi: &b.start_phi,
-            slack: R::SLACK,
         };
         let inertia = self.inertia;
         let mass = |i: usize| rule.mass_diagonal(point.sigma, inertia[i]);
@@ -168,6 +158,30 @@ impl<'a, R: Index3Rule> StepProblem<'a, R> {
             let qdd = |i: usize| acceleration(rule, b, i);
             self.axial
                 .add_jacobian(values, (diagonal, force_row), weights, qdd);
+        }
+    }
+
+    /// Where the step's residual is evaluated, and its weights, from the buffers `b`: the
+    /// evaluation point and the step's end, the scales of the rows and the multipliers (also
+    /// the point of its Jacobian).
+    fn residual_terms<'b>(
+        b: &'b StepBuffers,
+        (rule, point): (&R, StepPoint),
+        scales: &'b [f64],
+    ) -> ResidualTerms<'b> {
+        let (q_eval, v_eval) = Self::eval_point(b);
+        ResidualTerms {
+            q_eval,
+            v_eval,
+            t_eval: point.t_eval,
+            q_end: &b.q,
+            t_end: point.t_end,
+            sigma: point.sigma,
+            lambda: &b.lambda,
+            scales,
+            end_weight: -rule.weights(point.sigma).2 / point.sigma,
+            start_phi: &b.start_phi,
+            slack: R::SLACK,
         }
     }
 
@@ -190,21 +204,9 @@ impl<R: Index3Rule> NewtonProblem for StepProblem<'_, R> {
     fn residual(&mut self, r: &mut [f64]) {
         self.kinematics();
         let b = &*self.buffers;
-        let (q_eval, v_eval) = Self::eval_point(b);
+        let (q_eval, _) = Self::eval_point(b);
         let (rule, point) = (&self.rule, self.point);
-        let terms = ResidualTerms {
-            q_eval,
-            v_eval,
-            t_eval: point.t_eval,
-            q_end: &b.q,
-            t_end: point.t_end,
-            sigma: point.sigma,
-            lambda: &b.lambda,
-            scales: self.scales,
-            end_weight: -rule.weights(point.sigma).2 / point.sigma,
-            start_phi: &b.start_phi,
-            slack: R::SLACK,
-        };
+        let terms = Self::residual_terms(b, (rule, point), self.scales);
         let (system, layout, inertia) = (self.system, self.layout, self.inertia);
         let g = system.gravity();
         let row = Rows {
