@@ -235,8 +235,10 @@ impl LineHydro {
         let (cn, ca) = self.drag_factors();
         let drag = match &tangent {
             Some(tg) => {
-                let ra = scale(dot(tg.t, r), tg.t);
-                add(quadratic(cn, sub(r, ra)), quadratic(ca, ra))
+                // |r_a| = |t . r| (t a unit vector): no square root for the axial part.
+                let along = dot(tg.t, r);
+                let ra = scale(along, tg.t);
+                add(quadratic(cn, sub(r, ra)), scale(ca * along.abs(), ra))
             }
             None => quadratic(cn, r),
         };
@@ -367,7 +369,8 @@ impl LineHydro {
                 let along = dot(t, r);
                 let ra = scale(along, t);
                 let dn = quadratic_derivative(cn, sub(r, ra));
-                let da = quadratic_derivative(ca, ra);
+                // d(c |r_a| r_a)/dr_a with r_a = (t . r) t: c |t . r| (I + t t^T).
+                let da = scale_mat(ca * along.abs(), add_mat(diag(1.0), outer(1.0, t, t)));
                 let m = add_mat(da, scale_mat(-1.0, dn));
                 let mt = mat_vec(&m, t);
                 let mut df_dt = add_mat(outer(1.0, mt, r), scale_mat(along, m));
