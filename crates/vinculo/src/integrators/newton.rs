@@ -50,14 +50,14 @@
 //! inverse applied to that round-off, 1e-5 to 2e-4 in the multipliers and 1e-10 in the
 //! positions, of sizes that scatter from one to the next. The test above waits for a fresh
 //! increment above 0.9 of the one before, which such a scatter meets at random: a step of 400
-//! bodies took 7.5 residuals and 2.8 factorisations. So the loop also stops, converged, where
+//! bodies took 7.6 residuals and 2.8 factorisations. So the loop also stops, converged, where
 //! the residual is within the tolerance, at its own round-off ([`NewtonProblem::round_off`])
 //! and not halved by the last increment, made with a matrix factorised in this solve at that
 //! iterate or the one before ([`FLOOR_STAGNATION`]): no increment can then make the residual
 //! smaller, and the iterate is the one the first test would have stopped at, as far from the
 //! solution as the arithmetic lets it be. A Newton step still converging cuts the residual by
-//! far more than half. The 400 bodies: 5.1 residuals and 1.9 factorisations a step, a fourth
-//! less time (`vinculo.bench.rigid_chain`, `docs/guide/benchmarks.md`).
+//! far more than half. The 400 bodies: 5.7 residuals and 2.2 factorisations a step, 22 % less
+//! time (`vinculo.bench.rigid_chain`, `docs/guide/benchmarks.md`).
 //!
 //! # Reuse while the matrix contracts fast (the default)
 //!
