@@ -488,7 +488,11 @@ fn place_constraint<V: Entries + ?Sized>(
     (grad_column, grad_row): Grads<'_>,
 ) {
     for (b, m) in blocks.iter().zip(hess) {
-        values.add_block(b, 1.0, m);
+        // An element over many particles (a joint's equation over the particles of two
+        // bodies) has mostly zero blocks: skipped, not added entry by entry.
+        if m.iter().any(|r| r.iter().any(|&x| x != 0.0)) {
+            values.add_block(b, 1.0, m);
+        }
     }
     for (x, (column, row)) in columns.iter().zip(rows).enumerate() {
         for k in 0..3 {

@@ -132,12 +132,18 @@ impl Constraint {
     /// the built-in kinds hand over their gradients from the stack, whatever their size.
     #[inline(always)]
     pub fn with_gradient<R>(&self, q: &[Vec3], t: f64, use_it: impl FnOnce(&[Vec3]) -> R) -> R {
-        use_it(&self.gradient_rows(q, t))
+        match self {
+            // Over points (a joint's equation): the rows on the stack, not in a Vec.
+            Constraint::OnPoints(c) => c.with_residual_and_gradient(q, t, |_, g| use_it(g)),
+            other => use_it(&other.gradient_rows(q, t)),
+        }
     }
 
     /// Calls `use_it(hessian, gradient)` with `w` times d2Phi/dq2 (n x n blocks, x-major) and
     /// dPhi/dq at (q, t): the Jacobian's constraint terms in one dispatch. A distance hands
-    /// both over from the stack; the other kinds fill `buffer` with their Hessian.
+    /// both over from the stack; the other kinds fill `buffer` with their Hessian, except a
+    /// constraint over points whose Hessian is zero, which hands over no blocks (an empty
+    /// slice: nothing to add).
     #[inline(always)]
     pub fn with_hessian_and_gradient<R>(
         &self,
@@ -149,6 +155,7 @@ impl Constraint {
         match self {
             Constraint::Distance(c) => use_it(&c.hessian(w), &c.gradient(q, t)),
             Constraint::ElasticDistance(c) => use_it(&c.hessian(q, w), &c.gradient(q, t)),
+            Constraint::OnPoints(c) => c.with_hessian_and_gradient((q, t), w, buffer, use_it),
             other => {
                 buffer.reset(other.particles().len());
                 other.add_hessian(q, t, w, buffer);
@@ -190,6 +197,8 @@ impl Constraint {
                 let (phi, g) = c.residual_and_gradient(q, t);
                 use_it(phi, &g)
             }
+            // And mechanisms' joints: the points' positions found once.
+            Constraint::OnPoints(c) => c.with_residual_and_gradient(q, t, use_it),
             other => use_it(other.residual(q, t), &other.gradient_rows(q, t)),
         }
     }

@@ -220,26 +220,32 @@ impl PointMap {
     }
 
     fn combine(&self, x: &[Vec3], offsets: bool) -> Points {
-        self.terms
-            .iter()
-            .zip(&self.offsets)
-            .map(|(terms, offset)| {
-                let mut y = if offsets { *offset } else { [0.0; 3] };
-                for &(u, w) in terms {
-                    let p = self.particles[u];
-                    for k in 0..3 {
-                        y[k] += w * x[p][k];
-                    }
+        // A loop into storage of the right length (a collect through the iterator adapters
+        // was a tenth of a rigid-body chain's step).
+        let mut out: Points = smallvec::smallvec![[0.0; 3]; self.terms.len()];
+        for ((y, terms), offset) in out.iter_mut().zip(&self.terms).zip(&self.offsets) {
+            if offsets {
+                *y = *offset;
+            }
+            for &(u, w) in terms {
+                let p = self.particles[u];
+                for k in 0..3 {
+                    y[k] += w * x[p][k];
                 }
-                y
-            })
-            .collect()
+            }
+        }
+        out
     }
 
     /// Per-particle rows g_p = sum_j w_jp g_j from per-point rows: `rows[a]` belongs to point
     /// `at[a]`.
     pub fn rows(&self, at: &[usize], rows: &[Vec3]) -> Vec<Vec3> {
-        let mut out = vec![[0.0; 3]; self.particles.len()];
+        self.rows_on_stack(at, rows).into_vec()
+    }
+
+    /// [`PointMap::rows`] on the stack for up to 8 particles (a joint's two bodies).
+    pub fn rows_on_stack(&self, at: &[usize], rows: &[Vec3]) -> Points {
+        let mut out: Points = smallvec::smallvec![[0.0; 3]; self.particles.len()];
         for (&j, g) in at.iter().zip(rows) {
             for &(u, w) in &self.terms[j] {
                 for k in 0..3 {
