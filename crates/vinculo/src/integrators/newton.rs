@@ -667,6 +667,17 @@ mod tests {
         }
     }
 
+    /// [`NoisyWithFloor`] from x = 0 with a slope of 1e-7 (a nearly singular matrix) and the
+    /// residual's round-off `noise`.
+    fn with_floor(noise: f64) -> NoisyWithFloor {
+        NoisyWithFloor(Noisy {
+            x: 0.0,
+            slope: 1e-7,
+            noise,
+            calls: 0,
+        })
+    }
+
     fn solve_one(problem: &mut impl NewtonProblem) -> Result<NewtonReport, NewtonFailure> {
         let mut solver: Box<dyn LinearSolver> = Box::new(DenseLu::new(1));
         let (mut values, mut r) = (vec![0.0], vec![0.0]);
@@ -698,12 +709,7 @@ mod tests {
     /// problem that reports that round-off converges at it, within 3 noise / slope of the root.
     #[test]
     fn a_residual_at_its_reported_round_off_converges_above_the_tolerance() {
-        let mut problem = NoisyWithFloor(Noisy {
-            x: 0.0,
-            slope: 1e-7,
-            noise: 4e-9,
-            calls: 0,
-        });
+        let mut problem = with_floor(4e-9);
         let report = solve_one(&mut problem).expect("converged at the reported round-off");
         assert!(
             report.residual > 1e-10 && report.residual <= 3.0 * 4e-9,
@@ -721,12 +727,7 @@ mod tests {
     /// tolerance asks for what the arithmetic cannot give, and the solve fails.
     #[test]
     fn a_round_off_far_above_the_tolerance_still_fails() {
-        let mut problem = NoisyWithFloor(Noisy {
-            x: 0.0,
-            slope: 1e-7,
-            noise: 4e-6,
-            calls: 0,
-        });
+        let mut problem = with_floor(4e-6);
         // Round-off 1.2e-5 > 1e3 x 1e-10.
         let result = solve_one(&mut problem);
         assert!(
@@ -772,12 +773,7 @@ mod tests {
     /// two more residuals to see the floor), x within 2 noise / slope of the root.
     #[test]
     fn a_residual_left_at_its_round_off_by_a_recent_matrix_ends_the_solve() {
-        let mut problem = NoisyWithFloor(Noisy {
-            x: 0.0,
-            slope: 1e-7,
-            noise: 4e-15,
-            calls: 0,
-        });
+        let mut problem = with_floor(4e-15);
         let report = solve_one(&mut problem).expect("converged at the round-off floor");
         assert_eq!(
             (report.factorisations, problem.0.calls),
