@@ -134,7 +134,7 @@ impl Constraint {
     pub fn with_gradient<R>(&self, q: &[Vec3], t: f64, use_it: impl FnOnce(&[Vec3]) -> R) -> R {
         match self {
             // Over points (a joint's equation): the rows on the stack, not in a Vec.
-            Constraint::OnPoints(c) => c.with_residual_and_gradient(q, t, |_, g| use_it(g)),
+            Constraint::OnPoints(c) => c.with_gradient(q, t, use_it),
             other => use_it(&other.gradient_rows(q, t)),
         }
     }

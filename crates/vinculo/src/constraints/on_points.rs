@@ -73,6 +73,18 @@ impl OnPoints {
         use_it(buffer.as_slice(), &rows)
     }
 
+    /// Calls `use_it` with dPhi/dq, the rows on the stack.
+    #[inline]
+    pub(crate) fn with_gradient<R>(
+        &self,
+        q: &[Vec3],
+        t: f64,
+        use_it: impl FnOnce(&[Vec3]) -> R,
+    ) -> R {
+        let g = self.inner.gradient_rows(&self.map.positions(q), t);
+        use_it(&self.map.rows_on_stack(self.inner.particles(), &g))
+    }
+
     /// Calls `use_it` with Phi(q, t) and dPhi/dq from one evaluation of the points'
     /// positions, the rows on the stack.
     #[inline]

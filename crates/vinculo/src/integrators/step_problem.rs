@@ -790,6 +790,71 @@ mod tests {
         assert_parallel_assembly_is_serial(&s, GeneralizedAlpha { rho_inf: 0.6 });
     }
 
+    /// The Jacobian of a chain of two four-particle rigid bodies, hinged to the ground and to
+    /// each other by revolute joints (equations over points of the bodies: a coincidence of
+    /// points, whose Hessian is zero and hands over no blocks, and the axes' dot products,
+    /// whose Hessian does), moving and turning, equals central finite differences of the
+    /// residual for the trapezoidal rule and generalised-alpha, with the sparse LU's and the
+    /// dense layout; and the parallel assembly gives the serial one.
+    #[test]
+    fn jacobian_with_joints_between_bodies_matches_finite_differences() {
+        use crate::model::{JointKind, RigidBodySpec};
+        let mut s = System::new([0.0, 0.0, -9.81]);
+        let inertia = [[0.02, 0.0, 0.0], [0.0, 0.05, 0.0], [0.0, 0.0, 0.06]];
+        let spec = |centre: Vec3, spin: Vec3| RigidBodySpec {
+            mass: 1.5,
+            centre,
+            inertia,
+            velocity: [0.1, -0.2, 0.3],
+            angular_velocity: spin,
+            ..RigidBodySpec::default()
+        };
+        let a = s
+            .add_rigid_tetrahedron(&spec([0.25, 0.0, 0.0], [0.2, 1.0, -0.1]))
+            .unwrap();
+        let b = s
+            .add_rigid_tetrahedron(&spec([0.75, 0.02, 0.0], [-0.3, 0.6, 0.2]))
+            .unwrap();
+        let hinge = JointKind::Revolute;
+        s.add_joint(hinge, (&[], &a.particles), [0.0; 3], [0.0, 1.0, 0.0])
+            .unwrap();
+        s.add_joint(
+            hinge,
+            (&a.particles, &b.particles),
+            [0.5, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+        )
+        .unwrap();
+        let q_n = s.initial_positions();
+        for dense_limit in [0, 1000] {
+            // An iterate off the step's start and every multiplier non-zero (each Hessian
+            // weighted).
+            let workspace = || {
+                let mut ws = gathered(&s, dense_limit, SparseSolver::SparseLu);
+                let (q, lambda) = (&mut ws.state.q, &mut ws.state.lambda);
+                for (i, (x, x_n)) in q.iter_mut().zip(&q_n).enumerate() {
+                    let i = i as f64;
+                    *x = [
+                        x_n[0] + 0.003 * i,
+                        x_n[1] - 0.002,
+                        x_n[2] + 0.001 * (i % 3.0),
+                    ];
+                }
+                for (k, l) in lambda.iter_mut().enumerate() {
+                    *l = 0.3 * (k as f64 + 1.0).sin();
+                }
+                ws
+            };
+            let mut state = RuleState::new(&q_n);
+            let rule = GeneralizedTrapezoidal { alpha: 0.6 };
+            assert_step_jacobian_matches(&s, workspace(), rule, &mut state);
+            let mut state = alpha_state(q_n.len());
+            let rule = GeneralizedAlpha { rho_inf: 0.6 };
+            assert_step_jacobian_matches(&s, workspace(), rule, &mut state);
+        }
+        assert_parallel_assembly_is_serial(&s, GeneralizedAlpha { rho_inf: 0.6 });
+    }
+
     /// Closed form: a node of mass m between two fixed neighbours on the x axis, in water
     /// without gravity nor drag, displaced by d from rest in one backward-Euler step
     /// (qdd = d/h^2): its scaled residual is sigma (m + CaAx rho V) d_x / h^2 along the line
