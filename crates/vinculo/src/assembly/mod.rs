@@ -490,7 +490,7 @@ fn place_constraint<V: Entries + ?Sized>(
     for (b, m) in blocks.iter().zip(hess) {
         // An element over many particles (a joint's equation over the particles of two
         // bodies) has mostly zero blocks: skipped, not added entry by entry.
-        if m.iter().any(|r| r.iter().any(|&x| x != 0.0)) {
+        if *m != crate::math::ZERO3 {
             values.add_block(b, 1.0, m);
         }
     }

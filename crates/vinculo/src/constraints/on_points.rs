@@ -9,7 +9,8 @@
 use super::{Constraint, Hessian};
 use crate::laws::Law;
 use crate::local::Blocks;
-use crate::math::{Mat3, Vec3};
+use crate::math::{Mat3, Vec3, ZERO3};
+use crate::model::point::Points;
 use crate::model::PointMap;
 
 /// A constraint over points.
@@ -33,16 +34,26 @@ impl OnPoints {
     }
 
     pub(crate) fn gradient(&self, q: &[Vec3], t: f64) -> crate::local::Rows {
-        let x = self.map.positions(q);
-        let g = self.inner.gradient_rows(&x, t);
-        crate::local::Rows::Any(self.map.rows(self.inner.particles(), &g))
+        crate::local::Rows::Any(self.gradient_at(&self.map.positions(q), t).into_vec())
     }
 
     pub(crate) fn add_hessian(&self, q: &[Vec3], t: f64, w: f64, out: &mut Hessian) {
-        let x = self.map.positions(q);
-        let mut h = Blocks::zeros(self.inner.particles().len());
-        self.inner.add_hessian(&x, t, w, &mut h);
+        let h = self.hessian_at(&self.map.positions(q), t, w);
         self.map.add_blocks(self.inner.particles(), &h, out);
+    }
+
+    /// The inner constraint's gradient at the points' positions `x`, taken to the particles
+    /// (on the stack).
+    fn gradient_at(&self, x: &[Vec3], t: f64) -> Points {
+        let g = self.inner.gradient_rows(x, t);
+        self.map.rows_on_stack(self.inner.particles(), &g)
+    }
+
+    /// `w` times the inner constraint's Hessian at the points' positions `x`, over its points.
+    fn hessian_at(&self, x: &[Vec3], t: f64, w: f64) -> Blocks {
+        let mut h = Blocks::zeros(self.inner.particles().len());
+        self.inner.add_hessian(x, t, w, &mut h);
+        h
     }
 
     /// [`Constraint::with_hessian_and_gradient`] over points: the points' positions found
@@ -60,16 +71,13 @@ impl OnPoints {
         use_it: impl FnOnce(&[Mat3], &[Vec3]) -> R,
     ) -> R {
         let x = self.map.positions(q);
-        let at = self.inner.particles();
-        let mut h = Blocks::zeros(at.len());
-        self.inner.add_hessian(&x, t, w, &mut h);
-        let rows = self.map.rows_on_stack(at, &self.inner.gradient_rows(&x, t));
-        let zero = h.as_slice().iter().all(|b| *b == [[0.0; 3]; 3]);
-        if zero {
+        let h = self.hessian_at(&x, t, w);
+        let rows = self.gradient_at(&x, t);
+        if h.as_slice().iter().all(|b| *b == ZERO3) {
             return use_it(&[], &rows);
         }
         buffer.reset(self.map.particles.len());
-        self.map.add_blocks(at, &h, buffer);
+        self.map.add_blocks(self.inner.particles(), &h, buffer);
         use_it(buffer.as_slice(), &rows)
     }
 
@@ -81,8 +89,7 @@ impl OnPoints {
         t: f64,
         use_it: impl FnOnce(&[Vec3]) -> R,
     ) -> R {
-        let g = self.inner.gradient_rows(&self.map.positions(q), t);
-        use_it(&self.map.rows_on_stack(self.inner.particles(), &g))
+        use_it(&self.gradient_at(&self.map.positions(q), t))
     }
 
     /// Calls `use_it` with Phi(q, t) and dPhi/dq from one evaluation of the points'
@@ -95,8 +102,7 @@ impl OnPoints {
         use_it: impl FnOnce(f64, &[Vec3]) -> R,
     ) -> R {
         let x = self.map.positions(q);
-        let (phi, g) = (self.inner.residual(&x, t), self.inner.gradient_rows(&x, t));
-        use_it(phi, &self.map.rows_on_stack(self.inner.particles(), &g))
+        use_it(self.inner.residual(&x, t), &self.gradient_at(&x, t))
     }
 
     pub(crate) fn phi_t(&self, q: &[Vec3], t: f64) -> f64 {

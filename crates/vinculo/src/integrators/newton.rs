@@ -503,13 +503,14 @@ pub fn solve(
                 worst: worst_entry(r),
             });
         }
-        let stagnant = residual > FLOOR_RESIDUAL_DROP * residual_before;
         // Within the tolerance, a residual that the last increment, made with a matrix
         // factorised in this solve at that iterate or the one before, did not halve, and that
         // is at its own round-off, is the floor too, whatever the increments (module
         // documentation, "The floor of ill-determined multipliers").
         let recent = factorisations > 0 && solves_with_matrix <= 2;
-        let at_floor = (fresh && increment > FLOOR_CONTRACTION * increment_before && stagnant)
+        let at_floor = (fresh
+            && increment > FLOOR_CONTRACTION * increment_before
+            && residual > FLOOR_RESIDUAL_DROP * residual_before)
             || (recent
                 && residual > FLOOR_STAGNATION * residual_before
                 && residual <= options.tolerance

@@ -262,7 +262,7 @@ impl PointMap {
         for (a, &j) in at.iter().enumerate() {
             for (b, &l) in at.iter().enumerate() {
                 let h: &Mat3 = &blocks[a][b];
-                if h.iter().all(|r| r.iter().all(|&x| x == 0.0)) {
+                if *h == crate::math::ZERO3 {
                     continue;
                 }
                 for &(u, wu) in &self.terms[j] {
