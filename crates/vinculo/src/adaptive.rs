@@ -194,6 +194,7 @@ impl ErrorControl {
             let stab = stabilized.as_deref_mut();
             if self
                 .scheme
+                .rule()
                 .step(system, ws, stab, start, rule_half, newton)
                 .is_err()
             {
@@ -242,7 +243,9 @@ impl ErrorControl {
         let rule_half = self.rule_half.as_ref().expect("set by judge");
         rule.copy_from(rule_half);
         let start = StepStart::new(t + 0.5 * h, &self.q_mid, &self.v_mid, 0.5 * h);
-        self.scheme.end_acceleration(rule_half, start, v, acc);
+        self.scheme
+            .rule()
+            .end_acceleration(rule_half, start, v, acc);
     }
 
     /// The state (q, v, lambda) at t + h/2 of the step last accepted, between its half steps.

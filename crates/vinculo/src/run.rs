@@ -158,7 +158,7 @@ use crate::initial::{
 };
 use crate::integrators::energy_guard::EnergyGuard;
 use crate::integrators::{
-    Formulation, JacobianReuse, NewtonFailure, NewtonOptions, RuleState, Scheme,
+    Formulation, JacobianReuse, NewtonFailure, NewtonOptions, Rule, RuleState, Scheme,
     StabilizedWorkspace, StepStart, StepWorkspace,
 };
 use crate::math::Vec3;
@@ -613,6 +613,8 @@ struct Scratch {
 pub struct Simulation<'a> {
     system: &'a System,
     options: SimulationOptions,
+    /// The time rule of `options.scheme`, its coefficients computed once.
+    rule: Rule,
     newton: NewtonOptions,
     tension_floor: f64,
     /// The constraints whose violations a stored state reports ([`rigid_constraints`]).
@@ -867,6 +869,7 @@ impl<'a> Simulation<'a> {
         Ok(Simulation {
             system,
             options: options.clone(),
+            rule: options.scheme.rule(),
             newton,
             tension_floor,
             rigid,
@@ -1184,7 +1187,8 @@ impl Simulation<'_> {
 
     /// One attempt at a step towards `stop`: the shared loop body.
     fn attempt(&mut self, stop: f64, observer: &mut dyn Observer) -> Next {
-        let (system, scheme, t_end) = (self.system, self.options.scheme, self.options.t_end);
+        let (system, scheme, t_end) = (self.system, self.rule, self.options.t_end);
+        let setting = self.options.scheme;
         let c = &mut self.carried;
         let event_stop = match &c.controller {
             Controller::Fixed(fixed) => fixed.event_stop.filter(|&te| te > c.t && te < stop),
@@ -1284,7 +1288,7 @@ impl Simulation<'_> {
                 {
                     // Counted as a step rejected, as a solved step that found the switch.
                     self.sol.steps_rejected += 1;
-                    go_to_switch(fixed, (system, scheme, &ws.inertia), c.t, at);
+                    go_to_switch(fixed, (system, setting, &ws.inertia), c.t, at);
                     return Next::Go;
                 }
             }
@@ -1325,7 +1329,7 @@ impl Simulation<'_> {
                             // then through the transient it starts in short steps.
                             self.sol.steps_rejected += 1;
                             c.rule.copy_from(&self.scratch.rule_saved);
-                            go_to_switch(fixed, (system, scheme, &ws.inertia), c.t, at);
+                            go_to_switch(fixed, (system, setting, &ws.inertia), c.t, at);
                             return Next::Go;
                         }
                         if to_event {
@@ -1467,7 +1471,7 @@ impl Simulation<'_> {
         report: crate::integrators::NewtonReport,
         observer: &mut dyn Observer,
     ) -> Next {
-        let (system, scheme) = (self.system, self.options.scheme);
+        let (system, scheme) = (self.system, self.rule);
         let c = &mut self.carried;
         let s = &mut self.scratch;
         let ws = &mut self.ws;
@@ -1518,20 +1522,21 @@ impl Simulation<'_> {
             // summed squares of a_{n+1} - (a_n + h r) over the particles, for r the last rate
             // and the one before, both measured over steps of this size.
             let judged = c.acc_rate_step.abs() == h && c.acc_rate_before_step == h;
-            let mut errors = [0.0f64; 2];
+            // The two sums in scalars (in an array they went through memory).
+            let (mut linear, mut lagged) = (0.0f64, 0.0f64);
             let rates = c.acc_rate.iter_mut().zip(c.acc_rate_before.iter_mut());
             for ((rate, before), (end, old)) in rates.zip(s.acc_new.iter().zip(&c.acc)) {
                 let new: Vec3 = std::array::from_fn(|k| (end[k] - old[k]) / h);
                 if judged {
                     for k in 0..3 {
-                        errors[0] += (new[k] - rate[k]) * (new[k] - rate[k]);
-                        errors[1] += (new[k] - before[k]) * (new[k] - before[k]);
+                        linear += (new[k] - rate[k]) * (new[k] - rate[k]);
+                        lagged += (new[k] - before[k]) * (new[k] - before[k]);
                     }
                 }
                 *before = *rate;
                 *rate = new;
             }
-            c.alternating = judged && errors[1] < errors[0];
+            c.alternating = judged && lagged < linear;
             c.acc_rate_before_step = c.acc_rate_step.abs();
             // Negative: the run no longer extrapolates (a failed extrapolated attempt).
             c.acc_rate_step = if c.acc_rate_step < 0.0 { -h } else { h };
@@ -1841,7 +1846,9 @@ mod tests {
         let mut predicted = vec![[0.0; 3]; c.q.len()];
         if extrapolated {
             let start = StepStart::new(c.t, &c.q, &c.v, h);
-            scheme.predict(&c.rule, start, (&c.acc, &c.acc_rate), &mut predicted);
+            scheme
+                .rule()
+                .predict(&c.rule, start, (&c.acc, &c.acc_rate), &mut predicted);
         } else {
             extrapolate((&c.q, &c.v, &c.acc), h, &mut predicted);
         }

@@ -122,7 +122,7 @@ mod tests {
                         .unwrap();
                 }
                 Scheme::GeneralizedAlpha { rho_inf } => {
-                    let ga = GeneralizedAlpha { rho_inf };
+                    let ga = GeneralizedAlpha::new(rho_inf);
                     index3_step(ga, &system, &mut ws, start, rule, &newton).unwrap();
                 }
             }
@@ -142,7 +142,7 @@ mod tests {
         // so that its step is the step of a run on the exact motion.
         let rule = |dt: f64| match scheme {
             Scheme::GeneralizedAlpha { rho_inf } => {
-                let k = GeneralizedAlpha { rho_inf }.coefficients();
+                let k = GeneralizedAlpha::new(rho_inf).coefficients();
                 let delta = k.alpha_m - k.alpha_f;
                 let kappa = 0.5 * (1.0 - k.alpha_f) - (1.0 - k.alpha_m) * (0.5 + delta);
                 let a = e[2] + delta * dt * e[3] + kappa * dt * dt * e[4];

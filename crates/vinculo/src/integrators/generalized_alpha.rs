@@ -71,11 +71,17 @@ use super::rule::{
 };
 use crate::math::Vec3;
 
-/// The scheme, given by its spectral radius at infinite frequency rho_inf in [0, 1].
+/// The scheme, given by its spectral radius at infinite frequency rho_inf in [0, 1], with the
+/// coefficients derived from it ([`GeneralizedAlpha::new`]): computed once, since a step asks
+/// for them several times (their divisions, twenty a step, took 8 % of a pendulum's step).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GeneralizedAlpha {
     /// Spectral radius at infinite frequency (1: no numerical damping).
     pub rho_inf: f64,
+    /// alpha_m, alpha_f, gamma and beta of rho_inf.
+    k: AlphaCoefficients,
+    /// The weights of [`Predictors`] that do not depend on the step: c_a, c_m and c_f.
+    ratios: [f64; 3],
 }
 
 /// The coefficients of the scheme derived from rho_inf.
@@ -129,13 +135,15 @@ struct Predictors {
 }
 
 impl Predictors {
-    fn new(k: &AlphaCoefficients, h: f64) -> Predictors {
+    /// The predictors of a step of size h of `rule`: one division.
+    fn new(rule: &GeneralizedAlpha, h: f64) -> Predictors {
+        let [c_a, c_m, c_f] = rule.ratios;
         Predictors {
-            inv_beta_h2: 1.0 / (k.beta * h * h),
-            h_gamma: h * k.gamma,
-            c_a: (1.0 - k.alpha_m) / (1.0 - k.alpha_f),
-            c_m: k.alpha_m / (1.0 - k.alpha_f),
-            c_f: k.alpha_f / (1.0 - k.alpha_f),
+            inv_beta_h2: 1.0 / (rule.k.beta * h * h),
+            h_gamma: h * rule.k.gamma,
+            c_a,
+            c_m,
+            c_f,
         }
     }
 
@@ -206,19 +214,30 @@ impl Index3Rule for AlphaStep<'_> {
 }
 
 impl GeneralizedAlpha {
-    /// The coefficients alpha_m, alpha_f, gamma, beta (see the module documentation).
-    pub fn coefficients(&self) -> AlphaCoefficients {
-        let rho = self.rho_inf;
+    /// The scheme of spectral radius `rho_inf`, its coefficients computed.
+    pub fn new(rho_inf: f64) -> GeneralizedAlpha {
+        let rho = rho_inf;
         let alpha_m = (2.0 * rho - 1.0) / (rho + 1.0);
         let alpha_f = rho / (rho + 1.0);
         let gamma = 0.5 + alpha_f - alpha_m;
         let beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
-        AlphaCoefficients {
+        let k = AlphaCoefficients {
             alpha_m,
             alpha_f,
             gamma,
             beta,
-        }
+        };
+        let ratios = [
+            (1.0 - alpha_m) / (1.0 - alpha_f),
+            alpha_m / (1.0 - alpha_f),
+            alpha_f / (1.0 - alpha_f),
+        ];
+        GeneralizedAlpha { rho_inf, k, ratios }
+    }
+
+    /// The coefficients alpha_m, alpha_f, gamma, beta (see the module documentation).
+    pub fn coefficients(&self) -> AlphaCoefficients {
+        self.k
     }
 }
 
@@ -236,7 +255,7 @@ impl TimeRule for GeneralizedAlpha {
 
     /// At t_{n+1}, rows scaled by 1/(c m_ref) (module documentation).
     fn point(&self, start: &StepStart, mass_ref: f64) -> StepPoint {
-        let (k, h) = (self.coefficients(), start.h);
+        let (k, h) = (self.k, start.h);
         let c = (1.0 - k.alpha_m) / ((1.0 - k.alpha_f) * k.beta * h * h);
         StepPoint::new(start, 1.0, 1.0 / (c * mass_ref))
     }
@@ -245,12 +264,13 @@ impl TimeRule for GeneralizedAlpha {
         let (k, h) = (self.coefficients(), start.h);
         state.predict(&k, &start);
         let state = &*state;
+        let known = Predictors::new(self, h);
         AlphaStep {
             p: &state.predicted_q,
             w: &state.predicted_v,
             a_n: &state.algorithmic,
             qdd_n: &state.acceleration,
-            known: Predictors::new(&k, h),
+            known,
             c: (1.0 - k.alpha_m) / ((1.0 - k.alpha_f) * k.beta * h * h),
             dv_dq: k.gamma / (k.beta * h),
         }
@@ -258,7 +278,7 @@ impl TimeRule for GeneralizedAlpha {
 
     /// qdd_{n+1} and a_{n+1} from q_{n+1} and the step's predictors.
     fn advance(&self, state: &mut RuleState, h: f64, q: &[Vec3]) {
-        let known = Predictors::new(&self.coefficients(), h);
+        let known = Predictors::new(self, h);
         let predicted = state.predicted_q.iter().zip(&state.predicted_v);
         let carried = state
             .acceleration
@@ -351,12 +371,12 @@ mod tests {
     /// beta = 1), and second-order accuracy gamma = 1/2 + alpha_f - alpha_m in between.
     #[test]
     fn coefficients_at_the_ends_of_the_range() {
-        let one = GeneralizedAlpha { rho_inf: 1.0 }.coefficients();
+        let one = GeneralizedAlpha::new(1.0).coefficients();
         assert_eq!(
             (one.alpha_m, one.alpha_f, one.gamma, one.beta),
             (0.5, 0.5, 0.5, 0.25)
         );
-        let zero = GeneralizedAlpha { rho_inf: 0.0 }.coefficients();
+        let zero = GeneralizedAlpha::new(0.0).coefficients();
         assert_eq!(
             (zero.alpha_m, zero.alpha_f, zero.gamma, zero.beta),
             (-1.0, 0.0, 1.5, 1.0)

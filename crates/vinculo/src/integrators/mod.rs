@@ -5,8 +5,10 @@
 //! every rule; and the Newton loop they share. The equations discretised are chosen by
 //! [`Formulation`].
 //!
-//! A new rule is one file implementing [`TimeRule`] and one registration: a variant of
-//! [`Scheme`] and its arm in `with_rule!` below, the only `match` on the scheme.
+//! A new rule is one file implementing [`TimeRule`] and its registration: a variant of
+//! [`Scheme`] (the run's setting) and of [`Rule`] (the rule object a run holds), the arm that
+//! builds the one from the other in [`Scheme::rule`], and its arm in `with_rule!` below, the
+//! only `match` on the rules.
 
 pub mod energy_guard;
 pub mod error_estimate;
@@ -58,19 +60,13 @@ pub enum Scheme {
     },
 }
 
-/// Evaluates `$body` with `$rule` bound to the [`TimeRule`] object of the scheme `$scheme`
-/// (statically dispatched: the body is compiled once per rule). The registry of the rules.
+/// Evaluates `$body` with `$rule` bound to the [`TimeRule`] object of the [`Rule`] `$built`
+/// (statically dispatched: the body is compiled once per rule).
 macro_rules! with_rule {
-    ($scheme:expr, $rule:ident => $body:expr) => {
-        match $scheme {
-            $crate::integrators::Scheme::GeneralizedTrapezoidal { alpha } => {
-                let $rule = $crate::integrators::GeneralizedTrapezoidal { alpha };
-                $body
-            }
-            $crate::integrators::Scheme::GeneralizedAlpha { rho_inf } => {
-                let $rule = $crate::integrators::GeneralizedAlpha { rho_inf };
-                $body
-            }
+    ($built:expr, $rule:ident => $body:expr) => {
+        match $built {
+            $crate::integrators::Rule::GeneralizedTrapezoidal($rule) => $body,
+            $crate::integrators::Rule::GeneralizedAlpha($rule) => $body,
         }
     };
 }
@@ -105,6 +101,41 @@ impl Scheme {
         }
     }
 
+    /// The scheme's rule object, its coefficients computed: what a run holds, so that its
+    /// steps do not derive them again (the registry of the rules).
+    pub fn rule(&self) -> Rule {
+        match *self {
+            Scheme::GeneralizedTrapezoidal { alpha } => {
+                Rule::GeneralizedTrapezoidal(GeneralizedTrapezoidal { alpha })
+            }
+            Scheme::GeneralizedAlpha { rho_inf } => {
+                Rule::GeneralizedAlpha(GeneralizedAlpha::new(rho_inf))
+            }
+        }
+    }
+
+    /// Order of accuracy of the positions.
+    pub fn order(&self) -> usize {
+        self.rule().order()
+    }
+
+    /// The rule's state at the start of a run with the consistent accelerations `acc`.
+    pub fn initial_state(&self, acc: &[Vec3]) -> RuleState {
+        self.rule().initial_state(acc)
+    }
+}
+
+/// A [`Scheme`]'s rule object ([`Scheme::rule`]), dispatched statically by `with_rule!`, the
+/// only `match` on the rules.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Rule {
+    /// The generalised trapezoidal rule.
+    GeneralizedTrapezoidal(GeneralizedTrapezoidal),
+    /// Generalised-alpha.
+    GeneralizedAlpha(GeneralizedAlpha),
+}
+
+impl Rule {
     /// Order of accuracy of the positions.
     pub fn order(&self) -> usize {
         with_rule!(*self, rule => rule.order())

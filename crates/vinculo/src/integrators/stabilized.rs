@@ -574,7 +574,7 @@ mod tests {
                 let h = 0.01;
                 let mass_ref = ws.mass_ref;
                 let start = StepStart::new(0.3, &q_n, &v_n, h);
-                let rule = crate::integrators::with_rule!(scheme, r => {
+                let rule = crate::integrators::with_rule!(scheme.rule(), r => {
                     ggl.prepare(r, mass_ref, start, &alpha)
                 });
                 perturbed_iterate(&mut ws, &q_n);

@@ -474,7 +474,7 @@ mod tests {
             let round_off = |mut ws: StepWorkspace| {
                 wiggled_iterate(&mut ws, &q_n);
                 let mut state = alpha_state(q_n.len());
-                let rule = GeneralizedAlpha { rho_inf: 0.6 };
+                let rule = GeneralizedAlpha::new(0.6);
                 let (mut problem, work) =
                     problem_at(rule, &s, &mut ws, &mut state, start(&q_n, &v_n));
                 problem.residual(work.r);
@@ -532,7 +532,7 @@ mod tests {
                         &mut state,
                     )
                 } else {
-                    assemble(GeneralizedAlpha { rho_inf: 0.6 }, &s, &mut ws, &mut state)
+                    assemble(GeneralizedAlpha::new(0.6), &s, &mut ws, &mut state)
                 }
             };
             for trapezoidal in [true, false] {
@@ -623,7 +623,7 @@ mod tests {
             assert_jacobian_matches(&mut problem, &layout);
             let mut ws = workspace();
             let mut state = alpha_state(q_n.len());
-            let rule = GeneralizedAlpha { rho_inf: 0.6 };
+            let rule = GeneralizedAlpha::new(0.6);
             let (mut problem, _) = problem_at(rule, s, &mut ws, &mut state, start(&q_n, &v_n));
             assert_jacobian_matches(&mut problem, &layout);
         }
@@ -681,7 +681,7 @@ mod tests {
         });
         assert_eq!(touching.count(), 3);
         assert_parallel_assembly_is_serial(&s, GeneralizedTrapezoidal { alpha: 0.6 });
-        assert_parallel_assembly_is_serial(&s, GeneralizedAlpha { rho_inf: 0.6 });
+        assert_parallel_assembly_is_serial(&s, GeneralizedAlpha::new(0.6));
     }
 
     /// The Jacobian with compliant rows (the compliance on the multipliers' diagonal, a winch's
@@ -748,7 +748,7 @@ mod tests {
                 state.acceleration = (0..q_n.len())
                     .map(|i| [-0.1, 0.4 * i as f64, 0.7])
                     .collect();
-                let rule = GeneralizedAlpha { rho_inf };
+                let rule = GeneralizedAlpha::new(rho_inf);
                 assert_step_jacobian_matches(&s, workspace(), rule, &mut state);
             }
         }
@@ -783,11 +783,11 @@ mod tests {
             }
             for rho_inf in [0.0, 0.6] {
                 let mut state = alpha_state(q_n.len());
-                let rule = GeneralizedAlpha { rho_inf };
+                let rule = GeneralizedAlpha::new(rho_inf);
                 assert_step_jacobian_matches(&s, workspace(), rule, &mut state);
             }
         }
-        assert_parallel_assembly_is_serial(&s, GeneralizedAlpha { rho_inf: 0.6 });
+        assert_parallel_assembly_is_serial(&s, GeneralizedAlpha::new(0.6));
     }
 
     /// The Jacobian of a chain of two four-particle rigid bodies, hinged to the ground and to
@@ -849,10 +849,10 @@ mod tests {
             let rule = GeneralizedTrapezoidal { alpha: 0.6 };
             assert_step_jacobian_matches(&s, workspace(), rule, &mut state);
             let mut state = alpha_state(q_n.len());
-            let rule = GeneralizedAlpha { rho_inf: 0.6 };
+            let rule = GeneralizedAlpha::new(0.6);
             assert_step_jacobian_matches(&s, workspace(), rule, &mut state);
         }
-        assert_parallel_assembly_is_serial(&s, GeneralizedAlpha { rho_inf: 0.6 });
+        assert_parallel_assembly_is_serial(&s, GeneralizedAlpha::new(0.6));
     }
 
     /// Closed form: a node of mass m between two fixed neighbours on the x axis, in water
