@@ -1187,8 +1187,8 @@ impl Simulation<'_> {
 
     /// One attempt at a step towards `stop`: the shared loop body.
     fn attempt(&mut self, stop: f64, observer: &mut dyn Observer) -> Next {
-        let (system, scheme, t_end) = (self.system, self.rule, self.options.t_end);
-        let setting = self.options.scheme;
+        let (system, time_rule, t_end) = (self.system, self.rule, self.options.t_end);
+        let scheme = self.options.scheme;
         let c = &mut self.carried;
         let event_stop = match &c.controller {
             Controller::Fixed(fixed) => fixed.event_stop.filter(|&te| te > c.t && te < stop),
@@ -1248,7 +1248,7 @@ impl Simulation<'_> {
                 } else {
                     &c.acc_rate
                 };
-                scheme.predict(&c.rule, start, (&c.acc, rate), &mut ws.state.q);
+                time_rule.predict(&c.rule, start, (&c.acc, rate), &mut ws.state.q);
             } else {
                 extrapolate((&c.q, &c.v, &c.acc), h_try, &mut ws.state.q);
             }
@@ -1270,7 +1270,7 @@ impl Simulation<'_> {
             // Modified Newton starting from a matrix of an earlier step gets one more attempt
             // with a fresh matrix before the step counts as failed.
             let stale = self.newton.jacobian_reuse.across_steps()
-                && ws.matrix.holds(scheme.matrix_key(h_try));
+                && ws.matrix.holds(time_rule.matrix_key(h_try));
             // A step to an event found before is not searched for events again.
             let to_event = event_stop.is_some_and(|te| end == StepEnd::At(te));
             let events = matches!(c.controller, Controller::Fixed(_))
@@ -1288,7 +1288,7 @@ impl Simulation<'_> {
                 {
                     // Counted as a step rejected, as a solved step that found the switch.
                     self.sol.steps_rejected += 1;
-                    go_to_switch(fixed, (system, setting, &ws.inertia), c.t, at);
+                    go_to_switch(fixed, (system, scheme, &ws.inertia), c.t, at);
                     return Next::Go;
                 }
             }
@@ -1303,7 +1303,7 @@ impl Simulation<'_> {
             } else {
                 &self.newton
             };
-            let attempt = scheme.step(system, ws, stabilized, start, &mut c.rule, newton);
+            let attempt = time_rule.step(system, ws, stabilized, start, &mut c.rule, newton);
             self.sol.factorisations = ws.matrix.factorisations;
             self.sol.residual_evaluations = ws.matrix.residuals;
             // A failed user function stops the run at once (NaN terms would only fail again).
@@ -1329,7 +1329,7 @@ impl Simulation<'_> {
                             // then through the transient it starts in short steps.
                             self.sol.steps_rejected += 1;
                             c.rule.copy_from(&self.scratch.rule_saved);
-                            go_to_switch(fixed, (system, setting, &ws.inertia), c.t, at);
+                            go_to_switch(fixed, (system, scheme, &ws.inertia), c.t, at);
                             return Next::Go;
                         }
                         if to_event {
@@ -1471,12 +1471,12 @@ impl Simulation<'_> {
         report: crate::integrators::NewtonReport,
         observer: &mut dyn Observer,
     ) -> Next {
-        let (system, scheme) = (self.system, self.rule);
+        let (system, time_rule) = (self.system, self.rule);
         let c = &mut self.carried;
         let s = &mut self.scratch;
         let ws = &mut self.ws;
         let start = StepStart::new(c.t, &c.q, &c.v, h);
-        scheme.end_acceleration(&c.rule, start, &ws.state.v, &mut s.acc_new);
+        time_rule.end_acceleration(&c.rule, start, &ws.state.v, &mut s.acc_new);
         let t_new = match &mut c.controller {
             Controller::Fixed(fixed) => fixed.accepted(end),
             Controller::Adaptive(control) => {
