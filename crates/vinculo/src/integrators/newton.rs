@@ -499,11 +499,11 @@ pub fn solve(
     // fast").
     let mut apart = f64::INFINITY;
     let mut newton_like = false;
-    // Whether an increment leaves the iterate close enough to the solution (module
-    // documentation): one made with a matrix factorised at its iterate as full Newton's, one
-    // made with a kept matrix far below the tolerance.
     // The solve's first increment (infinite before it).
     let mut first = f64::INFINITY;
+    // Whether an increment leaves the iterate close enough to the solution (module
+    // documentation): one made with a matrix factorised at its iterate as full Newton's, one
+    // made with a kept matrix far below the tolerance and the solve's first increment.
     let close_enough = |increment: f64, fresh: bool, first: f64| {
         if !while_fast || fresh {
             increment <= options.tolerance
