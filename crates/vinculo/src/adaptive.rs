@@ -30,7 +30,7 @@ use crate::assembly::NONE;
 use crate::error::{Error, Result};
 use crate::initial::factor_saddle;
 use crate::integrators::{
-    richardson_factor, NewtonOptions, RuleState, Scheme, StabilizedWorkspace, StepStart,
+    richardson_factor, NewtonOptions, Rule, RuleState, Scheme, StabilizedWorkspace, StepStart,
     StepWorkspace,
 };
 use crate::math::Vec3;
@@ -43,6 +43,8 @@ use crate::step_control::{AdaptiveOptions, ErrorWeights, PiController};
 #[derive(Debug, Clone)]
 pub(crate) struct ErrorControl {
     pub(crate) scheme: Scheme,
+    /// The scheme's rule, its coefficients computed once ([`Scheme::rule`]).
+    pub(crate) rule: Rule,
     pub(crate) control: AdaptiveOptions,
     pub(crate) weights: ErrorWeights,
     /// The PI controller's memory (last error norm, last attempt rejected).
@@ -82,6 +84,7 @@ impl ErrorControl {
     ) -> ErrorControl {
         ErrorControl {
             scheme,
+            rule: scheme.rule(),
             control,
             weights,
             pi: PiController::new(scheme.order(), control.hold),
@@ -193,8 +196,7 @@ impl ErrorControl {
             let start = StepStart::new(t_k, q_k, v_k, half);
             let stab = stabilized.as_deref_mut();
             if self
-                .scheme
-                .rule()
+                .rule
                 .step(system, ws, stab, start, rule_half, newton)
                 .is_err()
             {
@@ -208,7 +210,7 @@ impl ErrorControl {
         }
         // Richardson: the step's error C h^(p+1) exceeds that of the two halves by
         // (1 - 2^-p) C h^(p+1).
-        let factor = richardson_factor(self.scheme.order());
+        let factor = richardson_factor(self.rule.order());
         for i in 0..q.len() {
             for c in 0..3 {
                 self.e_q[i][c] = factor * (self.q_big[i][c] - ws.state.q[i][c]);
@@ -243,9 +245,7 @@ impl ErrorControl {
         let rule_half = self.rule_half.as_ref().expect("set by judge");
         rule.copy_from(rule_half);
         let start = StepStart::new(t + 0.5 * h, &self.q_mid, &self.v_mid, 0.5 * h);
-        self.scheme
-            .rule()
-            .end_acceleration(rule_half, start, v, acc);
+        self.rule.end_acceleration(rule_half, start, v, acc);
     }
 
     /// The state (q, v, lambda) at t + h/2 of the step last accepted, between its half steps.

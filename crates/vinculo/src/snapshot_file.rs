@@ -240,6 +240,7 @@ impl Reader<'_> {
         };
         Ok(ErrorControl {
             scheme,
+            rule: scheme.rule(),
             control,
             weights,
             pi,
