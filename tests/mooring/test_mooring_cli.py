@@ -22,6 +22,10 @@ TAUT = DATA / "taut_line.txt"
         ["mooring", "run", str(TAUT), "--t-end", "-1"],
         ["mooring", "run", str(TAUT), "--t-end", "10", "--dt", "0"],
         ["mooring", "run", str(TAUT), "--t-end", "10", "--motion", "no/such/motion.csv"],
+        ["mooring", "run", str(TAUT), "--t-end", "10", "--tolerance", "0"],
+        ["mooring", "run", str(TAUT), "--t-end", "10", "--tolerance", "1"],
+        ["mooring", "run", str(TAUT), "--t-end", "10", "--tolerance", "nan"],
+        ["mooring", "run", str(TAUT), "--t-end", "10", "--tolerance", "tight"],
     ],
 )
 def test_bad_arguments_exit_with_code_2(arguments, capsys):
