@@ -20,35 +20,12 @@ use vinculo::integrators::{
 };
 use vinculo::linear::{LinearSolver, Singular};
 use vinculo::model::System;
-use vinculo::{simulate_with_observer, Observer, SimulationOptions};
+use vinculo::{simulate_with_observer, SimulationOptions};
+
+mod common;
+use common::{chain, Clock};
 
 const DT: f64 = 1e-3;
-
-fn chain(n: usize, hanging: bool) -> System {
-    let mut s = System::new([0.0, 0.0, -9.81]);
-    let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
-    for i in 1..=n {
-        let x = 0.1 * i as f64;
-        let pos = if hanging {
-            [0.0, 0.0, -x]
-        } else {
-            [x, 0.0, 0.0]
-        };
-        let p = s.add_particle(0.1, pos, [0.0; 3], false).unwrap();
-        s.add_distance(prev, p, None).unwrap();
-        prev = p;
-    }
-    s
-}
-
-/// Records the wall-clock time of every accepted step.
-struct Clock(Vec<Instant>);
-impl Observer for Clock {
-    fn step(&mut self, _t: f64, _t_end: f64) -> bool {
-        self.0.push(Instant::now());
-        true
-    }
-}
 
 /// A linear solver that solves nothing (zero increment): a Newton iteration costs its assembly.
 struct Nothing;

@@ -10,35 +10,11 @@
 //! stores only its first and last states. Prints the fitted exponent of time per step against N.
 
 use std::process::Command;
+mod common;
+
+use common::{chain, Clock};
 use std::time::Instant;
-use vinculo::model::System;
-use vinculo::{simulate_with_observer, Observer, SimulationOptions};
-
-fn chain(n: usize, hanging: bool) -> System {
-    let mut s = System::new([0.0, 0.0, -9.81]);
-    let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
-    for i in 1..=n {
-        let x = 0.1 * i as f64;
-        let pos = if hanging {
-            [0.0, 0.0, -x]
-        } else {
-            [x, 0.0, 0.0]
-        };
-        let p = s.add_particle(0.1, pos, [0.0; 3], false).unwrap();
-        s.add_distance(prev, p, None).unwrap();
-        prev = p;
-    }
-    s
-}
-
-/// Records the wall-clock time of every accepted step.
-struct Clock(Vec<Instant>);
-impl Observer for Clock {
-    fn step(&mut self, _t: f64, _t_end: f64) -> bool {
-        self.0.push(Instant::now());
-        true
-    }
-}
+use vinculo::{simulate_with_observer, SimulationOptions};
 
 fn peak_memory_mb() -> f64 {
     let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
