@@ -88,7 +88,7 @@ fn assembly_times(system: &System, parallel_from: usize) -> (f64, f64) {
 
 /// One case, in this process: prints "N s/step residuals/step fact/step t_res t_jac".
 fn one(n: usize, hanging: bool, modified: bool, parallel: bool) {
-    let system = chain(n, hanging);
+    let system = chain(n, 0.1, hanging);
     let parallel_from = if parallel { 0 } else { usize::MAX };
     let steps = (2_000_000 / n).clamp(6, 200);
     let options = SimulationOptions {

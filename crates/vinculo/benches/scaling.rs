@@ -29,7 +29,7 @@ fn peak_memory_mb() -> f64 {
 /// One size, in this process: prints "N seconds_per_step iterations_per_step peak_MB solver".
 fn one(n: usize, hanging: bool, parallel_from: usize) {
     let steps = (2_000_000 / n).clamp(6, 200);
-    let system = chain(n, hanging);
+    let system = chain(n, 0.1, hanging);
     let options = SimulationOptions {
         t_end: steps as f64 * 1e-3,
         dt: 1e-3,

@@ -4,6 +4,9 @@
 //! analysis included, output included), after one warm-up run, with full Newton, modified
 //! Newton and the default reuse of the iteration matrix (`NewtonOptions::jacobian_reuse`).
 
+mod common;
+
+use common::chain;
 use std::time::Instant;
 use vinculo::integrators::{JacobianReuse, NewtonOptions};
 use vinculo::model::System;
@@ -16,23 +19,6 @@ fn pendulum() -> System {
         .add_particle(1.0, [1.0, 0.0, 0.0], [0.0; 3], false)
         .unwrap();
     s.add_distance(a, b, None).unwrap();
-    s
-}
-
-fn chain(n: usize, link: f64, hanging: bool) -> System {
-    let mut s = System::new([0.0, 0.0, -9.81]);
-    let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
-    for i in 1..=n {
-        let x = i as f64 * link;
-        let pos = if hanging {
-            [0.0, 0.0, -x]
-        } else {
-            [x, 0.0, 0.0]
-        };
-        let p = s.add_particle(0.1, pos, [0.0; 3], false).unwrap();
-        s.add_distance(prev, p, None).unwrap();
-        prev = p;
-    }
     s
 }
 

@@ -1,19 +1,20 @@
 //! What the chain benchmarks share: the chain of point masses they time and the observer that
-//! clocks its steps.
+//! clocks its steps (each benchmark uses what it needs of them).
+#![allow(dead_code)]
 
 use std::time::Instant;
 
 use vinculo::model::System;
 use vinculo::Observer;
 
-/// A chain of `n` point masses of 0.1 kg joined by 0.1 m distance constraints to a fixed
-/// anchor at the origin, at rest along -z (`hanging`: its equilibrium) or along +x (swinging
-/// down when released), under gravity.
-pub fn chain(n: usize, hanging: bool) -> System {
+/// A chain of `n` point masses of 0.1 kg joined by distance constraints of length `link` (m)
+/// to a fixed anchor at the origin, at rest along -z (`hanging`: its equilibrium) or along +x
+/// (swinging down when released), under gravity.
+pub fn chain(n: usize, link: f64, hanging: bool) -> System {
     let mut s = System::new([0.0, 0.0, -9.81]);
     let mut prev = s.add_particle(1.0, [0.0; 3], [0.0; 3], true).unwrap();
     for i in 1..=n {
-        let x = 0.1 * i as f64;
+        let x = i as f64 * link;
         let pos = if hanging {
             [0.0, 0.0, -x]
         } else {
