@@ -1155,6 +1155,16 @@ def point_stiffness(system: System, positions: npt.NDArray[np.float64],
     Raises:
         ConvergenceError: a singular equilibrium Jacobian at the point.
     """
+def points_stiffness(system: System, positions: npt.NDArray[np.float64],
+                     multipliers: npt.NDArray[np.float64], particles: list[int],
+                     t: float = 0.0) -> npt.NDArray[np.float64]:
+    """The joint 3n x 3n stiffness (N/m) at n particles in an equilibrium: blocks
+    K_ij = -dF_i/dx_j.
+
+    Raises:
+        ConvergenceError: a singular equilibrium Jacobian, or block of its inverse on the points.
+        InvalidInputError: no particles, one out of range, or one listed twice.
+    """
 def point_force(system: System, positions: npt.NDArray[np.float64],
                 multipliers: npt.NDArray[np.float64], particle: int,
                 t: float = 0.0) -> tuple[float, float, float]:

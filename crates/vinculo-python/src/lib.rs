@@ -35,6 +35,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run::time_simulate, m)?)?;
     m.add_function(wrap_pyfunction!(statics::solve_statics, m)?)?;
     m.add_function(wrap_pyfunction!(statics::point_stiffness, m)?)?;
+    m.add_function(wrap_pyfunction!(statics::points_stiffness, m)?)?;
     m.add_function(wrap_pyfunction!(statics::point_force, m)?)?;
     Ok(())
 }

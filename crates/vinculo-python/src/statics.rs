@@ -107,6 +107,25 @@ pub fn point_stiffness<'py>(
     PyArray1::from_vec(py, flat).reshape([3, 3])
 }
 
+/// The joint 3n x 3n linearised stiffness (N/m) at the points `particles` in an equilibrium.
+#[pyfunction]
+#[pyo3(signature = (system, positions, multipliers, particles, t=0.0))]
+pub fn points_stiffness<'py>(
+    py: Python<'py>,
+    system: Bound<'py, PySystem>,
+    positions: PyReadonlyArray2<'py, f64>,
+    multipliers: PyReadonlyArray1<'py, f64>,
+    particles: Vec<usize>,
+    t: f64,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let st = equilibrium(positions, multipliers, t)?;
+    let this = system.borrow();
+    check_sizes(&this.inner, &st)?;
+    let k = statics::points_stiffness(&this.inner, &st, &particles).map_err(to_py)?;
+    let n = 3 * particles.len();
+    PyArray1::from_vec(py, k).reshape([n, n])
+}
+
 /// The force (N) that the system's elements exert on `particle` in an equilibrium.
 #[pyfunction]
 #[pyo3(signature = (system, positions, multipliers, particle, t=0.0))]

@@ -49,7 +49,7 @@ use crate::integrators::newton::{
     self, JacobianReuse, LinearWork, NewtonFailure, NewtonOptions, NewtonProblem,
 };
 use crate::integrators::{Index3Rule, StepPoint, StepProblem, StepStart, StepWorkspace};
-use crate::linear::assemble_and_factor;
+use crate::linear::{assemble_and_factor, DenseLu, LinearSolver};
 use crate::math::{Mat3, Vec3};
 use crate::model::System;
 
@@ -507,21 +507,113 @@ pub fn point_force(system: &System, statics: &Statics, particle: usize) -> Vec3 
 /// [`Error::SingularMatrix`] when the equilibrium's Jacobian, or its Schur complement on the
 /// point, is singular (an inextensible taut line is infinitely stiff along itself).
 pub fn point_stiffness(system: &System, statics: &Statics, particle: usize) -> Result<Mat3> {
-    if particle >= system.particles().len() {
-        return Err(Error::InvalidParameter {
-            name: "particle of point_stiffness".into(),
-            value: particle as f64,
-            expected: format!(
-                "must be one of the system's {} particles",
-                system.particles().len()
-            ),
-        });
+    let (x, sigma) = inverse_on_points(system, statics, &[particle])?;
+    let x: Mat3 = std::array::from_fn(|i| std::array::from_fn(|k| x[3 * i + k]));
+    let s = inverse(&x).ok_or_else(|| {
+        stiffness_singular(
+            statics.t,
+            &[particle],
+            "the point's block of J^-1 is singular",
+        )
+    })?;
+    Ok(std::array::from_fn(|i| {
+        std::array::from_fn(|k| s[i][k] / sigma)
+    }))
+}
+
+/// The joint linearised stiffness (N/m) of `system` at the points `particles` in the
+/// equilibrium `statics`: the 3n x 3n matrix, row-major, of blocks K_ij = -dF_i/dx_j, F_i the
+/// [`point_force`] on point i, as point j moves while the other points stay where they are and
+/// every other free particle stays in equilibrium: the Schur complement of the equilibrium's
+/// Jacobian on the points' rows, [(J^-1)_PP]^-1 / sigma (module documentation). Its diagonal
+/// blocks are [`point_stiffness`] of each point with the others held; the off-diagonal ones
+/// couple points joined through the system (a bridle's two fairleads). The points are freed
+/// for the computation, and the constraints on one of them alone (its supports) left out.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for no points, an index out of range or a point listed twice;
+/// [`Error::SingularMatrix`] when the equilibrium's Jacobian, or its block on the points of
+/// its inverse, is singular (an inextensible taut line between two of them).
+pub fn points_stiffness(
+    system: &System,
+    statics: &Statics,
+    particles: &[usize],
+) -> Result<Vec<f64>> {
+    let (x, sigma) = inverse_on_points(system, statics, particles)?;
+    let n = 3 * particles.len();
+    // S = X^-1, column by column of the identity, X factorised by partial pivoting (in the
+    // column-major order of the factorisation).
+    let mut lu = DenseLu::new(n);
+    let column_major: Vec<f64> = (0..n * n).map(|e| x[(e % n) * n + e / n]).collect();
+    lu.factor(&column_major).map_err(|s| {
+        stiffness_singular(
+            statics.t,
+            particles,
+            &format!("the points' block of J^-1: {}", s.detail),
+        )
+    })?;
+    let mut k = vec![0.0; n * n];
+    let mut e = vec![0.0; n];
+    for c in 0..n {
+        e.fill(0.0);
+        e[c] = 1.0;
+        lu.solve_in_place(&mut e);
+        for r in 0..n {
+            k[r * n + c] = e[r] / sigma;
+        }
     }
-    // The point is freed, and the constraints on it alone (the supports that prescribe a
-    // coupled point's coordinates) are left out: F is the force of the other elements.
+    Ok(k)
+}
+
+/// The error of a stiffness whose matrix is singular.
+fn stiffness_singular(t: f64, particles: &[usize], detail: &str) -> Error {
+    let which = match particles {
+        [p] => format!("particle {p}"),
+        _ => format!("particles {particles:?}"),
+    };
+    Error::SingularMatrix {
+        t,
+        equation: format!("the static equilibrium's stiffness at {which}"),
+        detail: detail.into(),
+    }
+}
+
+/// (J^-1)_PP, the block on the rows of the points `particles` of the inverse of the
+/// equilibrium's Jacobian with those points freed and their supports left out (3n x 3n,
+/// row-major), and the rows' scale sigma: the inverse of the Schur complement on the points.
+fn inverse_on_points(
+    system: &System,
+    statics: &Statics,
+    particles: &[usize],
+) -> Result<(Vec<f64>, f64)> {
+    let count = system.particles().len();
+    let invalid = |value: f64, expected: String| Error::InvalidParameter {
+        name: "particle of a stiffness".into(),
+        value,
+        expected,
+    };
+    if particles.is_empty() {
+        return Err(invalid(0.0, "give at least one point".into()));
+    }
+    for (k, &p) in particles.iter().enumerate() {
+        if p >= count {
+            return Err(invalid(
+                p as f64,
+                format!("must be one of the system's {count} particles"),
+            ));
+        }
+        if particles[..k].contains(&p) {
+            return Err(invalid(p as f64, "each point once".into()));
+        }
+    }
+    // The points are freed, and the constraints on one of them alone (the supports that
+    // prescribe a coupled point's coordinates) are left out: F is the force of the other
+    // elements.
     let mut free = system.clone();
-    free.set_fixed(particle, false);
-    let kept = free.retain_constraints(|c| !support_of(c, particle));
+    for &p in particles {
+        free.set_fixed(p, false);
+    }
+    let kept = free.retain_constraints(|c| !particles.iter().any(|&p| support_of(c, p)));
     free.set_initial_state(&statics.positions, &vec![[0.0; 3]; statics.positions.len()]);
     let mut ws = StepWorkspace::new(&free, 48);
     ws.state.q.clone_from(&statics.positions);
@@ -542,33 +634,32 @@ pub fn point_stiffness(system: &System, statics: &Statics, particle: usize) -> R
         mu: 0.0,
         previous: &statics.positions,
     };
-    let d = ws.layout.dof[particle];
+    let rows: Vec<usize> = particles
+        .iter()
+        .flat_map(|&p| {
+            let d = ws.layout.dof[p];
+            [d, d + 1, d + 2]
+        })
+        .collect();
     let (mut problem, work) = StepProblem::new(&free, &mut ws, (&start, point), rule);
     let newton::LinearWork {
         solver, values, r, ..
     } = work;
     problem.residual(r);
-    let singular = |detail: String| Error::SingularMatrix {
-        t,
-        equation: format!("the static equilibrium's stiffness at particle {particle}"),
-        detail,
-    };
     assemble_and_factor(solver, values, |values| problem.jacobian(values))
-        .map_err(|s| singular(s.detail))?;
-    // (J^-1)_pp, column by column: the inverse of the Schur complement S on the point.
-    let mut x = [[0.0; 3]; 3];
-    for k in 0..3 {
+        .map_err(|s| stiffness_singular(t, particles, &s.detail))?;
+    // (J^-1)_PP, column by column.
+    let n = rows.len();
+    let mut x = vec![0.0; n * n];
+    for (k, &column) in rows.iter().enumerate() {
         r.fill(0.0);
-        r[d + k] = 1.0;
+        r[column] = 1.0;
         solver.solve_in_place(r);
-        for i in 0..3 {
-            x[i][k] = r[d + i];
+        for (i, &row) in rows.iter().enumerate() {
+            x[i * n + k] = r[row];
         }
     }
-    let s = inverse(&x).ok_or_else(|| singular("the point's block of J^-1 is singular".into()))?;
-    Ok(std::array::from_fn(|i| {
-        std::array::from_fn(|k| s[i][k] / sigma)
-    }))
+    Ok((x, sigma))
 }
 
 /// The inverse of a 3x3 matrix, or None when it is singular or not finite.
@@ -676,6 +767,86 @@ mod tests {
             (fa[2] + fb[2] + weight).abs() < 1e-6 * weight,
             "{fa:?} {fb:?}"
         );
+    }
+
+    /// A bridle: a line of 8 segments from an anchor at the origin to a free node, which two
+    /// 1.5 m segments hold from two fixed fairleads. The joint stiffness of the two fairleads
+    /// (6 x 6) equals central differences of both fairleads' forces over re-solved equilibria
+    /// (each fairlead moved by +-1 mm along each axis, the other held), its diagonal blocks
+    /// [`point_stiffness`] of each fairlead, and its off-diagonal blocks, the coupling through
+    /// the bridle, are not small (the point of the joint matrix); it is symmetric.
+    #[test]
+    fn joint_stiffness_of_a_bridle_matches_finite_differences_of_the_statics() {
+        let (n, ea) = (8, 5e4);
+        let mut s = System::new([0.0, 0.0, -G]);
+        let node = 2.0 * 10.0 / n as f64;
+        let mut prev = s.add_particle(node, [0.0; 3], [0.0; 3], true).unwrap();
+        for i in 1..=n {
+            let u = i as f64 / n as f64;
+            let x = [8.0 * u, 0.0, 2.0 * u - 5.0 * u * (1.0 - u)];
+            let p = s.add_particle(node, x, [0.0; 3], false).unwrap();
+            s.add_elastic_distance(prev, p, (Law::Constant(10.0 / n as f64), 1.0), ea)
+                .unwrap();
+            prev = p;
+        }
+        let fairleads = [n + 1, n + 2];
+        for y in [1.0, -1.0] {
+            let b = s.add_particle(1.0, [9.0, y, 3.0], [0.0; 3], true).unwrap();
+            s.add_elastic_distance(prev, b, (Law::Constant(1.5), 1.0), ea)
+                .unwrap();
+        }
+        let st = solve_statics(&s, &StaticsOptions::default()).unwrap();
+        let k = points_stiffness(&s, &st, &fairleads).unwrap();
+        let scale = k.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let h = 1e-3;
+        let mut worst = 0.0f64;
+        for (jp, &pj) in fairleads.iter().enumerate() {
+            for j in 0..3 {
+                let forces = |sign: f64| {
+                    let mut moved = s.clone();
+                    let mut q = st.positions.clone();
+                    q[pj][j] += sign * h;
+                    moved.set_initial_state(&q, &vec![[0.0; 3]; q.len()]);
+                    let eq = solve_statics(&moved, &StaticsOptions::default()).unwrap();
+                    fairleads.map(|p| point_force(&moved, &eq, p))
+                };
+                let (fp, fm) = (forces(1.0), forces(-1.0));
+                for ip in 0..2 {
+                    for i in 0..3 {
+                        let fd = -(fp[ip][i] - fm[ip][i]) / (2.0 * h);
+                        let analytic = k[(3 * ip + i) * 6 + 3 * jp + j];
+                        worst = worst.max((fd - analytic).abs() / scale);
+                    }
+                }
+            }
+        }
+        // Central differences: O(h^2) truncation, as for one fairlead below (measured 5.2e-7;
+        // the coupling blocks' largest entry 0.91 of the largest).
+        assert!(worst < 1e-5, "relative difference {worst}, K = {k:?}");
+        for (ip, &p) in fairleads.iter().enumerate() {
+            let alone = point_stiffness(&s, &st, p).unwrap();
+            for i in 0..3 {
+                for j in 0..3 {
+                    let joint = k[(3 * ip + i) * 6 + 3 * ip + j];
+                    assert!(
+                        (joint - alone[i][j]).abs() < 1e-9 * scale,
+                        "{joint} {alone:?}"
+                    );
+                }
+            }
+        }
+        let coupling = (0..3)
+            .flat_map(|i| (3..6).map(move |j| (i, j)))
+            .fold(0.0f64, |m, (i, j)| m.max(k[i * 6 + j].abs()));
+        assert!(coupling > 0.1 * scale, "coupling {coupling} of {scale}");
+        for i in 0..6 {
+            for j in 0..6 {
+                assert!((k[i * 6 + j] - k[j * 6 + i]).abs() < 1e-8 * scale);
+            }
+        }
+        // A point listed twice is refused, naming it.
+        let twice = points_stiffness(&s, &st, &[n + 1, n + 1]).unwrap_err();
+        assert!(format!("{twice}").contains("each point once"), "{twice}");
     }
 
     /// The stiffness at the fairlead equals central differences of the fairlead force over

@@ -17,9 +17,11 @@
   which a run writes (:meth:`MooringRun.channels`).
 - :mod:`vinculo.mooring.motion`: the prescribed motion of the coupled (Vessel) points.
 - :mod:`vinculo.mooring.model`: the vinculo model of a file (:func:`build_model`).
-- :mod:`vinculo.mooring.analysis`: :func:`statics` (the static equilibrium: end tensions and
-  laid lengths) and :func:`run` (a run with the coupled points moved by a motion), the Python
-  side of ``vinculo mooring statics`` and ``vinculo mooring run``.
+- :mod:`vinculo.mooring.analysis`: :func:`statics` (the static equilibrium: end tensions,
+  laid lengths, and the linearised stiffness at the coupled points and on a vessel carrying
+  them, :meth:`MooringStatics.vessel_stiffness`) and :func:`run` (a run with the coupled points
+  moved by a motion), the Python side of ``vinculo mooring statics`` and ``vinculo mooring
+  run``.
 - :mod:`vinculo.mooring.peer`: run MoorDyn itself (the ``moordyn`` package) on the same file
   with the same fairlead motion, for comparisons and benchmarks.
 

@@ -105,6 +105,168 @@ class MooringStatics:
                          f"{e.laid_length:>10.4g}")
         return "\n".join(lines)
 
+    def coupled_points(self) -> list[int]:
+        """The ids of the coupled (Vessel/Coupled) points, in file order.
+
+        Returns:
+            The point ids.
+        """
+        return [p.id for p in self.model.file.coupled_points()]
+
+    def _particles(self, points: Any) -> tuple[list[int], list[int]]:
+        """The ids of ``points`` (None: the coupled ones) and their particle indices."""
+        ids = self.coupled_points() if points is None else [int(p) for p in points]
+        count = len(self.model.points)
+        if not ids:
+            raise InvalidInputError("the file has no coupled (Vessel/Coupled) points: give the "
+                                    "points to take the stiffness at", name="points", value=ids)
+        for k in ids:
+            if not 1 <= k <= count:
+                raise InvalidInputError(f"point {k} is not one of the file's points 1 to "
+                                        f"{count}", name="points", value=k)
+        if len(set(ids)) != len(ids):
+            raise InvalidInputError("each point once", name="points", value=ids)
+        return ids, [self.model.points[k - 1].index for k in ids]
+
+    def point_forces(self, points: Any = None) -> np.ndarray:
+        """The force of the mooring on each point in the equilibrium (N): that of its lines and
+        of the other elements acting on it, not the point's own weight and buoyancy.
+
+        Arguments:
+            points: the point ids (None: the coupled points, :meth:`coupled_points`).
+
+        Returns:
+            ``(n, 3)`` forces, in the order of ``points``.
+        """
+        from vinculo.mooring.statics import point_force
+
+        _, particles = self._particles(points)
+        system, statics = self.model.system, self.model.statics
+        return np.array([point_force(system, statics, p) for p in particles])
+
+    def stiffness(self, points: Any = None) -> np.ndarray:
+        """The joint linearised stiffness of the mooring at points (N/m), from the analytic
+        Jacobian of the equilibrium (``docs/theory/moorings.md``, stiffness).
+
+        Block ``(i, j)``, rows and columns ``3i:3i+3`` and ``3j:3j+3``, is ``-dF_i/dx_j``:
+        ``F_i`` the mooring's force on point i (:meth:`point_forces`) as point j moves, the
+        other points held and every free node and point in equilibrium. A restoring mooring
+        has a positive definite matrix (MoorDyn's sign of a coupled stiffness).
+
+        Arguments:
+            points: the point ids (None: the coupled points).
+
+        Returns:
+            ``(3n, 3n)`` stiffness (N/m).
+
+        Raises:
+            InvalidInputError: for no points, an unknown one or one listed twice.
+            ConvergenceError: when the stiffness is infinite (an inextensible taut line).
+        """
+        from vinculo.mooring.statics import points_stiffness
+
+        _, particles = self._particles(points)
+        return points_stiffness(self.model.system, self.model.statics, particles)
+
+    def vessel_stiffness(self, reference: Any = (0.0, 0.0, 0.0),
+                         points: Any = None) -> np.ndarray:
+        """The 6x6 linearised stiffness of the mooring on a rigid vessel that carries the
+        points (the coupled points by default), about the point ``reference``.
+
+        With the vessel's small translation u and rotation theta about ``reference``, point i
+        moves by ``u + theta x r_i`` (``r_i`` from the reference to the point), and the
+        mooring's force and moment on the vessel are ``F = sum F_i`` and
+        ``M = sum r_i x F_i``, ``r_i`` turning with the vessel. With the joint stiffness
+        ``K_ij`` (:meth:`stiffness`) and ``[a]`` the matrix of ``a x``::
+
+            K_uu = sum_ij K_ij                  K_ut = -sum_ij K_ij [r_j]
+            K_tu = sum_ij [r_i] K_ij            K_tt = -sum_ij [r_i] K_ij [r_j] - sum_i [F_i] [r_i]
+
+        the last term the change of the moment of the point forces as their points turn (a line
+        hanging below the reference restores a heel with it). Rows and columns: x, y, z
+        (translations, m; forces, N), then rotations about x, y, z (rad; moments, N m).
+
+        Arguments:
+            reference: the point the rotations and moments are about (m).
+            points: the point ids (None: the coupled points).
+
+        Returns:
+            ``(6, 6)`` stiffness: N/m, N/rad, N m/m and N m/rad blocks.
+
+        Raises:
+            InvalidInputError: for a reference that is not three finite numbers, or bad points.
+            ConvergenceError: when the stiffness is infinite (an inextensible taut line).
+        """
+        origin = np.asarray(reference, dtype=float)
+        if origin.shape != (3,) or not np.all(np.isfinite(origin)):
+            raise InvalidInputError("give the reference point as three finite coordinates (m)",
+                                    name="reference", value=reference)
+        ids, particles = self._particles(points)
+        k = self.stiffness(ids)
+        forces = self.point_forces(ids)
+        positions = np.asarray(self.model.statics.positions, dtype=float)[particles]
+        arms = positions - origin
+        out = np.zeros((6, 6))
+        for i, (ri, fi) in enumerate(zip(arms, forces, strict=True)):
+            out[3:, 3:] -= _cross_matrix(fi) @ _cross_matrix(ri)
+            for j, rj in enumerate(arms):
+                kij = k[3 * i:3 * i + 3, 3 * j:3 * j + 3]
+                out[:3, :3] += kij
+                out[:3, 3:] -= kij @ _cross_matrix(rj)
+                out[3:, :3] += _cross_matrix(ri) @ kij
+                out[3:, 3:] -= _cross_matrix(ri) @ kij @ _cross_matrix(rj)
+        return out
+
+    def stiffness_table(self, reference: Any = (0.0, 0.0, 0.0),
+                        stiffness: np.ndarray | None = None) -> str:
+        """A text table of :meth:`vessel_stiffness` about ``reference``: rows and columns x, y,
+        z, rx, ry, rz.
+
+        Arguments:
+            reference: the vessel's reference point (m).
+            stiffness: the matrix (None: :meth:`vessel_stiffness` about ``reference``).
+
+        Returns:
+            The table, with a header line.
+        """
+        k = self.vessel_stiffness(reference) if stiffness is None else stiffness
+        lines = [f"{'':>4}" + "".join(f"{name:>14}" for name in VESSEL_DOFS)]
+        for name, row in zip(VESSEL_DOFS, k, strict=True):
+            lines.append(f"{name:>4}" + "".join(f"{x:>14.6g}" for x in row))
+        return "\n".join(lines)
+
+    def stiffness_to_csv(self, path: str | Path, stiffness: np.ndarray | None = None,
+                         reference: Any = (0.0, 0.0, 0.0)) -> Path:
+        """Write the vessel stiffness: a header ``row,x,y,z,rx,ry,rz``, then one row per degree
+        of freedom, named in the first column (N/m, N/rad, N m/m, N m/rad).
+
+        Arguments:
+            path: the file to write.
+            stiffness: the matrix (None: :meth:`vessel_stiffness` about ``reference``).
+            reference: the vessel's reference point (m), where ``stiffness`` is None.
+
+        Returns:
+            The path written.
+        """
+        k = self.vessel_stiffness(reference) if stiffness is None else stiffness
+        return _write_matrix(path, list(VESSEL_DOFS), k)
+
+    def point_stiffness_to_csv(self, path: str | Path,
+                               stiffness: np.ndarray | None = None) -> Path:
+        """Write the joint stiffness of the coupled points (:meth:`stiffness`): a header
+        ``row,point<k>_x,point<k>_y,point<k>_z,...``, then one row per coordinate (N/m).
+
+        Arguments:
+            path: the file to write.
+            stiffness: the matrix (None: :meth:`stiffness` of the coupled points).
+
+        Returns:
+            The path written.
+        """
+        k = self.stiffness() if stiffness is None else stiffness
+        names = [f"point{p}_{c}" for p in self.coupled_points() for c in "xyz"]
+        return _write_matrix(path, names, k)
+
     def slack_segments(self) -> dict[int, int]:
         """The segments without tension, shorter than their length (a line's spare length,
         which the statics lays slack as a run does: ``vinculo.mooring.statics``).
@@ -167,6 +329,27 @@ def statics(path: str | Path | MoorDynFile, motion: Motion | None = None,
     positions = np.asarray(built.statics.positions, dtype=float)
     return MooringStatics(model=built, ends=_line_ends(built, built.statics, positions),
                           cpu_time=cpu)
+
+
+#: The degrees of freedom of a vessel's stiffness, in the order of its rows and columns:
+#: translations along x, y, z, then rotations about them.
+VESSEL_DOFS = ("x", "y", "z", "rx", "ry", "rz")
+
+
+def _write_matrix(path: str | Path, names: list[str], matrix: np.ndarray) -> Path:
+    """Write a square matrix as CSV: a header ``row,<names>``, then each row named."""
+    path = Path(path)
+    with path.open("w", newline="", encoding="utf-8") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(["row", *names])
+        for name, row in zip(names, matrix, strict=True):
+            writer.writerow([name, *map(repr, map(float, row))])
+    return path
+
+
+def _cross_matrix(a: np.ndarray) -> np.ndarray:
+    """The matrix of ``a x``: ``_cross_matrix(a) @ b == np.cross(a, b)``."""
+    return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
 
 
 @dataclass

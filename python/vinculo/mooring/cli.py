@@ -2,14 +2,17 @@
 
 Usage::
 
-    vinculo mooring statics FILE [--output DIR]
+    vinculo mooring statics FILE [--output DIR] [--reference X Y Z]
     vinculo mooring run FILE [--motion FILE.csv] --t-end T [--dt DT] [--output-every S]
                         [--start statics|file] [--tolerance TOL] [--check-step]
                         [--output DIR] [--no-plots] [--no-progress]
 
 ``statics`` prints each line's end tensions and laid length and writes ``DIR/statics.csv``
 (columns ``line,end,point,x,y,z,fx,fy,fz,tension,laid_length``, two rows per line: end A, then
-end B; ``fx fy fz`` the force the line exerts on the end point). ``run`` starts from that
+end B; ``fx fy fz`` the force the line exerts on the end point) and, when the file has
+Vessel/Coupled points, the 6x6 stiffness of the mooring on a vessel carrying them
+(``DIR/stiffness.csv``, about ``--reference``) and their joint 3x3 blocks
+(``DIR/point_stiffness.csv``). ``run`` starts from that
 equilibrium, moves the Vessel/Coupled points by the motion file (``time``, then ``x, y, z`` of
 each coupled point in file order) and writes ``DIR/tensions.csv``, ``DIR/run.nc``, the plots
 ``DIR/shapes.png`` and ``DIR/tensions.png``, and, when the file has an OUTPUTS section,
@@ -62,6 +65,20 @@ def _tolerance(text: str) -> float:
 _tolerance.__name__ = "tolerance"
 
 
+def _coordinate(text: str) -> float:
+    """An argparse type: a finite coordinate (m)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r}: give a finite coordinate in m")
+    return value
+
+
+_coordinate.__name__ = "coordinate"
+
+
 def _existing_file(text: str) -> Path:
     """An argparse type: a file that exists."""
     path = Path(text)
@@ -99,13 +116,21 @@ def add_mooring_parser(commands: Any) -> None:
             "no time step), print each line's end tensions and laid length, and write "
             "DIR/statics.csv with the columns line,end,point,x,y,z,fx,fy,fz,tension,"
             "laid_length: two rows per line, end A then end B; fx fy fz is the force the line "
-            "exerts on the end point (N), laid_length the length on the seabed (m)."
+            "exerts on the end point (N), laid_length the length on the seabed (m). With "
+            "Vessel/Coupled points, also print the 6x6 linearised stiffness of the mooring on "
+            "a vessel carrying them, about --reference, and write it (DIR/stiffness.csv) with "
+            "the joint 3x3 blocks of the points (DIR/point_stiffness.csv)."
         ),
     )
     statics.add_argument("file", metavar="FILE", type=_existing_file,
                          help="the MoorDyn v2 input file")
     statics.add_argument("--output", "-o", metavar="DIR", type=Path, default=Path("output"),
                          help="folder of statics.csv (created if missing; default: output)")
+    statics.add_argument("--reference", metavar=("X", "Y", "Z"), type=_coordinate, nargs=3,
+                         default=(0.0, 0.0, 0.0),
+                         help="the vessel's reference point, about which its rotations and "
+                         "moments are taken (m; default 0 0 0, the origin of the file's "
+                         "coordinates)")
     statics.set_defaults(handler=_statics)
     run = actions.add_parser(
         "run",
@@ -177,9 +202,31 @@ def _statics(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
         print(f"segments without tension, shorter than their length (spare length lying "
               f"slack): {listed}", flush=True)
     print(result.table(), flush=True)
-    path = result.to_csv(folder / "statics.csv")
-    print(f"results: {path}", flush=True)
+    paths = [result.to_csv(folder / "statics.csv")]
+    if result.coupled_points():
+        paths += _stiffness(result, args.reference, folder)
+    print(f"results: {', '.join(str(p) for p in paths)}", flush=True)
     return 0
+
+
+def _stiffness(result: Any, reference: Any, folder: Path) -> list[Path]:
+    """Print the vessel stiffness of the statics ``result`` and write its two files (none,
+    with a message, when it is infinite)."""
+    from vinculo.errors import ConvergenceError
+
+    try:
+        vessel = result.vessel_stiffness(reference)
+        joint = result.stiffness()
+    except ConvergenceError as exc:
+        print(f"stiffness at the coupled points not computed: {exc}", flush=True)
+        return []
+    where = ", ".join(f"{c:g}" for c in reference)
+    print(f"stiffness of the mooring on a vessel carrying points "
+          f"{', '.join(map(str, result.coupled_points()))}, about ({where}) m "
+          f"(N/m, N/rad; N m/m, N m/rad):", flush=True)
+    print(result.stiffness_table(reference, vessel), flush=True)
+    return [result.stiffness_to_csv(folder / "stiffness.csv", vessel),
+            result.point_stiffness_to_csv(folder / "point_stiffness.csv", joint)]
 
 
 def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:

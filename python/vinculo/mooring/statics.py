@@ -14,7 +14,7 @@ initial conditions.
 
 :func:`point_stiffness` gives the 3x3 linearised stiffness ``K = -dF/dx`` at a point from the
 same analytic Jacobian (its Schur complement on the point), the other particles staying in
-equilibrium.
+equilibrium; :func:`points_stiffness` the joint one of several points.
 
 Example:
     >>> import vinculo
@@ -121,6 +121,33 @@ def point_stiffness(system: Any, statics: Statics, particle: int) -> np.ndarray:
     """
     return np.asarray(_core.point_stiffness(system, statics.positions, statics.multipliers,
                                             int(particle), statics.t))
+
+
+def points_stiffness(system: Any, statics: Statics, particles: list[int]) -> np.ndarray:
+    """The joint linearised stiffness (N/m) of ``system`` at several points.
+
+    The ``(3n, 3n)`` matrix of blocks ``K[3i:3i+3, 3j:3j+3] = -dF_i/dx_j``: ``F_i`` the force of
+    the system's elements on point i (:func:`point_force`) as point j moves, the other points
+    held and every other free particle in equilibrium (``docs/theory/moorings.md``). Its diagonal
+    blocks are :func:`point_stiffness` of each point; its off-diagonal blocks couple points
+    joined through the system (the two fairleads of a bridle). Fixed points are freed for the
+    computation.
+
+    Arguments:
+        system: the :class:`vinculo.System`.
+        statics: its equilibrium (:func:`solve_statics`).
+        particles: the points' particle indices, each once.
+
+    Returns:
+        ``(3n, 3n)`` stiffness.
+
+    Raises:
+        ConvergenceError: when the equilibrium's Jacobian, or its inverse's block on the points,
+            is singular (an inextensible taut line between two of them).
+        InvalidInputError: for no points, an index out of range or a point listed twice.
+    """
+    return np.asarray(_core.points_stiffness(system, statics.positions, statics.multipliers,
+                                             [int(p) for p in particles], statics.t))
 
 
 def point_force(system: Any, statics: Statics, particle: int) -> np.ndarray:
