@@ -22,6 +22,8 @@
   them, :meth:`MooringStatics.vessel_stiffness`) and :func:`run` (a run with the coupled points
   moved by a motion), the Python side of ``vinculo mooring statics`` and ``vinculo mooring
   run``.
+- :mod:`vinculo.mooring.offsets`: the offset curve (:func:`offset_curve`): restoring force and
+  line tensions as the coupled points are moved together, ``vinculo mooring offsets``.
 - :mod:`vinculo.mooring.peer`: run MoorDyn itself (the ``moordyn`` package) on the same file
   with the same fairlead motion, for comparisons and benchmarks.
 
@@ -57,6 +59,7 @@ from vinculo.mooring.moordyn_file import (
     write_moordyn,
 )
 from vinculo.mooring.motion import Motion
+from vinculo.mooring.offsets import OffsetCurve, offset_curve, plot_offset_curve
 from vinculo.mooring.seafloor import Seafloor, read_seafloor
 from vinculo.mooring.stiffness_curve import StiffnessCurve, read_stiffness_curve
 from vinculo.mooring.wave_components import WaveComponents, read_wave_frequencies
@@ -99,6 +102,7 @@ __all__ = [
     "MooringRun",
     "MooringStatics",
     "Motion",
+    "OffsetCurve",
     "Seafloor",
     "SlopeCatenarySolution",
     "StepCheck",
@@ -107,7 +111,9 @@ __all__ = [
     "build_model",
     "check_step",
     "format_moordyn",
+    "offset_curve",
     "parse_moordyn",
+    "plot_offset_curve",
     "read_current_profile",
     "read_moordyn",
     "read_seafloor",

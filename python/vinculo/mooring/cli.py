@@ -3,6 +3,7 @@
 Usage::
 
     vinculo mooring statics FILE [--output DIR] [--reference X Y Z]
+    vinculo mooring offsets FILE --max M [--count N] [--heading DEG] [--output DIR]
     vinculo mooring run FILE [--motion FILE.csv] --t-end T [--dt DT] [--output-every S]
                         [--start statics|file] [--tolerance TOL] [--check-step]
                         [--output DIR] [--no-plots] [--no-progress]
@@ -12,7 +13,9 @@ Usage::
 end B; ``fx fy fz`` the force the line exerts on the end point) and, when the file has
 Vessel/Coupled points, the 6x6 stiffness of the mooring on a vessel carrying them
 (``DIR/stiffness.csv``, about ``--reference``) and their joint 3x3 blocks
-(``DIR/point_stiffness.csv``). ``run`` starts from that
+(``DIR/point_stiffness.csv``). ``offsets`` moves the coupled points together from -M to M
+along a heading and writes the restoring force and line tensions at each offset
+(``DIR/offsets.csv``, ``DIR/offsets.png``; :mod:`vinculo.mooring.offsets`). ``run`` starts from that
 equilibrium, moves the Vessel/Coupled points by the motion file (``time``, then ``x, y, z`` of
 each coupled point in file order) and writes ``DIR/tensions.csv``, ``DIR/run.nc``, the plots
 ``DIR/shapes.png`` and ``DIR/tensions.png``, and, when the file has an OUTPUTS section,
@@ -79,6 +82,34 @@ def _coordinate(text: str) -> float:
 _coordinate.__name__ = "coordinate"
 
 
+def _positive_length(text: str) -> float:
+    """An argparse type: a finite length > 0 (m)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not (math.isfinite(value) and value > 0.0):
+        raise argparse.ArgumentTypeError(f"{text!r}: give a length in m greater than 0")
+    return value
+
+
+_positive_length.__name__ = "length"
+
+
+def _offset_count(text: str) -> int:
+    """An argparse type: a number of offsets, 2 or more."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if value < 2:
+        raise argparse.ArgumentTypeError(f"{text!r}: give 2 offsets or more")
+    return value
+
+
+_offset_count.__name__ = "count"
+
+
 def _existing_file(text: str) -> Path:
     """An argparse type: a file that exists."""
     path = Path(text)
@@ -132,6 +163,31 @@ def add_mooring_parser(commands: Any) -> None:
                          "moments are taken (m; default 0 0 0, the origin of the file's "
                          "coordinates)")
     statics.set_defaults(handler=_statics)
+    offsets = actions.add_parser(
+        "offsets",
+        help="offset curve: restoring force and tensions as the coupled points move",
+        description=(
+            "Move the Vessel/Coupled points together by offsets along a horizontal heading, "
+            "solve the static equilibrium at each, print the restoring force and the lines' "
+            "largest end tensions, and write DIR/offsets.csv (offset, fx, fy, fz, restoring, "
+            "then each line's end tensions and laid length) and DIR/offsets.png. An offset "
+            "whose equilibrium is not found is reported and left NaN; the others are kept."
+        ),
+    )
+    offsets.add_argument("file", metavar="FILE", type=_existing_file,
+                         help="the MoorDyn v2 input file")
+    offsets.add_argument("--max", metavar="M", type=_positive_length, required=True,
+                         help="the largest offset (m): the offsets run from -M to M")
+    offsets.add_argument("--count", metavar="N", type=_offset_count, default=21,
+                         help="the number of offsets from -M to M (default 21)")
+    offsets.add_argument("--heading", metavar="DEG", type=_coordinate, default=0.0,
+                         help="the offsets' heading in the horizontal plane, degrees from +x "
+                         "towards +y (default 0)")
+    offsets.add_argument("--output", "-o", metavar="DIR", type=Path, default=Path("output"),
+                         help="folder of offsets.csv and offsets.png (created if missing; "
+                         "default: output)")
+    offsets.add_argument("--no-plots", action="store_true", help="do not draw the plot")
+    offsets.set_defaults(handler=_offsets)
     run = actions.add_parser(
         "run",
         help="move the coupled points by a recorded motion: tensions over time, NetCDF, plots",
@@ -207,6 +263,32 @@ def _statics(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
         paths += _stiffness(result, args.reference, folder)
     print(f"results: {', '.join(str(p) for p in paths)}", flush=True)
     return 0
+
+
+def _offsets(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
+    """Solve the statics over the offsets, print the table and write the curve."""
+    import numpy as np
+
+    from vinculo.mooring.moordyn_file import read_moordyn
+    from vinculo.mooring.offsets import offset_curve, plot_offset_curve
+
+    model = read_moordyn(args.file)
+    if not model.coupled_points():
+        parser.error(f"{args.file}: the file has no Vessel/Coupled points to move")
+    folder = _output(args.output, parser)
+    values = np.linspace(-args.max, args.max, args.count)
+    curve = offset_curve(model, values, heading=args.heading, progress=True)
+    print(f"{args.file}: points {', '.join(map(str, curve.points))} moved along heading "
+          f"{args.heading:g} deg, {args.count} offsets from {-args.max:g} to {args.max:g} m",
+          flush=True)
+    print(curve.table(), flush=True)
+    for s, message in curve.failed.items():
+        print(f"offset {s:g} m: no equilibrium: {message}", flush=True)
+    paths = [curve.to_csv(folder / "offsets.csv")]
+    if not args.no_plots:
+        paths.append(plot_offset_curve(curve, folder / "offsets.png"))
+    print(f"results: {', '.join(str(p) for p in paths)}", flush=True)
+    return 0 if not curve.failed else 1
 
 
 def _stiffness(result: Any, reference: Any, folder: Path) -> list[Path]:

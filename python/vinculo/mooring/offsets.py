@@ -1,0 +1,230 @@
+"""The offset curve of a mooring: its restoring force and line tensions as a vessel carrying
+the coupled points is moved away from its position.
+
+The coupled (Vessel/Coupled) points of a MoorDyn file are moved together by ``s d`` for each
+offset ``s`` along the unit direction ``d``, and the static equilibrium is solved again at each
+(:func:`vinculo.mooring.statics`, no time step): the mooring's total force on the points, its
+restoring component ``-F . d`` (the sign of the offset where the mooring pulls back), and every
+line's end tensions and laid length.
+The slope of the restoring force at zero offset is ``d^T K_uu d`` of the vessel stiffness
+(:meth:`vinculo.mooring.analysis.MooringStatics.vessel_stiffness`); the curve shows how the
+mooring stiffens (or slackens) beyond the linear range, where a line lifts off the seabed or
+snaps taut. An offset whose equilibrium is not found leaves NaN in its row and its message in
+:attr:`OffsetCurve.failed`: the other offsets are kept.
+
+Example:
+    >>> import vinculo.mooring as mooring
+    >>> curve = mooring.offset_curve("tests/data/moordyn/oc3_hywind.txt",
+    ...                              heading=0.0, offsets=[-10.0, 0.0, 10.0])  # doctest: +SKIP
+    >>> curve.restoring  # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from vinculo.errors import ConvergenceError, InvalidInputError
+from vinculo.mooring.moordyn_file import MoorDynFile, read_moordyn
+
+__all__ = ["OffsetCurve", "offset_curve", "plot_offset_curve"]
+
+
+@dataclass
+class OffsetCurve:
+    """A mooring's forces and tensions over offsets of its coupled points.
+
+    Arguments:
+        direction: the unit direction of the offsets.
+        offsets: ``(k,)`` the offsets along it (m).
+        forces: ``(k, 3)`` the mooring's total force on the coupled points (N).
+        end_tensions: ``(k, lines, 2)`` each line's tension at end A and end B (N).
+        laid_lengths: ``(k, lines)`` each line's length on the seabed (m).
+        lines: the line ids, in file order.
+        points: the ids of the points moved.
+        failed: the offsets whose equilibrium was not found, with the error's message (their
+            rows are NaN).
+    """
+
+    direction: np.ndarray
+    offsets: np.ndarray
+    forces: np.ndarray
+    end_tensions: np.ndarray
+    laid_lengths: np.ndarray
+    lines: list[int]
+    points: list[int]
+    failed: dict[float, str] = field(default_factory=dict)
+
+    @property
+    def restoring(self) -> np.ndarray:
+        """``(k,)`` the restoring force, ``-F . d`` (N): the mooring's pull against the
+        direction of the offsets, with the sign of the offset where it pulls the points back
+        towards zero (a spring's ``k s``)."""
+        return -(self.forces @ self.direction)
+
+    def columns(self) -> list[str]:
+        """The CSV columns: ``offset, fx, fy, fz, restoring``, then each line's
+        ``line<k>_A_tension``, ``line<k>_B_tension`` and ``line<k>_laid_length``."""
+        names = ["offset", "fx", "fy", "fz", "restoring"]
+        for k in self.lines:
+            names += [f"line{k}_A_tension", f"line{k}_B_tension", f"line{k}_laid_length"]
+        return names
+
+    def to_csv(self, path: str | Path) -> Path:
+        """Write the curve, one row per offset (N and m; NaN where the equilibrium failed).
+
+        Arguments:
+            path: the file to write.
+
+        Returns:
+            The path written.
+        """
+        path = Path(path)
+        with path.open("w", newline="", encoding="utf-8") as handle:
+            writer = csv.writer(handle)
+            writer.writerow(self.columns())
+            for i, s in enumerate(self.offsets):
+                row = [s, *self.forces[i], self.restoring[i]]
+                for k in range(len(self.lines)):
+                    row += [*self.end_tensions[i, k], self.laid_lengths[i, k]]
+                writer.writerow([repr(float(x)) for x in row])
+        return path
+
+    def table(self) -> str:
+        """A text table: offset, restoring force and the largest end tension of each line.
+
+        Returns:
+            The table, with a header line.
+        """
+        lines = [f"{'offset (m)':>11} {'restoring (N)':>14}"
+                 + "".join(f"{f'line {k} max T (N)':>18}" for k in self.lines)]
+        for i, s in enumerate(self.offsets):
+            largest = np.max(self.end_tensions[i], axis=1)
+            lines.append(f"{s:>11.4g} {self.restoring[i]:>14.6g}"
+                         + "".join(f"{t:>18.6g}" for t in largest))
+        return "\n".join(lines)
+
+
+def _direction(heading: float | None, direction: Any) -> np.ndarray:
+    """The unit direction of the offsets from a heading (deg) or a vector."""
+    if (heading is None) == (direction is None):
+        raise InvalidInputError("give the offsets' heading (degrees in the horizontal plane) or "
+                                "their direction (a vector), one of the two",
+                                name="heading", value=heading)
+    if heading is not None:
+        if not math.isfinite(heading):
+            raise InvalidInputError("give a finite heading in degrees", name="heading",
+                                    value=heading)
+        angle = math.radians(heading)
+        return np.array([math.cos(angle), math.sin(angle), 0.0])
+    d = np.asarray(direction, dtype=float)
+    norm = float(np.linalg.norm(d)) if d.shape == (3,) else 0.0
+    if not (math.isfinite(norm) and norm > 0.0):
+        raise InvalidInputError("give the offsets' direction as three finite numbers, not all "
+                                "zero", name="direction", value=direction)
+    return d / norm
+
+
+def offset_curve(path: str | Path | MoorDynFile, offsets: Sequence[float], *,
+                 heading: float | None = None, direction: Any = None,
+                 progress: bool = False, **statics_options: Any) -> OffsetCurve:
+    """The offset curve of the mooring of a MoorDyn file (module documentation).
+
+    Arguments:
+        path: the MoorDyn v2 input file (or its content).
+        offsets: the offsets (m), each a static equilibrium.
+        heading: the offsets' direction as a heading in the horizontal plane (degrees from +x
+            towards +y).
+        direction: or as a vector (normalised here).
+        progress: print a line per offset on standard error.
+        **statics_options: passed to the statics (``tolerance``, ``max_iterations``).
+
+    Returns:
+        The curve.
+
+    Raises:
+        MooringFileError: for a malformed or unsupported file.
+        InvalidInputError: for a file without coupled points, offsets that are not finite
+            numbers, or neither or both of ``heading`` and ``direction``.
+    """
+    import sys
+
+    from vinculo.mooring.analysis import statics
+
+    model = path if isinstance(path, MoorDynFile) else read_moordyn(path)
+    d = _direction(heading, direction)
+    values = np.asarray(offsets, dtype=float).reshape(-1)
+    if values.size == 0 or not np.all(np.isfinite(values)):
+        raise InvalidInputError("give one or more finite offsets (m)", name="offsets",
+                                value=offsets)
+    moved = [p.id for p in model.coupled_points()]
+    if not moved:
+        raise InvalidInputError("the file has no coupled (Vessel/Coupled) points to move",
+                                name="points", value=[])
+    n_lines = len(model.lines)
+    forces = np.full((values.size, 3), np.nan)
+    tensions = np.full((values.size, n_lines, 2), np.nan)
+    laid = np.full((values.size, n_lines), np.nan)
+    failed: dict[float, str] = {}
+    for i, s in enumerate(values):
+        shift = s * d
+        points = tuple(
+            dataclasses.replace(p, position=tuple(float(x) for x in np.add(p.position, shift)))
+            if p.id in moved else p for p in model.points)
+        try:
+            result = statics(dataclasses.replace(model, points=points), **statics_options)
+        except ConvergenceError as exc:
+            failed[float(s)] = str(exc)
+            if progress:
+                print(f"offset {s:g} m: no equilibrium ({exc})", file=sys.stderr, flush=True)
+            continue
+        forces[i] = result.point_forces(moved).sum(axis=0)
+        for end in result.ends:
+            k = [row.id for row in model.lines].index(end.line)
+            tensions[i, k, "AB".index(end.end)] = end.tension
+            laid[i, k] = end.laid_length
+        if progress:
+            print(f"offset {s:g} m ({i + 1} of {values.size}): restoring "
+                  f"{-(forces[i] @ d):.6g} N", file=sys.stderr, flush=True)
+    return OffsetCurve(direction=d, offsets=values, forces=forces, end_tensions=tensions,
+                       laid_lengths=laid, lines=[row.id for row in model.lines], points=moved,
+                       failed=failed)
+
+
+def plot_offset_curve(curve: OffsetCurve, path: str | Path) -> Path:
+    """The restoring force and the lines' end tensions against the offset.
+
+    Arguments:
+        curve: the curve (:func:`offset_curve`).
+        path: the PNG file to write.
+
+    Returns:
+        The path written.
+    """
+    from matplotlib.figure import Figure
+
+    from vinculo.plotting import _save
+
+    figure = Figure(figsize=(10, 6.5), layout="constrained")
+    top, bottom = figure.subplots(2, 1, sharex=True)
+    top.plot(curve.offsets, curve.restoring / 1e3, "o-")
+    top.axhline(0.0, color="0.6", lw=0.8)
+    top.set_ylabel("restoring force (kN)")
+    d = curve.direction
+    top.set_title(f"offsets along ({d[0]:.3g}, {d[1]:.3g}, {d[2]:.3g}) of points "
+                  f"{', '.join(map(str, curve.points))}")
+    for k, line in enumerate(curve.lines):
+        bottom.plot(curve.offsets, curve.end_tensions[:, k, 1] / 1e3, label=f"line {line}, end B")
+        bottom.plot(curve.offsets, curve.end_tensions[:, k, 0] / 1e3, "--",
+                    label=f"line {line}, end A")
+    bottom.set_xlabel("offset (m)")
+    bottom.set_ylabel("tension (kN)")
+    bottom.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
+    return _save(figure, path)

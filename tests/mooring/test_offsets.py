@@ -1,0 +1,131 @@
+"""The offset curve of a mooring (``vinculo.mooring.offset_curve``, ``vinculo mooring
+offsets``): against the elastic catenary in closed form, against the analytic stiffness at zero
+offset, and what a sweep keeps when an offset fails."""
+
+import csv
+import dataclasses
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import vinculo.mooring as mooring
+from vinculo import cli
+from vinculo.errors import ConvergenceError, InvalidInputError
+
+DATA = Path(__file__).resolve().parent.parent / "data" / "moordyn"
+OC3 = DATA / "oc3_hywind.txt"
+CHAIN = DATA / "chain_on_seabed.txt"
+
+
+def test_a_single_line_follows_the_elastic_catenary_over_its_offsets():
+    # Reference: the elastic catenary with a frictionless seabed in closed form
+    # (docs/theory/catenary.md) at each moved fairlead, the anchor 300 + s m away and 40 m
+    # below. The fairlead tension is held to 1e-3 of itself, and the horizontal and anchor
+    # tensions, a tenth of it where the line lies slackest (-15 m), to 1e-3 of it; the laid
+    # length within a segment. Those are discretisation errors of the touchdown: measured at
+    # -15 m, the anchor tension 1.2e-2, 1.7e-3, 6.1e-4 and 1.8e-4 of the fairlead tension off
+    # at 80, 160, 320 and 640 segments; 320 here.
+    model = mooring.read_moordyn(CHAIN)
+    model = dataclasses.replace(model, lines=(dataclasses.replace(model.lines[0],
+                                                                  segments=320),))
+    offsets = [-15.0, -5.0, 0.0, 5.0, 10.0]
+    curve = mooring.offset_curve(model, offsets, heading=0.0)
+    assert not curve.failed
+    kind = model.line_types["chain"]
+    o = model.options
+    w = mooring.weight_in_water(kind.mass_per_length, kind.diameter, o.density, o.gravity)
+    for i, s in enumerate(offsets):
+        cat = mooring.solve_catenary(300.0 + s, 40.0, 315.0, w, kind.ea, seabed_contact=True)
+        # The line pulls the fairlead back towards the anchor (-x): restoring +H.
+        assert abs(curve.restoring[i] - cat.horizontal_tension) <= 1e-3 * cat.fairlead_tension
+        assert curve.end_tensions[i, 0, 1] == pytest.approx(cat.fairlead_tension, rel=1e-3)
+        assert abs(curve.end_tensions[i, 0, 0] - cat.anchor_tension) <= (
+            1e-3 * cat.fairlead_tension)
+        assert abs(curve.laid_lengths[i, 0] - cat.laid_length_stretched) <= 315.0 / 320
+    # A tauter line pulls harder: the curve rises with the offset.
+    assert np.all(np.diff(curve.restoring) > 0.0)
+
+
+@pytest.mark.parametrize(("heading", "row"), [(0.0, 0), (90.0, 1), (30.0, None)])
+def test_the_curves_slope_at_zero_is_the_analytic_stiffness(heading, row):
+    # Central differences of the restoring force over +-1 cm of offset against d^T K_uu d of
+    # the vessel stiffness from the analytic Jacobian (two independent computations: re-solved
+    # equilibria, and the Schur complement of one): to 1e-5 relative (O(h^2) truncation).
+    curve = mooring.offset_curve(OC3, [-0.01, 0.0, 0.01], heading=heading)
+    slope = (curve.restoring[2] - curve.restoring[0]) / 0.02
+    k = mooring.statics(OC3).vessel_stiffness()[:3, :3]
+    d = curve.direction
+    assert d == pytest.approx([math.cos(math.radians(heading)), math.sin(math.radians(heading)),
+                               0.0])
+    expected = d @ k @ d
+    if row is not None:
+        assert expected == pytest.approx(k[row, row], rel=1e-12)
+    assert slope == pytest.approx(expected, rel=1e-5)
+    # At zero offset the mooring is balanced horizontally by its symmetry (to round-off of
+    # the 1 MN tensions).
+    assert abs(curve.restoring[1]) < 1e-5 * curve.end_tensions[1].max()
+
+
+def test_a_failed_offset_is_reported_and_the_others_kept(monkeypatch):
+    # The equilibrium at one offset fails (here made to fail): its row is NaN with the error's
+    # message, and the other offsets are the same as in a sweep without it.
+    import vinculo.mooring.analysis as analysis
+
+    real = analysis.statics
+
+    def failing(model, **options):
+        if model.points[3].position[0] > 5.2 + 7.0:
+            raise ConvergenceError("no equilibrium found (made to fail)")
+        return real(model, **options)
+
+    whole = mooring.offset_curve(OC3, [-5.0, 0.0, 5.0], heading=0.0)
+    monkeypatch.setattr(analysis, "statics", failing)
+    curve = mooring.offset_curve(OC3, [-5.0, 0.0, 5.0, 10.0], heading=0.0)
+    assert list(curve.failed) == [10.0]
+    assert "made to fail" in curve.failed[10.0]
+    assert np.all(np.isnan(curve.forces[3])) and np.all(np.isnan(curve.end_tensions[3]))
+    np.testing.assert_array_equal(curve.forces[:3], whole.forces)
+
+
+def test_bad_offset_requests_are_refused():
+    with pytest.raises(InvalidInputError, match="heading"):
+        mooring.offset_curve(OC3, [1.0])
+    with pytest.raises(InvalidInputError, match="one of the two"):
+        mooring.offset_curve(OC3, [1.0], heading=0.0, direction=(1.0, 0.0, 0.0))
+    with pytest.raises(InvalidInputError, match="not all zero"):
+        mooring.offset_curve(OC3, [1.0], direction=(0.0, 0.0, 0.0))
+    with pytest.raises(InvalidInputError, match="finite offsets"):
+        mooring.offset_curve(OC3, [1.0, math.nan], heading=0.0)
+    anchored = mooring.read_moordyn(CHAIN)
+    fixed = tuple(dataclasses.replace(p, attachment="fixed") for p in anchored.points)
+    with pytest.raises(InvalidInputError, match="no coupled"):
+        mooring.offset_curve(dataclasses.replace(anchored, points=fixed), [1.0], heading=0.0)
+
+
+def test_the_offsets_command_writes_the_curve(tmp_path, capsys):
+    output = tmp_path / "out"
+    code = cli.main(["mooring", "offsets", str(OC3), "--max", "10", "--count", "3",
+                     "--heading", "90", "--output", str(output)])
+    assert code == 0
+    out = capsys.readouterr().out
+    assert "moved along heading 90 deg, 3 offsets from -10 to 10 m" in out
+    with (output / "offsets.csv").open() as handle:
+        rows = list(csv.reader(handle))
+    curve = mooring.offset_curve(OC3, [-10.0, 0.0, 10.0], heading=90.0)
+    assert rows[0] == curve.columns()
+    assert rows[0][:5] == ["offset", "fx", "fy", "fz", "restoring"]
+    table = np.array(rows[1:], dtype=float)
+    np.testing.assert_array_equal(table[:, 0], [-10.0, 0.0, 10.0])
+    np.testing.assert_array_equal(table[:, 4], curve.restoring)
+    assert (output / "offsets.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("arguments", [["--max", "0"], ["--max", "5", "--count", "1"],
+                                       ["--max", "5", "--heading", "inf"]])
+def test_bad_offsets_arguments_exit_with_code_2(arguments, capsys):
+    with pytest.raises(SystemExit) as info:
+        cli.main(["mooring", "offsets", str(OC3), *arguments])
+    assert info.value.code == 2
+    assert "usage: vinculo mooring offsets" in capsys.readouterr().err
