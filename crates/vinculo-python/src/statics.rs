@@ -88,6 +88,19 @@ fn check_sizes(system: &vinculo::model::System, st: &Statics) -> PyResult<()> {
     Ok(())
 }
 
+/// The system and its equilibrium from the arrays, their sizes checked against each other.
+fn system_in_equilibrium<'py>(
+    system: &'py Bound<'py, PySystem>,
+    positions: PyReadonlyArray2<'py, f64>,
+    multipliers: PyReadonlyArray1<'py, f64>,
+    t: f64,
+) -> PyResult<(PyRef<'py, PySystem>, Statics)> {
+    let st = equilibrium(positions, multipliers, t)?;
+    let this = system.borrow();
+    check_sizes(&this.inner, &st)?;
+    Ok((this, st))
+}
+
 /// The 3x3 linearised stiffness K = -dF/dx (N/m) at `particle` in an equilibrium.
 #[pyfunction]
 #[pyo3(signature = (system, positions, multipliers, particle, t=0.0))]
@@ -99,9 +112,7 @@ pub fn point_stiffness<'py>(
     particle: usize,
     t: f64,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let st = equilibrium(positions, multipliers, t)?;
-    let this = system.borrow();
-    check_sizes(&this.inner, &st)?;
+    let (this, st) = system_in_equilibrium(&system, positions, multipliers, t)?;
     let k = statics::point_stiffness(&this.inner, &st, particle).map_err(to_py)?;
     let flat: Vec<f64> = k.iter().flatten().copied().collect();
     PyArray1::from_vec(py, flat).reshape([3, 3])
@@ -118,9 +129,7 @@ pub fn points_stiffness<'py>(
     particles: Vec<usize>,
     t: f64,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let st = equilibrium(positions, multipliers, t)?;
-    let this = system.borrow();
-    check_sizes(&this.inner, &st)?;
+    let (this, st) = system_in_equilibrium(&system, positions, multipliers, t)?;
     let k = statics::points_stiffness(&this.inner, &st, &particles).map_err(to_py)?;
     let n = 3 * particles.len();
     PyArray1::from_vec(py, k).reshape([n, n])
@@ -136,9 +145,7 @@ pub fn point_force(
     particle: usize,
     t: f64,
 ) -> PyResult<(f64, f64, f64)> {
-    let st = equilibrium(positions, multipliers, t)?;
-    let this = system.borrow();
-    check_sizes(&this.inner, &st)?;
+    let (this, st) = system_in_equilibrium(&system, positions, multipliers, t)?;
     if particle >= this.inner.particles().len() {
         return Err(pyo3::exceptions::PyIndexError::new_err(format!(
             "particle {particle} is not one of the system's {} particles",

@@ -12,7 +12,7 @@ from __future__ import annotations
 import csv
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -294,14 +294,9 @@ class MooringStatics:
         Returns:
             The path written.
         """
-        path = Path(path)
-        with path.open("w", newline="", encoding="utf-8") as handle:
-            writer = csv.writer(handle)
-            writer.writerow(STATICS_COLUMNS)
-            for e in self.ends:
-                writer.writerow([e.line, e.end, e.point, *map(repr, e.position),
-                                 *map(repr, e.force), repr(e.tension), repr(e.laid_length)])
-        return path
+        return write_csv(path, STATICS_COLUMNS, (
+            [e.line, e.end, e.point, *e.position, *e.force, e.tension, e.laid_length]
+            for e in self.ends))
 
 
 def statics(path: str | Path | MoorDynFile, motion: Motion | None = None,
@@ -336,15 +331,35 @@ def statics(path: str | Path | MoorDynFile, motion: Motion | None = None,
 VESSEL_DOFS = ("x", "y", "z", "rx", "ry", "rz")
 
 
-def _write_matrix(path: str | Path, names: list[str], matrix: np.ndarray) -> Path:
-    """Write a square matrix as CSV: a header ``row,<names>``, then each row named."""
+def write_csv(path: str | Path, header: Sequence[str], rows: Iterable[Sequence[Any]]) -> Path:
+    """Write a CSV table: the ``header``, then the ``rows``, numbers as the shortest text that
+    reads back to the same float (``repr``), other entries (names, ids) as they are.
+
+    Arguments:
+        path: the file to write.
+        header: the column names.
+        rows: the rows.
+
+    Returns:
+        The path written.
+    """
     path = Path(path)
+
+    def text(x: Any) -> Any:
+        return repr(float(x)) if isinstance(x, float | np.floating) else x
+
     with path.open("w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
-        writer.writerow(["row", *names])
-        for name, row in zip(names, matrix, strict=True):
-            writer.writerow([name, *map(repr, map(float, row))])
+        writer.writerow(header)
+        for row in rows:
+            writer.writerow([text(x) for x in row])
     return path
+
+
+def _write_matrix(path: str | Path, names: list[str], matrix: np.ndarray) -> Path:
+    """Write a square matrix as CSV: a header ``row,<names>``, then each row named."""
+    return write_csv(path, ["row", *names],
+                     ([name, *map(float, row)] for name, row in zip(names, matrix, strict=True)))
 
 
 def _cross_matrix(a: np.ndarray) -> np.ndarray:
@@ -412,15 +427,10 @@ class MooringRun:
         Returns:
             The path written.
         """
-        path = Path(path)
         values = self.channels()
-        with path.open("w", newline="", encoding="utf-8") as handle:
-            writer = csv.writer(handle)
-            writer.writerow(["time", *values])
-            columns = list(values.values())
-            for i, t in enumerate(self.times):
-                writer.writerow([repr(float(t)), *(repr(float(c[i])) for c in columns)])
-        return path
+        columns = list(values.values())
+        return write_csv(path, ["time", *values], (
+            [float(t), *(float(c[i]) for c in columns)] for i, t in enumerate(self.times)))
 
     def to_csv(self, path: str | Path) -> Path:
         """Write the end forces and tensions over time.
@@ -431,19 +441,17 @@ class MooringRun:
         Returns:
             The path written.
         """
-        path = Path(path)
         tensions = self.end_tensions
-        with path.open("w", newline="", encoding="utf-8") as handle:
-            writer = csv.writer(handle)
-            writer.writerow(["time", *self.tension_columns()])
-            for i, t in enumerate(self.times):
-                row = [repr(float(t))]
-                for k in range(self.end_forces.shape[1]):
-                    for e in range(2):
-                        row += [repr(float(v)) for v in self.end_forces[i, k, e]]
-                        row.append(repr(float(tensions[i, k, e])))
-                writer.writerow(row)
-        return path
+
+        def row(i: int) -> list[float]:
+            values = [float(self.times[i])]
+            for k in range(self.end_forces.shape[1]):
+                for e in range(2):
+                    values += [*map(float, self.end_forces[i, k, e]), float(tensions[i, k, e])]
+            return values
+
+        return write_csv(path, ["time", *self.tension_columns()],
+                         (row(i) for i in range(len(self.times))))
 
 
 def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_end: float, *,

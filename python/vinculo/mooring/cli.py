@@ -37,77 +37,43 @@ from typing import Any
 __all__ = ["add_mooring_parser"]
 
 
-def _positive_time(text: str) -> float:
-    """An argparse type: a finite time > 0 (s)."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not (math.isfinite(value) and value > 0.0):
-        raise argparse.ArgumentTypeError(f"{text!r}: give a time in s greater than 0")
-    return value
+def _argument_type(name: str, convert: Any, valid: Any, hint: str) -> Any:
+    """An argparse type named ``name``: ``convert(text)`` (float or int), refused with
+    ``hint`` unless ``valid(value)``."""
+
+    def parse(text: str) -> Any:
+        try:
+            value = convert(text)
+        except ValueError:
+            whole = "whole " if convert is int else ""
+            raise argparse.ArgumentTypeError(f"{text!r} is not a {whole}number") from None
+        if not valid(value):
+            raise argparse.ArgumentTypeError(f"{text!r}: {hint}")
+        return value
+
+    parse.__name__ = name
+    return parse
 
 
-_positive_time.__name__ = "time"
+def _positive(value: float) -> bool:
+    return math.isfinite(value) and value > 0.0
 
 
-def _tolerance(text: str) -> float:
-    """An argparse type: Newton's tolerance, a finite number > 0 and below 1 (relative to the
-    model's length scale)."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not (math.isfinite(value) and 0.0 < value < 1.0):
-        raise argparse.ArgumentTypeError(
-            f"{text!r}: give a tolerance greater than 0 and below 1 (relative to the model's "
-            "length scale; default 1e-10)")
-    return value
-
-
-_tolerance.__name__ = "tolerance"
-
-
-def _coordinate(text: str) -> float:
-    """An argparse type: a finite coordinate (m)."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not math.isfinite(value):
-        raise argparse.ArgumentTypeError(f"{text!r}: give a finite coordinate in m")
-    return value
-
-
-_coordinate.__name__ = "coordinate"
-
-
-def _positive_length(text: str) -> float:
-    """An argparse type: a finite length > 0 (m)."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not (math.isfinite(value) and value > 0.0):
-        raise argparse.ArgumentTypeError(f"{text!r}: give a length in m greater than 0")
-    return value
-
-
-_positive_length.__name__ = "length"
-
-
-def _offset_count(text: str) -> int:
-    """An argparse type: a number of offsets, 2 or more."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
-    if value < 2:
-        raise argparse.ArgumentTypeError(f"{text!r}: give 2 offsets or more")
-    return value
-
-
-_offset_count.__name__ = "count"
+#: A finite time > 0 (s).
+_positive_time = _argument_type("time", float, _positive, "give a time in s greater than 0")
+#: Newton's tolerance, relative to the model's length scale.
+_tolerance = _argument_type(
+    "tolerance", float, lambda v: math.isfinite(v) and 0.0 < v < 1.0,
+    "give a tolerance greater than 0 and below 1 (relative to the model's length scale; "
+    "default 1e-10)")
+#: A finite coordinate (m).
+_coordinate = _argument_type("coordinate", float, math.isfinite,
+                             "give a finite coordinate in m")
+#: A finite length > 0 (m).
+_positive_length = _argument_type("length", float, _positive,
+                                  "give a length in m greater than 0")
+#: A number of offsets, 2 or more.
+_offset_count = _argument_type("count", int, lambda v: v >= 2, "give 2 offsets or more")
 
 
 def _existing_file(text: str) -> Path:

@@ -21,7 +21,6 @@ Example:
 
 from __future__ import annotations
 
-import csv
 import dataclasses
 import math
 from collections.abc import Sequence
@@ -86,16 +85,15 @@ class OffsetCurve:
         Returns:
             The path written.
         """
-        path = Path(path)
-        with path.open("w", newline="", encoding="utf-8") as handle:
-            writer = csv.writer(handle)
-            writer.writerow(self.columns())
-            for i, s in enumerate(self.offsets):
-                row = [s, *self.forces[i], self.restoring[i]]
-                for k in range(len(self.lines)):
-                    row += [*self.end_tensions[i, k], self.laid_lengths[i, k]]
-                writer.writerow([repr(float(x)) for x in row])
-        return path
+        from vinculo.mooring.analysis import write_csv
+
+        def row(i: int) -> list[float]:
+            values = [self.offsets[i], *self.forces[i], self.restoring[i]]
+            for k in range(len(self.lines)):
+                values += [*self.end_tensions[i, k], self.laid_lengths[i, k]]
+            return [float(x) for x in values]
+
+        return write_csv(path, self.columns(), (row(i) for i in range(len(self.offsets))))
 
     def table(self) -> str:
         """A text table: offset, restoring force and the largest end tension of each line.
