@@ -151,7 +151,7 @@ class MooringStatics:
         Block ``(i, j)``, rows and columns ``3i:3i+3`` and ``3j:3j+3``, is ``-dF_i/dx_j``:
         ``F_i`` the mooring's force on point i (:meth:`point_forces`) as point j moves, the
         other points held and every free node and point in equilibrium. A restoring mooring
-        has a positive definite matrix (MoorDyn's sign of a coupled stiffness).
+        has a positive definite matrix (a spring's sign: K = -dF/dx).
 
         Arguments:
             points: the point ids (None: the coupled points).

@@ -105,7 +105,7 @@ def point_stiffness(system: Any, statics: Statics, particle: int) -> np.ndarray:
 
     ``F`` is the force that the system's elements exert on the point, and the other free
     particles stay in equilibrium as it moves; a restoring mooring has a positive definite
-    ``K`` (MoorDyn's coupled stiffness convention). A fixed point is freed for the computation.
+    ``K`` (a spring's sign). A fixed point is freed for the computation.
 
     Arguments:
         system: the :class:`vinculo.System`.
