@@ -201,3 +201,25 @@ def test_a_bad_reference_is_refused(capsys):
         cli.main(["mooring", "statics", str(OC3), "--reference", "0", "nan", "0"])
     assert info.value.code == 2
     assert "argument --reference" in capsys.readouterr().err
+
+
+def test_a_point_without_a_line_has_no_stiffness_and_the_statics_is_still_written(tmp_path,
+                                                                                 capsys):
+    # A coupled point that no line holds has no stiffness (its rows of the equilibrium's
+    # matrix are empty): the API says so naming the points, and the command still writes the
+    # statics, reporting the stiffness as not computed.
+    from vinculo import cli
+    from vinculo.errors import ConvergenceError
+
+    text = (DATA / "hanging_line.txt").read_text()
+    row = "2   Coupled     40.0    0.0  -20.0  0     0       0    0\n"
+    assert row in text
+    path = tmp_path / "dangling.txt"
+    path.write_text(text.replace(row, row + "3   Coupled     10.0    0.0  -5.0  0  0  0  0\n"))
+    with pytest.raises(ConvergenceError, match="no finite stiffness at points 2, 3"):
+        mooring.statics(path).stiffness()
+    output = tmp_path / "out"
+    assert cli.main(["mooring", "statics", str(path), "--output", str(output)]) == 0
+    out = capsys.readouterr().out
+    assert "stiffness at the coupled points not computed: no finite stiffness at points 2, 3" in out
+    assert (output / "statics.csv").exists() and not (output / "stiffness.csv").exists()

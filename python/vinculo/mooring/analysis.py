@@ -163,10 +163,18 @@ class MooringStatics:
             InvalidInputError: for no points, an unknown one or one listed twice.
             ConvergenceError: when the stiffness is infinite (an inextensible taut line).
         """
+        from vinculo.errors import ConvergenceError
         from vinculo.mooring.statics import points_stiffness
 
-        _, particles = self._particles(points)
-        return points_stiffness(self.model.system, self.model.statics, particles)
+        ids, particles = self._particles(points)
+        try:
+            return points_stiffness(self.model.system, self.model.statics, particles)
+        except ConvergenceError as exc:
+            listed = ", ".join(map(str, ids))
+            raise ConvergenceError(
+                f"no finite stiffness at points {listed}: the equilibrium's matrix is singular "
+                f"there (a point without a line, or a taut line that cannot stretch): {exc}"
+            ) from exc
 
     def vessel_stiffness(self, reference: Any = (0.0, 0.0, 0.0),
                          points: Any = None) -> np.ndarray:
