@@ -129,3 +129,28 @@ def test_bad_offsets_arguments_exit_with_code_2(arguments, capsys):
         cli.main(["mooring", "offsets", str(OC3), *arguments])
     assert info.value.code == 2
     assert "usage: vinculo mooring offsets" in capsys.readouterr().err
+
+
+def test_the_command_reports_a_failed_offset_and_writes_the_others(tmp_path, capsys,
+                                                                    monkeypatch):
+    # An offset whose equilibrium fails (made to fail) is printed with its message, its row of
+    # offsets.csv is NaN, the other rows are written, and the command exits with 1.
+    import vinculo.mooring.analysis as analysis
+
+    real = analysis.statics
+
+    def failing(model, **options):
+        if model.points[3].position[0] > 5.2 + 7.0:
+            raise ConvergenceError("no equilibrium found (made to fail)")
+        return real(model, **options)
+
+    monkeypatch.setattr(analysis, "statics", failing)
+    output = tmp_path / "out"
+    code = cli.main(["mooring", "offsets", str(OC3), "--max", "10", "--count", "3",
+                     "--output", str(output), "--no-plots"])
+    assert code == 1
+    assert "offset 10 m: no equilibrium: no equilibrium found (made to fail)" in (
+        capsys.readouterr().out)
+    with (output / "offsets.csv").open() as handle:
+        table = np.array(list(csv.reader(handle))[1:], dtype=float)
+    assert np.all(np.isfinite(table[:2, 1:])) and np.all(np.isnan(table[2, 1:]))
