@@ -113,7 +113,7 @@ def _line_of(text: str, needle: str) -> int:
         ("1   rope      1        2", "1   rope      R1A      2", "AttachA", "rod ends"),
         ("95.0      20", "95.0      0 ", "NumSegs", "at least 1"),
         ("95.0      20", "-95.0     20", "UnstrLen", "must be > 0"),
-        ("2   Coupled", "2   Body1  ", "Attachment", "bodies"),
+        ("2   Coupled", "2   Body1  ", "Attachment", "there is no body 1"),
         ("2   Coupled", "2   Sliding", "Attachment", "not a point attachment"),
         ("2   Coupled", "3   Coupled", "ID", "numbered"),
         ("80.0          WtrDpth", "bathy.txt     WtrDpth", "WtrDpth", "no such seafloor file"),
@@ -160,7 +160,7 @@ def test_a_bad_file_names_the_file_line_and_field(tmp_path, old, new, field, wor
          "-10 0 0 -5 4 -\n", "rods"),
         ("---------------------- BODIES ----------------------\nID Attachment X0 Y0 Z0 r0 p0 "
          "y0 Mass CG I Volume CdA Ca\n(#) (-) (m) (m) (m) (deg) (deg) (deg) (kg) (m) (kg-m^2) "
-         "(m^3) (m^2) (-)\n1 coupled 0 0 0 0 0 0 0 0 0 0 0 0\n", "bodies"),
+         "(m^3) (m^2) (-)\n1 free 0 0 0 0 0 0 0 0 0 0 0 0\n", "free bodies"),
     ],
 )
 def test_unsupported_sections_are_rejected_on_their_first_row(section, what):

@@ -49,6 +49,7 @@ from vinculo.mooring.catenary import (
 from vinculo.mooring.current_profile import CurrentProfile, read_current_profile
 from vinculo.mooring.model import MooringModel, build_model
 from vinculo.mooring.moordyn_file import (
+    FileBody,
     FileLine,
     FileOptions,
     FilePoint,
@@ -94,6 +95,7 @@ the module of the equilibrium solver (``vinculo.mooring.statics.solve_statics``)
 __all__ = [
     "CatenarySolution",
     "CurrentProfile",
+    "FileBody",
     "FileLine",
     "FileOptions",
     "FilePoint",

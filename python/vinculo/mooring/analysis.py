@@ -225,6 +225,39 @@ class MooringStatics:
                 out[3:, 3:] -= _cross_matrix(ri) @ kij @ _cross_matrix(rj)
         return out
 
+    def coupled_bodies(self) -> list[int]:
+        """The ids of the file's Coupled bodies, in file order.
+
+        Returns:
+            The body ids.
+        """
+        return [b.id for b in self.model.file.bodies if b.attachment == "coupled"]
+
+    def body_stiffness(self, body: int) -> np.ndarray:
+        """The 6x6 linearised stiffness of the mooring on a body of the file, about its
+        reference point (X0, Y0, Z0): :meth:`vessel_stiffness` of the points attached to it.
+
+        Arguments:
+            body: the body's id.
+
+        Returns:
+            ``(6, 6)`` stiffness: N/m, N/rad, N m/m and N m/rad blocks.
+
+        Raises:
+            InvalidInputError: for a body that is not in the file or carries no point.
+            ConvergenceError: when the stiffness is infinite.
+        """
+        bodies = {b.id: b for b in self.model.file.bodies}
+        if body not in bodies:
+            raise InvalidInputError(f"body {body} is not one of the file's bodies "
+                                    f"({', '.join(map(str, bodies)) or 'none'})", name="body",
+                                    value=body)
+        points = [p.id for p in self.model.file.points if p.body == body]
+        if not points:
+            raise InvalidInputError(f"body {body} carries no point, so no line pulls it",
+                                    name="body", value=body)
+        return self.vessel_stiffness(bodies[body].position, points)
+
     def stiffness_table(self, reference: Any = (0.0, 0.0, 0.0),
                         stiffness: np.ndarray | None = None) -> str:
         """A text table of :meth:`vessel_stiffness` about ``reference``: rows and columns x, y,
@@ -521,6 +554,13 @@ def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_en
     if start not in ("statics", "file"):
         raise InvalidInputError(f"start = {start!r}: give \"statics\" or \"file\"",
                                 name="start", value=start)
+    coupled_bodies = [b.id for b in path.bodies if b.attachment == "coupled"]
+    if coupled_bodies:
+        raise InvalidInputError(
+            f"body {coupled_bodies[0]} is Coupled: runs of coupled bodies (moved in six degrees "
+            f"of freedom) are not supported yet; their statics, stiffness and offset curves are "
+            f"(vinculo mooring statics, offsets), and a run moves Coupled points",
+            name="bodies", value=coupled_bodies)
     if motion is not None:
         first, last = motion.domain()
         if first > 0.0 or last < t_end:

@@ -97,10 +97,11 @@ def add_mooring_parser(commands: Any) -> None:
         "mooring",
         help="statics and runs of a MoorDyn input file",
         description=(
-            "Read a MoorDyn v2 input file (LINE TYPES, POINTS, LINES, OPTIONS) and solve its "
-            "static equilibrium, or run it with the Vessel/Coupled points moved by a recorded "
-            "motion. Rods, bodies and wave kinematics are not supported yet: such a file is "
-            "rejected with an error naming the line and the field."
+            "Read a MoorDyn v2 input file (LINE TYPES, BODIES, POINTS, LINES, OPTIONS) and "
+            "solve its static equilibrium, or run it with the Vessel/Coupled points moved by a "
+            "recorded motion. Rods, free bodies, runs of coupled bodies and wave grids are not "
+            "supported yet: such a file is rejected with an error naming the line and the "
+            "field."
         ),
     )
     actions = mooring.add_subparsers(dest="mooring_command", metavar="ACTION")
@@ -227,6 +228,8 @@ def _statics(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     paths = [result.to_csv(folder / "statics.csv")]
     if result.coupled_points():
         paths += _stiffness(result, args.reference, folder)
+    for body in result.coupled_bodies():
+        paths += _body_stiffness(result, body, folder)
     print(f"results: {', '.join(str(p) for p in paths)}", flush=True)
     return 0
 
@@ -255,6 +258,24 @@ def _offsets(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
         paths.append(plot_offset_curve(curve, folder / "offsets.png"))
     print(f"results: {', '.join(str(p) for p in paths)}", flush=True)
     return 0 if not curve.failed else 1
+
+
+def _body_stiffness(result: Any, body: int, folder: Path) -> list[Path]:
+    """Print the stiffness of the mooring on a coupled body about its reference point and
+    write it (none, with a message, when it is infinite)."""
+    from vinculo.errors import ConvergenceError
+
+    try:
+        k = result.body_stiffness(body)
+    except ConvergenceError as exc:
+        print(f"stiffness on body {body} not computed: {exc}", flush=True)
+        return []
+    row = result.model.file.bodies[body - 1]
+    where = ", ".join(f"{c:g}" for c in row.position)
+    print(f"stiffness of the mooring on body {body}, about its reference point ({where}) m "
+          f"(N/m, N/rad; N m/m, N m/rad):", flush=True)
+    print(result.stiffness_table(row.position, k), flush=True)
+    return [result.stiffness_to_csv(folder / f"stiffness_body{body}.csv", k)]
 
 
 def _stiffness(result: Any, reference: Any, folder: Path) -> list[Path]:

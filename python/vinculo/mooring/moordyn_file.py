@@ -8,12 +8,13 @@ The format is MoorDyn's (moordyn.readthedocs.io, "Input Files", "The V2 Input Fi
 
 What is read: LINE TYPES (name, diameter, mass per length, EA, BA or a negative damping ratio,
 EI, Cd, Ca, CdAx, CaAx), POINTS (also spelled POINT PROPERTIES, CONNECTION PROPERTIES or
-NODE PROPERTIES; attachments Fixed, Coupled/Vessel and Free/Point/Connect), LINES, OPTIONS
-(water depth, density, gravity, seabed contact and friction, time step and MoorDyn's own
-simulation settings) and OUTPUTS (kept for writing back). What is not supported yet raises a
+NODE PROPERTIES; attachments Fixed, Coupled/Vessel, Free/Point/Connect and Body<n>), BODIES
+(Fixed and Coupled bodies, which place the points attached to them), LINES, OPTIONS (water
+depth, density, gravity, seabed contact and friction, time step and MoorDyn's own simulation
+settings) and OUTPUTS (kept for writing back). What is not supported yet raises a
 :class:`~vinculo.errors.MooringFileError` that names the file, the line and the field: rods,
-bodies, failures, external loads, control channels, wave grids and dynamic currents,
-viscoelastic stiffness, vortex-induced vibration, points attached to bodies.
+free bodies, failures, external loads, control channels, wave grids and dynamic currents,
+viscoelastic stiffness, vortex-induced vibration.
 
 Units are SI throughout (m, kg, N, s), as in the file.
 """
@@ -36,6 +37,7 @@ from vinculo.mooring.wave_components import WAVE_FILE, WaveComponents, read_wave
 
 __all__ = [
     "ATTACHMENTS",
+    "FileBody",
     "FileLine",
     "FileOptions",
     "FilePoint",
@@ -101,7 +103,6 @@ _SECTIONS = {
 _UNSUPPORTED_SECTIONS = {
     "rod_types": "rod types",
     "rods": "rods",
-    "bodies": "bodies",
     "failure": "line failures",
     "control": "control channels",
     "external_loads": "external loads",
@@ -122,6 +123,10 @@ class FilePoint:
         volume: a float's displaced volume (m^3).
         cda: drag coefficient times projected area (m^2).
         ca: added-mass coefficient (on the displaced volume).
+        body: the body the point is attached to (``Body<n>``), whose attachment it then has;
+            None for a point of its own.
+        relative: for a point on a body, its position in the body's frame as the file gives
+            it (``position`` is then where the body places it).
     """
 
     id: int
@@ -131,6 +136,48 @@ class FilePoint:
     volume: float = 0.0
     cda: float = 0.0
     ca: float = 0.0
+    body: int | None = None
+    relative: tuple[float, float, float] | None = None
+
+
+@dataclass(frozen=True)
+class FileBody:
+    """A row of the BODIES section: a Fixed or Coupled rigid body, which places the points
+    attached to it (``Body<n>`` in the POINTS section).
+
+    A point at ``r`` in the body's frame is at ``position + R r``, with
+    ``R = Rx(roll) Ry(pitch) Rz(yaw)`` (MoorDyn-C's composition of the body's angles, checked
+    against the point positions MoorDyn 2.7.2 reports). The body's own mass, inertia, volume and
+    drag act on a Free body only, which vinculo does not model yet: they are kept as written.
+
+    Arguments:
+        id: the body's number (1, 2, ... in file order).
+        attachment: ``"fixed"`` or ``"coupled"`` (MoorDyn's Coupled or Vessel).
+        position: the reference point (X0, Y0, Z0), m.
+        rotation: roll, pitch and yaw (r0, p0, y0), degrees.
+        properties: the Mass, CG, I, Volume, CdA and Ca columns as written.
+    """
+
+    id: int
+    attachment: str
+    position: tuple[float, float, float]
+    rotation: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    properties: tuple[str, ...] = ("0", "0", "0", "0", "0", "0")
+
+    def rotation_matrix(self) -> tuple[tuple[float, float, float], ...]:
+        """``R = Rx(roll) Ry(pitch) Rz(yaw)``, rows."""
+        (cr, sr), (cp, sp), (cy, sy) = (
+            (math.cos(math.radians(a)), math.sin(math.radians(a))) for a in self.rotation)
+        return ((cp * cy, -cp * sy, sp),
+                (cr * sy + sr * sp * cy, cr * cy - sr * sp * sy, -sr * cp),
+                (sr * sy - cr * sp * cy, sr * cy + cr * sp * sy, cr * cp))
+
+    def place(self, relative: tuple[float, float, float]) -> tuple[float, float, float]:
+        """The position of the point at ``relative`` in the body's frame (m)."""
+        rows = self.rotation_matrix()
+        return tuple(  # type: ignore[return-value]
+            self.position[i] + sum(rows[i][k] * relative[k] for k in range(3))
+            for i in range(3))
 
 
 @dataclass(frozen=True)
@@ -217,6 +264,7 @@ class MoorDynFile:
         outputs: the OUTPUTS channel names (:mod:`vinculo.mooring.channels`): a run writes
             them (``channels.csv``), and they are written back.
         path: the file read (None for a model parsed from text or built in code).
+        bodies: the BODIES rows, in file order (body ``k`` is ``bodies[k - 1]``).
     """
 
     line_types: dict[str, LineType]
@@ -226,6 +274,7 @@ class MoorDynFile:
     title: str = ""
     outputs: tuple[str, ...] = ()
     path: Path | None = None
+    bodies: tuple[FileBody, ...] = ()
 
     def point(self, number: int) -> FilePoint:
         """The point with MoorDyn number ``number``.
@@ -461,7 +510,8 @@ def _curve(path: str, line: _Line, text: str) -> StiffnessCurve:
 _POINT_COLUMNS = ("ID", "Attachment", "X", "Y", "Z", "Mass", "Volume", "CdA", "Ca")
 
 
-def _point(path: str, line: _Line, fields: list[str], expected_id: int) -> FilePoint:
+def _point(path: str, line: _Line, fields: list[str], expected_id: int,
+           bodies: dict[int, FileBody]) -> FilePoint:
     _check_columns(path, line, fields, _POINT_COLUMNS, "POINTS")
     number = _whole(path, line, "ID", fields[0])
     if number != expected_id:
@@ -470,22 +520,59 @@ def _point(path: str, line: _Line, fields: list[str], expected_id: int) -> FileP
                      f"(expected {expected_id})", number)
     word = fields[1]
     attachment = _ATTACHMENT_NAMES.get(word.lower())
-    if attachment is None:
-        if re.fullmatch(r"(?i)(body|turbine)\d*", word):
-            raise _error(path, line.number, "Attachment",
-                         f"{word!r}: points attached to bodies or turbines are not supported "
-                         f"yet; use Fixed, Coupled (Vessel) or Free", word)
+    on_body = re.fullmatch(r"(?i)body(\d+)", word)
+    body = bodies.get(int(on_body.group(1))) if on_body else None
+    if on_body and body is None:
         raise _error(path, line.number, "Attachment",
-                     f"{word!r} is not a point attachment: use Fixed, Coupled (or Vessel) or "
-                     f"Free (or Point, Connect)", word)
+                     f"{word!r}: there is no body {on_body.group(1)} in a BODIES section "
+                     f"before POINTS", word)
+    if attachment is None and body is None:
+        if re.fullmatch(r"(?i)turbine\d*", word):
+            raise _error(path, line.number, "Attachment",
+                         f"{word!r}: points attached to turbines are not supported yet; use "
+                         f"Fixed, Coupled (Vessel), Free or a body", word)
+        raise _error(path, line.number, "Attachment",
+                     f"{word!r} is not a point attachment: use Fixed, Coupled (or Vessel), "
+                     f"Free (or Point, Connect) or Body<n>", word)
     x, y, z = (_number(path, line, name, fields[k]) for k, name in zip((2, 3, 4), "XYZ",
                                                                         strict=True))
     mass, volume, cda, ca = (
         _positive(path, line, name, _number(path, line, name, fields[k]), allow_zero=True)
         for k, name in zip((5, 6, 7, 8), ("Mass", "Volume", "CdA", "Ca"), strict=True)
     )
-    return FilePoint(id=number, attachment=attachment, position=(x, y, z), mass=mass,
+    if body is not None:
+        return FilePoint(id=number, attachment=body.attachment, position=body.place((x, y, z)),
+                         mass=mass, volume=volume, cda=cda, ca=ca, body=body.id,
+                         relative=(x, y, z))
+    return FilePoint(id=number, attachment=str(attachment), position=(x, y, z), mass=mass,
                      volume=volume, cda=cda, ca=ca)
+
+
+_BODY_COLUMNS = ("ID", "Attachment", "X0", "Y0", "Z0", "r0", "p0", "y0", "Mass", "CG", "I",
+                 "Volume", "CdA", "Ca")
+
+
+def _body(path: str, line: _Line, fields: list[str], expected_id: int) -> FileBody:
+    _check_columns(path, line, fields, _BODY_COLUMNS, "BODIES")
+    number = _whole(path, line, "ID", fields[0])
+    if number != expected_id:
+        raise _error(path, line.number, "ID",
+                     f"body {number}: bodies must be numbered 1, 2, ... in order "
+                     f"(expected {expected_id})", number)
+    word = fields[1]
+    attachment = _ATTACHMENT_NAMES.get(word.lower())
+    if attachment == "free":
+        raise _error(path, line.number, "Attachment",
+                     f"{word!r}: free bodies are not supported yet; vinculo reads Fixed and "
+                     f"Coupled (Vessel) bodies, which place their points (statics, stiffness, "
+                     f"offset curves)", word)
+    if attachment is None:
+        raise _error(path, line.number, "Attachment",
+                     f"{word!r} is not a body attachment: use Fixed or Coupled (or Vessel)",
+                     word)
+    pose = [_number(path, line, name, fields[k]) for k, name in enumerate(_BODY_COLUMNS[2:8], 2)]
+    return FileBody(id=number, attachment=attachment, position=(pose[0], pose[1], pose[2]),
+                    rotation=(pose[3], pose[4], pose[5]), properties=tuple(fields[8:14]))
 
 
 _LINE_COLUMNS = ("ID", "LineType", "AttachA", "AttachB", "UnstrLen", "NumSegs")
@@ -704,6 +791,7 @@ def parse_moordyn(text: str, path: str | Path = "<text>") -> MoorDynFile:
     title = ""
     line_types: dict[str, LineType] = {}
     points: list[FilePoint] = []
+    bodies: dict[int, FileBody] = {}
     lines: list[FileLine] = []
     options = FileOptions()
     outputs: list[str] = []
@@ -717,8 +805,8 @@ def parse_moordyn(text: str, path: str | Path = "<text>") -> MoorDynFile:
             rows = [ln for ln in body if ln.text.strip()]
             if rows:
                 raise _error(name, header.number, header.text.strip("- ") or header.text,
-                             "not a MoorDyn section vinculo knows (LINE TYPES, POINTS, LINES, "
-                             "OPTIONS, OUTPUTS; ROD TYPES, RODS, BODIES are not supported "
+                             "not a MoorDyn section vinculo knows (LINE TYPES, BODIES, POINTS, "
+                             "LINES, OPTIONS, OUTPUTS; ROD TYPES and RODS are not supported "
                              "yet)", header.text)
             continue
         if kind in seen:
@@ -743,9 +831,13 @@ def parse_moordyn(text: str, path: str | Path = "<text>") -> MoorDynFile:
                                  f"{line_type_rows[lt.name]})", lt.name)
                 line_types[lt.name] = lt
                 line_type_rows[lt.name] = line.number
+        elif kind == "bodies":
+            for line, fields in _table_rows(body):
+                row = _body(name, line, fields, len(bodies) + 1)
+                bodies[row.id] = row
         elif kind == "points":
             for line, fields in _table_rows(body):
-                points.append(_point(name, line, fields, len(points) + 1))
+                points.append(_point(name, line, fields, len(points) + 1, bodies))
         elif kind == "lines":
             for line, fields in _table_rows(body):
                 ln = _line(name, line, fields, len(lines) + 1)
@@ -782,7 +874,8 @@ def parse_moordyn(text: str, path: str | Path = "<text>") -> MoorDynFile:
                      "at least one line", None)
     return MoorDynFile(line_types=line_types, points=tuple(points), lines=tuple(lines),
                        options=options, title=title, outputs=tuple(outputs),
-                       path=Path(path) if name != "<text>" else None)
+                       path=Path(path) if name != "<text>" else None,
+                       bodies=tuple(bodies.values()))
 
 
 def read_moordyn(path: str | Path) -> MoorDynFile:
@@ -880,11 +973,22 @@ def format_moordyn(model: MoorDynFile, seafloor_path: str | Path | None = None,
           *map(_g, (t.ba, t.ei, t.cd, t.ca, t.cdax, t.caax))]
          for t in model.line_types.values()],
     )
+    if model.bodies:
+        out.append(_header("BODIES"))
+        out += _table(
+            list(_BODY_COLUMNS),
+            ["(#)", "(-)", "(m)", "(m)", "(m)", "(deg)", "(deg)", "(deg)", "(kg)", "(m)",
+             "(kg-m^2)", "(m^3)", "(m^2)", "(-)"],
+            [[str(b.id), _ATTACHMENT_WORDS[b.attachment], *map(_g, b.position),
+              *map(_g, b.rotation), *b.properties] for b in model.bodies],
+        )
     out.append(_header("POINTS"))
     out += _table(
         ["ID", "Attachment", "X", "Y", "Z", "Mass", "Volume", "CdA", "Ca"],
         ["(#)", "(-)", "(m)", "(m)", "(m)", "(kg)", "(m^3)", "(m^2)", "(-)"],
-        [[str(p.id), _ATTACHMENT_WORDS[p.attachment], *map(_g, p.position),
+        [[str(p.id),
+          _ATTACHMENT_WORDS[p.attachment] if p.body is None else f"Body{p.body}",
+          *map(_g, p.position if p.relative is None else p.relative),
           *map(_g, (p.mass, p.volume, p.cda, p.ca))] for p in model.points],
     )
     out.append(_header("LINES"))

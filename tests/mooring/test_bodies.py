@@ -1,0 +1,123 @@
+"""BODIES in MoorDyn files: Fixed and Coupled bodies place the points attached to them
+(``Body<n>``) as MoorDyn does, the statics and stiffness of a coupled body are those of its
+points, and what is not supported (free bodies, runs of coupled bodies) is refused by name."""
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import vinculo.mooring as mooring
+from vinculo import cli
+from vinculo.errors import InvalidInputError, MooringFileError
+from vinculo.mooring.moordyn_file import format_moordyn, parse_moordyn
+
+DATA = Path(__file__).resolve().parent.parent / "data" / "moordyn"
+
+ROTATED = """--------------------- MoorDyn Input File ------------------------------------
+a line from an anchor to a point of a rotated fixed body
+----------------------- LINE TYPES ------------------------------------------
+TypeName   Diam    Mass/m     EA         BA/-zeta    EI         Cd     Ca     CdAx    CaAx
+(name)     (m)     (kg/m)     (N)        (N-s/-)     (N-m^2)    (-)    (-)    (-)     (-)
+main       0.1     20.0       1.0E8      -1.0        0          1.2    1.0    0.2     0.0
+---------------------------- BODIES -----------------------------------------------------
+ID   Attachment  X0    Y0   Z0     r0    p0    y0    Mass  CG*  I*        Volume  CdA*  Ca
+(#)  (-)         (m)   (m)  (m)    (deg) (deg) (deg) (kg)  (m)  (kg-m^2)  (m^3)   (m^2) (-)
+1    Fixed       10.0  5.0  -20.0  30.0  20.0  40.0  0     0    0         0       0     0
+---------------------- POINTS --------------------------------
+ID    Type      X       Y       Z       Mass   Volume  CdA    Ca
+(#)   (-)       (m)     (m)     (m)     (kg)   (m^3)   (m^2)  (-)
+1     Fixed     -40     0       -60     0      0       0      0
+2     Body1     3.0     1.0     -2.0    0      0       0      0
+---------------------- LINES ----------------------------------------
+ID   LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
+(#)   (name)     (#)      (#)       (m)       (-)     (-)
+1     main       1        2         70.0      10      -
+---------------------- OPTIONS -----------------------------------------
+0             writeLog      Write a log file
+1E-4          dtM           time step to use in mooring integration (s)
+100           WtrDpth       water depth (m)
+0.0           TmaxIC        no initial-condition run
+------------------------- need this line --------------------------------------
+"""
+
+
+def _oc3_on_a_body(yaw: float = 0.0) -> str:
+    """The OC3-Hywind mooring with its fairleads on a Coupled body at the origin turned by
+    ``yaw`` degrees (the points' coordinates, in the body's frame, are the file's)."""
+    text = (DATA / "oc3_hywind.txt").read_text()
+    bodies = ("---------------------- BODIES ---------------------------------------------\n"
+              "ID Attachment X0 Y0 Z0 r0 p0 y0 Mass CG I Volume CdA Ca\n"
+              "(#) (-) (m) (m) (m) (deg) (deg) (deg) (kg) (m) (kg-m^2) (m^3) (m^2) (-)\n"
+              f"1 Coupled 0.0 0.0 0.0 0.0 0.0 {yaw} 0 0 0 0 0 0\n")
+    text = text.replace("---------------------- POINTS", bodies + "---------------------- POINTS")
+    return text.replace("   Vessel      ", "   Body1       ")
+
+
+def test_a_body_places_its_points_where_moordyn_does():
+    # Reference: MoorDyn 2.7.2's position of the point on a fixed body turned by (30, 20, 40)
+    # degrees, read through its API after it reads the same file (to round-off).
+    moordyn = pytest.importorskip("moordyn")
+    model = parse_moordyn(ROTATED)
+    point = model.points[1]
+    assert point.body == 1 and point.attachment == "fixed"
+    assert point.relative == (3.0, 1.0, -2.0)
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as folder:
+        file = Path(folder) / "rotated.txt"
+        file.write_text(ROTATED)
+        system = moordyn.Create(str(file))
+        moordyn.Init(system, [], [])
+        expected = moordyn.GetPointPos(moordyn.GetPoint(system, 2))
+        moordyn.Close(system)
+    np.testing.assert_allclose(point.position, expected, atol=1e-12)
+    # Written back, the file reads to the same model (the point on its body, in its frame).
+    again = parse_moordyn(format_moordyn(model))
+    assert again.bodies == model.bodies and again.points == model.points
+
+
+def test_a_coupled_body_is_its_points():
+    # The statics of the OC3 mooring with its fairleads on a Coupled body turned by 25 degrees
+    # equal those of the file with Coupled points where the body puts them (the same model,
+    # bit for bit), and the body's stiffness about its reference point is the vessel stiffness
+    # of those points about it.
+    on_body = parse_moordyn(_oc3_on_a_body(25.0))
+    points = tuple(dataclasses.replace(p, body=None, relative=None) for p in on_body.points)
+    plain = dataclasses.replace(on_body, points=points, bodies=())
+    a, b = mooring.statics(on_body), mooring.statics(plain)
+    assert [e.tension for e in a.ends] == [e.tension for e in b.ends]
+    assert a.coupled_bodies() == [1] and b.coupled_bodies() == []
+    np.testing.assert_array_equal(a.body_stiffness(1), b.vessel_stiffness((0.0, 0.0, 0.0)))
+
+
+def test_the_oc3_spar_as_a_coupled_body_has_its_published_stiffness(tmp_path, capsys):
+    # The OC3-Hywind fairleads on a Coupled body at the spar's reference point: the body's 6x6
+    # is the published matrix (Jonkman, NREL/TP-500-47535, 2010, eq. 5-3; 0.5 %, as
+    # test_vessel_stiffness.py), printed and written by the statics command.
+    path = tmp_path / "oc3_body.txt"
+    path.write_text(_oc3_on_a_body())
+    output = tmp_path / "out"
+    assert cli.main(["mooring", "statics", str(path), "--output", str(output)]) == 0
+    out = capsys.readouterr().out
+    assert "stiffness of the mooring on body 1, about its reference point (0, 0, 0) m" in out
+    k = np.genfromtxt(output / "stiffness_body1.csv", delimiter=",", skip_header=1)[:, 1:]
+    for (i, j), value in {(0, 0): 41_180.0, (2, 2): 11_940.0, (3, 3): 311_100_000.0,
+                          (5, 5): 11_560_000.0, (0, 4): -2_821_000.0}.items():
+        assert k[i, j] == pytest.approx(value, rel=5e-3), (i, j)
+
+
+def test_what_bodies_do_not_support_yet_is_refused_by_name(tmp_path):
+    free = ROTATED.replace("1    Fixed       10.0", "1    Free        10.0")
+    with pytest.raises(MooringFileError, match="line 10: Attachment: 'Free': free bodies"):
+        parse_moordyn(free)
+    missing = ROTATED.replace("2     Body1", "2     Body2")
+    with pytest.raises(MooringFileError, match="line 15: Attachment: 'Body2': there is no body"):
+        parse_moordyn(missing)
+    coupled = parse_moordyn(_oc3_on_a_body())
+    with pytest.raises(InvalidInputError, match="body 1 is Coupled: runs of coupled bodies"):
+        mooring.run(coupled, None, 1.0)
+    statics = mooring.statics(coupled)
+    with pytest.raises(InvalidInputError, match="body 2 is not one of the file's bodies"):
+        statics.body_stiffness(2)
