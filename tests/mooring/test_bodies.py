@@ -102,6 +102,9 @@ def test_the_oc3_spar_as_a_coupled_body_has_its_published_stiffness(tmp_path, ca
     assert cli.main(["mooring", "statics", str(path), "--output", str(output)]) == 0
     out = capsys.readouterr().out
     assert "stiffness of the mooring on body 1, about its reference point (0, 0, 0) m" in out
+    # The body's points are its own: no second matrix of them as a vessel of coupled points.
+    assert "on a vessel carrying points" not in out and not (output / "stiffness.csv").exists()
+    assert (output / "point_stiffness.csv").exists()
     k = np.genfromtxt(output / "stiffness_body1.csv", delimiter=",", skip_header=1)[:, 1:]
     for (i, j), value in {(0, 0): 41_180.0, (2, 2): 11_940.0, (3, 3): 311_100_000.0,
                           (5, 5): 11_560_000.0, (0, 4): -2_821_000.0}.items():

@@ -279,23 +279,27 @@ def _body_stiffness(result: Any, body: int, folder: Path) -> list[Path]:
 
 
 def _stiffness(result: Any, reference: Any, folder: Path) -> list[Path]:
-    """Print the vessel stiffness of the statics ``result`` and write its two files (none,
-    with a message, when it is infinite)."""
+    """Print the vessel stiffness of the statics ``result`` (its coupled points that are not on
+    a body, which get their own) and write it with the joint stiffness of all coupled points
+    (none, with a message, when it is infinite)."""
     from vinculo.errors import ConvergenceError
 
+    own = [p.id for p in result.model.file.coupled_points() if p.body is None]
     try:
-        vessel = result.vessel_stiffness(reference)
+        vessel = result.vessel_stiffness(reference, own) if own else None
         joint = result.stiffness()
     except ConvergenceError as exc:
         print(f"stiffness at the coupled points not computed: {exc}", flush=True)
         return []
-    where = ", ".join(f"{c:g}" for c in reference)
-    print(f"stiffness of the mooring on a vessel carrying points "
-          f"{', '.join(map(str, result.coupled_points()))}, about ({where}) m "
-          f"(N/m, N/rad; N m/m, N m/rad):", flush=True)
-    print(result.stiffness_table(reference, vessel), flush=True)
-    return [result.stiffness_to_csv(folder / "stiffness.csv", vessel),
-            result.point_stiffness_to_csv(folder / "point_stiffness.csv", joint)]
+    paths = [result.point_stiffness_to_csv(folder / "point_stiffness.csv", joint)]
+    if vessel is not None:
+        where = ", ".join(f"{c:g}" for c in reference)
+        print(f"stiffness of the mooring on a vessel carrying points "
+              f"{', '.join(map(str, own))}, about ({where}) m (N/m, N/rad; N m/m, N m/rad):",
+              flush=True)
+        print(result.stiffness_table(reference, vessel), flush=True)
+        paths.insert(0, result.stiffness_to_csv(folder / "stiffness.csv", vessel))
+    return paths
 
 
 def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
