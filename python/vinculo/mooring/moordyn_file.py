@@ -507,17 +507,26 @@ def _curve(path: str, line: _Line, text: str) -> StiffnessCurve:
     return read_stiffness_curve(candidate)
 
 
+def _numbered(path: str, line: _Line, fields: list[str], columns: tuple[str, ...],
+              section: str, what: tuple[str, str], expected_id: int) -> int:
+    """The ID of a row of a numbered table (points, bodies, lines: ``what``, singular and
+    plural), its columns checked and its number the next one."""
+    _check_columns(path, line, fields, columns, section)
+    number = _whole(path, line, "ID", fields[0])
+    if number != expected_id:
+        raise _error(path, line.number, "ID",
+                     f"{what[0]} {number}: {what[1]} must be numbered 1, 2, ... in order "
+                     f"(expected {expected_id})", number)
+    return number
+
+
 _POINT_COLUMNS = ("ID", "Attachment", "X", "Y", "Z", "Mass", "Volume", "CdA", "Ca")
 
 
 def _point(path: str, line: _Line, fields: list[str], expected_id: int,
            bodies: dict[int, FileBody]) -> FilePoint:
-    _check_columns(path, line, fields, _POINT_COLUMNS, "POINTS")
-    number = _whole(path, line, "ID", fields[0])
-    if number != expected_id:
-        raise _error(path, line.number, "ID",
-                     f"point {number}: points must be numbered 1, 2, ... in order "
-                     f"(expected {expected_id})", number)
+    number = _numbered(path, line, fields, _POINT_COLUMNS, "POINTS", ("point", "points"),
+                       expected_id)
     word = fields[1]
     attachment = _ATTACHMENT_NAMES.get(word.lower())
     on_body = re.fullmatch(r"(?i)body(\d+)", word)
@@ -553,12 +562,8 @@ _BODY_COLUMNS = ("ID", "Attachment", "X0", "Y0", "Z0", "r0", "p0", "y0", "Mass",
 
 
 def _body(path: str, line: _Line, fields: list[str], expected_id: int) -> FileBody:
-    _check_columns(path, line, fields, _BODY_COLUMNS, "BODIES")
-    number = _whole(path, line, "ID", fields[0])
-    if number != expected_id:
-        raise _error(path, line.number, "ID",
-                     f"body {number}: bodies must be numbered 1, 2, ... in order "
-                     f"(expected {expected_id})", number)
+    number = _numbered(path, line, fields, _BODY_COLUMNS, "BODIES", ("body", "bodies"),
+                       expected_id)
     word = fields[1]
     attachment = _ATTACHMENT_NAMES.get(word.lower())
     if attachment == "free":
@@ -591,12 +596,8 @@ def _attach(path: str, line: _Line, field_name: str, text: str) -> int:
 
 
 def _line(path: str, line: _Line, fields: list[str], expected_id: int) -> FileLine:
-    _check_columns(path, line, fields, _LINE_COLUMNS, "LINES")
-    number = _whole(path, line, "ID", fields[0])
-    if number != expected_id:
-        raise _error(path, line.number, "ID",
-                     f"line {number}: lines must be numbered 1, 2, ... in order "
-                     f"(expected {expected_id})", number)
+    number = _numbered(path, line, fields, _LINE_COLUMNS, "LINES", ("line", "lines"),
+                       expected_id)
     attach_a = _attach(path, line, "AttachA", fields[2])
     attach_b = _attach(path, line, "AttachB", fields[3])
     length = _positive(path, line, "UnstrLen", _number(path, line, "UnstrLen", fields[4]))
