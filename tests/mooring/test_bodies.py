@@ -124,3 +124,13 @@ def test_what_bodies_do_not_support_yet_is_refused_by_name(tmp_path):
     statics = mooring.statics(coupled)
     with pytest.raises(InvalidInputError, match="body 2 is not one of the file's bodies"):
         statics.body_stiffness(2)
+
+
+def test_the_moordyn_runner_refuses_a_coupled_body():
+    # MoorDyn takes six coupled degrees of freedom for a coupled body; the peer runner's
+    # motions move coupled points: it says so instead of handing MoorDyn the wrong state.
+    pytest.importorskip("moordyn")
+    from vinculo.mooring.peer import run_moordyn
+
+    with pytest.raises(InvalidInputError, match="body 1 is Coupled: MoorDyn runs"):
+        run_moordyn(parse_moordyn(_oc3_on_a_body()), None, 1.0)

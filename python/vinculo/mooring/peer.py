@@ -168,6 +168,14 @@ def _model_and_file(source: str | Path | MoorDynFile, folder: Path,
     import dataclasses
 
     model = source if isinstance(source, MoorDynFile) else read_moordyn(source)
+    coupled_bodies = [b.id for b in model.bodies if b.attachment == "coupled"]
+    if coupled_bodies:
+        # MoorDyn takes six coupled degrees of freedom for such a body, which the motions here
+        # (three a coupled point) do not give.
+        raise InvalidInputError(
+            f"body {coupled_bodies[0]} is Coupled: MoorDyn runs of coupled bodies are not "
+            f"supported here (a motion moves coupled points)", name="bodies",
+            value=coupled_bodies)
     if time_step is not None:
         model = dataclasses.replace(
             model, options=dataclasses.replace(model.options, time_step=float(time_step)))
