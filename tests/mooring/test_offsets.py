@@ -16,6 +16,7 @@ from vinculo.errors import ConvergenceError, InvalidInputError
 
 DATA = Path(__file__).resolve().parent.parent / "data" / "moordyn"
 OC3 = DATA / "oc3_hywind.txt"
+OC3_POINTS = {p.id: p.position for p in mooring.read_moordyn(OC3).points}
 CHAIN = DATA / "chain_on_seabed.txt"
 
 
@@ -68,6 +69,28 @@ def test_the_curves_slope_at_zero_is_the_analytic_stiffness(heading, row):
     assert abs(curve.restoring[1]) < 1e-5 * curve.end_tensions[1].max()
 
 
+@pytest.mark.parametrize(("axis", "reference"), [((0.0, 0.0, 1.0), (0.0, 0.0, 0.0)),
+                                                 ((1.0, 0.0, 0.0), (0.0, 0.0, -20.0)),
+                                                 ((0.0, 1.0, 1.0), (1.0, 2.0, 0.0))])
+def test_the_rotation_curves_slope_at_zero_is_the_analytic_stiffness(axis, reference):
+    # Rotations of the fairleads by +-0.01 degree about an axis through a reference point:
+    # central differences of the restoring moment per radian against d^T K_tt d of the vessel
+    # stiffness about that point (to 1e-5, O(h^2)); at zero angle the moment is the fairlead
+    # forces' r x F, which the mooring's symmetry balances about the spar's axis.
+    curve = mooring.offset_curve(OC3, [-0.01, 0.0, 0.01], rotation_axis=axis,
+                                 reference=reference)
+    assert curve.rotation
+    slope = (curve.restoring[2] - curve.restoring[0]) / math.radians(0.02)
+    d = np.asarray(axis) / np.linalg.norm(axis)
+    k = mooring.statics(OC3).vessel_stiffness(reference)[3:, 3:]
+    assert slope == pytest.approx(d @ k @ d, rel=1e-5)
+    statics = mooring.statics(OC3)
+    forces = statics.point_forces()
+    arms = np.array([OC3_POINTS[k] for k in (4, 5, 6)]) - np.asarray(reference)
+    np.testing.assert_allclose(curve.moments[1], np.cross(arms, forces).sum(axis=0),
+                               atol=1e-9 * np.abs(forces).max())
+
+
 def test_a_failed_offset_is_reported_and_the_others_kept(monkeypatch):
     # The equilibrium at one offset fails (here made to fail): its row is NaN with the error's
     # message, and the other offsets are the same as in a sweep without it.
@@ -92,10 +115,14 @@ def test_a_failed_offset_is_reported_and_the_others_kept(monkeypatch):
 def test_bad_offset_requests_are_refused():
     with pytest.raises(InvalidInputError, match="heading"):
         mooring.offset_curve(OC3, [1.0])
-    with pytest.raises(InvalidInputError, match="one of the two"):
+    with pytest.raises(InvalidInputError, match="one of the three"):
         mooring.offset_curve(OC3, [1.0], heading=0.0, direction=(1.0, 0.0, 0.0))
     with pytest.raises(InvalidInputError, match="not all zero"):
         mooring.offset_curve(OC3, [1.0], direction=(0.0, 0.0, 0.0))
+    with pytest.raises(InvalidInputError, match="rotation_axis as three finite numbers"):
+        mooring.offset_curve(OC3, [1.0], rotation_axis=(0.0, math.inf, 1.0))
+    with pytest.raises(InvalidInputError, match="reference point"):
+        mooring.offset_curve(OC3, [1.0], heading=0.0, reference=(0.0, 0.0))
     with pytest.raises(InvalidInputError, match="finite offsets"):
         mooring.offset_curve(OC3, [1.0, math.nan], heading=0.0)
     anchored = mooring.read_moordyn(CHAIN)
@@ -115,15 +142,32 @@ def test_the_offsets_command_writes_the_curve(tmp_path, capsys):
         rows = list(csv.reader(handle))
     curve = mooring.offset_curve(OC3, [-10.0, 0.0, 10.0], heading=90.0)
     assert rows[0] == curve.columns()
-    assert rows[0][:5] == ["offset", "fx", "fy", "fz", "restoring"]
+    assert rows[0][:8] == ["offset", "fx", "fy", "fz", "mx", "my", "mz", "restoring"]
     table = np.array(rows[1:], dtype=float)
     np.testing.assert_array_equal(table[:, 0], [-10.0, 0.0, 10.0])
-    np.testing.assert_array_equal(table[:, 4], curve.restoring)
+    np.testing.assert_array_equal(table[:, 7], curve.restoring)
     assert (output / "offsets.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+def test_the_offsets_command_turns_the_points(tmp_path, capsys):
+    # --about z: the fairleads turned about the vertical through the origin, the restoring
+    # moment per radian at small angles OC3's yaw stiffness (11.55 MN m/rad; the curve's
+    # secant over 1 degree within 1e-3 of it).
+    output = tmp_path / "out"
+    assert cli.main(["mooring", "offsets", str(OC3), "--max", "1", "--count", "3", "--about",
+                     "z", "--output", str(output), "--no-plots"]) == 0
+    assert "turned about z through (0, 0, 0) m, 3 angles from -1 to 1 deg" in (
+        capsys.readouterr().out)
+    with (output / "offsets.csv").open() as handle:
+        table = np.array(list(csv.reader(handle))[1:], dtype=float)
+    yaw = mooring.statics(OC3).vessel_stiffness()[5, 5]
+    assert table[2, 7] / math.radians(1.0) == pytest.approx(yaw, rel=1e-3)
+
+
 @pytest.mark.parametrize("arguments", [["--max", "0"], ["--max", "5", "--count", "1"],
-                                       ["--max", "5", "--heading", "inf"]])
+                                       ["--max", "5", "--heading", "inf"],
+                                       ["--max", "5", "--heading", "10", "--about", "z"],
+                                       ["--max", "5", "--about", "w"]])
 def test_bad_offsets_arguments_exit_with_code_2(arguments, capsys):
     with pytest.raises(SystemExit) as info:
         cli.main(["mooring", "offsets", str(OC3), *arguments])

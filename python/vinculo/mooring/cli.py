@@ -3,7 +3,8 @@
 Usage::
 
     vinculo mooring statics FILE [--output DIR] [--reference X Y Z]
-    vinculo mooring offsets FILE --max M [--count N] [--heading DEG] [--output DIR]
+    vinculo mooring offsets FILE --max M [--count N] [--heading DEG | --about x|y|z]
+                            [--reference X Y Z] [--output DIR]
     vinculo mooring run FILE [--motion FILE.csv] --t-end T [--dt DT] [--output-every S]
                         [--start statics|file] [--tolerance TOL] [--check-step]
                         [--output DIR] [--no-plots] [--no-progress]
@@ -14,7 +15,8 @@ end B; ``fx fy fz`` the force the line exerts on the end point) and, when the fi
 Vessel/Coupled points, the 6x6 stiffness of the mooring on a vessel carrying them
 (``DIR/stiffness.csv``, about ``--reference``) and their joint 3x3 blocks
 (``DIR/point_stiffness.csv``). ``offsets`` moves the coupled points together from -M to M
-along a heading and writes the restoring force and line tensions at each offset
+along a heading (or turns them about an axis) and writes the restoring force (or moment) and
+line tensions at each offset
 (``DIR/offsets.csv``, ``DIR/offsets.png``; :mod:`vinculo.mooring.offsets`). ``run`` starts from that
 equilibrium, moves the Vessel/Coupled points by the motion file (``time``, then ``x, y, z`` of
 each coupled point in file order) and writes ``DIR/tensions.csv``, ``DIR/run.nc``, the plots
@@ -69,9 +71,9 @@ _tolerance = _argument_type(
 #: A finite coordinate (m).
 _coordinate = _argument_type("coordinate", float, math.isfinite,
                              "give a finite coordinate in m")
-#: A finite length > 0 (m).
-_positive_length = _argument_type("length", float, _positive,
-                                  "give a length in m greater than 0")
+#: The largest offset: a finite number > 0 (m, or degrees of a rotation).
+_largest_offset = _argument_type("offset", float, _positive,
+                                 "give a number greater than 0 (m, or degrees with --about)")
 #: A number of offsets, 2 or more.
 _offset_count = _argument_type("count", int, lambda v: v >= 2, "give 2 offsets or more")
 
@@ -134,22 +136,32 @@ def add_mooring_parser(commands: Any) -> None:
         "offsets",
         help="offset curve: restoring force and tensions as the coupled points move",
         description=(
-            "Move the Vessel/Coupled points together by offsets along a horizontal heading, "
-            "solve the static equilibrium at each, print the restoring force and the lines' "
-            "largest end tensions, and write DIR/offsets.csv (offset, fx, fy, fz, restoring, "
-            "then each line's end tensions and laid length) and DIR/offsets.png. An offset "
+            "Move the Vessel/Coupled points together by offsets along a horizontal heading (or "
+            "turn them about an axis through --reference), solve the static equilibrium at "
+            "each, print the restoring force (or moment) and the lines' largest end tensions, "
+            "and write DIR/offsets.csv (offset, fx, fy, fz, mx, my, mz, restoring, then each "
+            "line's end tensions and laid length) and DIR/offsets.png. An offset "
             "whose equilibrium is not found is reported and left NaN; the others are kept."
         ),
     )
     offsets.add_argument("file", metavar="FILE", type=_existing_file,
                          help="the MoorDyn v2 input file")
-    offsets.add_argument("--max", metavar="M", type=_positive_length, required=True,
-                         help="the largest offset (m): the offsets run from -M to M")
+    offsets.add_argument("--max", metavar="M", type=_largest_offset, required=True,
+                         help="the largest offset (m; degrees with --about): the offsets run "
+                         "from -M to M")
     offsets.add_argument("--count", metavar="N", type=_offset_count, default=21,
                          help="the number of offsets from -M to M (default 21)")
-    offsets.add_argument("--heading", metavar="DEG", type=_coordinate, default=0.0,
-                         help="the offsets' heading in the horizontal plane, degrees from +x "
-                         "towards +y (default 0)")
+    way = offsets.add_mutually_exclusive_group()
+    way.add_argument("--heading", metavar="DEG", type=_coordinate, default=None,
+                     help="the offsets' heading in the horizontal plane, degrees from +x "
+                     "towards +y (default 0)")
+    way.add_argument("--about", choices=("x", "y", "z"), default=None,
+                     help="turn the points about this axis through --reference instead, by "
+                     "angles in degrees (roll, pitch, yaw)")
+    offsets.add_argument("--reference", metavar=("X", "Y", "Z"), type=_coordinate, nargs=3,
+                         default=(0.0, 0.0, 0.0),
+                         help="the point the moments are taken about and the rotations made "
+                         "about (m; default 0 0 0)")
     offsets.add_argument("--output", "-o", metavar="DIR", type=Path, default=Path("output"),
                          help="folder of offsets.csv and offsets.png (created if missing; "
                          "default: output)")
@@ -246,10 +258,20 @@ def _offsets(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
         parser.error(f"{args.file}: the file has no Vessel/Coupled points to move")
     folder = _output(args.output, parser)
     values = np.linspace(-args.max, args.max, args.count)
-    curve = offset_curve(model, values, heading=args.heading, progress=True)
-    print(f"{args.file}: points {', '.join(map(str, curve.points))} moved along heading "
-          f"{args.heading:g} deg, {args.count} offsets from {-args.max:g} to {args.max:g} m",
-          flush=True)
+    if args.about is not None:
+        axis = tuple(float(args.about == c) for c in "xyz")
+        curve = offset_curve(model, values, rotation_axis=axis, reference=args.reference,
+                             progress=True)
+        where = ", ".join(f"{c:g}" for c in args.reference)
+        how = (f"turned about {args.about} through ({where}) m, {args.count} angles from "
+               f"{-args.max:g} to {args.max:g} deg")
+    else:
+        heading = 0.0 if args.heading is None else args.heading
+        curve = offset_curve(model, values, heading=heading, reference=args.reference,
+                             progress=True)
+        how = (f"moved along heading {heading:g} deg, {args.count} offsets from "
+               f"{-args.max:g} to {args.max:g} m")
+    print(f"{args.file}: points {', '.join(map(str, curve.points))} {how}", flush=True)
     print(curve.table(), flush=True)
     for s, message in curve.failed.items():
         print(f"offset {s:g} m: no equilibrium: {message}", flush=True)
