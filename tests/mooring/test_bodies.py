@@ -134,3 +134,15 @@ def test_the_moordyn_runner_refuses_a_coupled_body():
 
     with pytest.raises(InvalidInputError, match="body 1 is Coupled: MoorDyn runs"):
         run_moordyn(parse_moordyn(_oc3_on_a_body()), None, 1.0)
+
+
+def test_a_coupled_bodys_offset_curve_turns_it_about_its_reference():
+    # The OC3 fairleads on a body turned by 25 degrees, turned further by +-0.01 degree about
+    # the vertical through the body's reference point: the restoring moment's slope per radian
+    # is the body's yaw stiffness (to 1e-5, central differences; measured 3e-9), a body that is
+    # not symmetric about its own axes any more.
+    model = parse_moordyn(_oc3_on_a_body(25.0))
+    curve = mooring.offset_curve(model, [-0.01, 0.0, 0.01], rotation_axis=(0.0, 0.0, 1.0),
+                                 reference=model.bodies[0].position)
+    slope = (curve.restoring[2] - curve.restoring[0]) / np.radians(0.02)
+    assert slope == pytest.approx(mooring.statics(model).body_stiffness(1)[5, 5], rel=1e-5)

@@ -223,9 +223,12 @@ def offset_curve(path: str | Path | MoorDynFile, offsets: Sequence[float], *,
 
             def place(x: np.ndarray, shift: np.ndarray = s * d) -> np.ndarray:
                 return x + shift
+        # A moved point of a body is no longer where the body's pose puts it: it becomes a
+        # coupled point of its own at its new position.
         points = tuple(
             dataclasses.replace(p, position=tuple(float(x) for x in place(np.asarray(
-                p.position)))) if p.id in moved else p for p in model.points)
+                p.position))), body=None, relative=None) if p.id in moved else p
+            for p in model.points)
         shifted = dataclasses.replace(model, points=points)
         try:
             result = statics(shifted, **statics_options)
