@@ -139,8 +139,8 @@ def test_the_moordyn_runner_refuses_a_coupled_body():
 def test_a_coupled_bodys_offset_curve_turns_it_about_its_reference():
     # The OC3 fairleads on a body turned by 25 degrees, turned further by +-0.01 degree about
     # the vertical through the body's reference point: the restoring moment's slope per radian
-    # is the body's yaw stiffness (to 1e-5, central differences; measured 3e-9), a body that is
-    # not symmetric about its own axes any more.
+    # is the body's yaw stiffness (to 1e-5, central differences; measured 3e-9), with the
+    # fairleads 25 degrees off their anchors' bearings, the lines pulling them sideways.
     model = parse_moordyn(_oc3_on_a_body(25.0))
     curve = mooring.offset_curve(model, [-0.01, 0.0, 0.01], rotation_axis=(0.0, 0.0, 1.0),
                                  reference=model.bodies[0].position)
