@@ -1,6 +1,7 @@
 """BODIES in MoorDyn files: Fixed and Coupled bodies place the points attached to them
-(``Body<n>``) as MoorDyn does, the statics and stiffness of a coupled body are those of its
-points, and what is not supported (free bodies, runs of coupled bodies) is refused by name."""
+(``Body<n>``) as MoorDyn does, the statics, stiffness and runs of a coupled body are those of
+its points moved rigidly with it, and what is not supported (free bodies) is refused by
+name."""
 
 import dataclasses
 from pathlib import Path
@@ -119,8 +120,6 @@ def test_what_bodies_do_not_support_yet_is_refused_by_name(tmp_path):
     with pytest.raises(MooringFileError, match="line 15: Attachment: 'Body2': there is no body"):
         parse_moordyn(missing)
     coupled = parse_moordyn(_oc3_on_a_body())
-    with pytest.raises(InvalidInputError, match="body 1 is Coupled: runs of coupled bodies"):
-        mooring.run(coupled, None, 1.0)
     statics = mooring.statics(coupled)
     with pytest.raises(InvalidInputError, match="body 2 is not one of the file's bodies"):
         statics.body_stiffness(2)
@@ -146,3 +145,57 @@ def test_a_coupled_bodys_offset_curve_turns_it_about_its_reference():
                                  reference=model.bodies[0].position)
     slope = (curve.restoring[2] - curve.restoring[0]) / np.radians(0.02)
     assert slope == pytest.approx(mooring.statics(model).body_stiffness(1)[5, 5], rel=1e-5)
+
+
+def _body_motion(path, times):
+    """A motion file of the body of _oc3_on_a_body: 2 m of surge and 3 degrees of yaw, both
+    with a period of 4 s, from rest at its file pose (25 degrees of yaw), smoothly: its
+    velocity and acceleration start from zero, as the equilibrium it starts from has them (a
+    recorded motion that starts with an acceleration leaves the trapezoidal rule's velocities
+    of the moved points oscillating about the motion's by its spline's jump in jerk)."""
+    ramp = (0.5 * (1.0 - np.cos(2.0 * np.pi * times / 4.0))) ** 2
+    surge = 2.0 * ramp
+    yaw = 25.0 + 3.0 * ramp
+    rows = np.column_stack([times, surge, 0.0 * times, 0.0 * times, 0.0 * times, 0.0 * times,
+                            yaw])
+    header = "time,x,y,z,roll,pitch,yaw\n"
+    path.write_text(header + "\n".join(",".join(repr(float(v)) for v in row) for row in rows))
+    return rows
+
+
+def test_a_coupled_body_runs_as_its_points_moved_with_it(tmp_path):
+    # A run of the OC3 fairleads on a coupled body, the body moved in surge and yaw by its six
+    # columns of the motion file, equals (bit for bit) the run of the same fairleads as
+    # Coupled points moved by the positions the body's pose gives them at each row of the file
+    # (the same splines through the same samples); and at those rows the run's fairleads are
+    # where the pose puts them: to the constraints' tolerance at a step's end, and to 1e-4 m
+    # where a node's touchdown shortened the steps and the row falls inside one, whose state is
+    # interpolated (measured 1.5e-5 m).
+    model = parse_moordyn(_oc3_on_a_body(25.0))
+    times = np.arange(0.0, 4.0001, 0.05)
+    rows = _body_motion(tmp_path / "body.csv", times)
+    body = model.bodies[0]
+    expected = np.array([[dataclasses.replace(body, position=tuple(r[1:4]),
+                                              rotation=tuple(r[4:7])).place(p.relative)
+                          for p in model.points if p.body == 1] for r in rows])
+    on_body = mooring.run(model, tmp_path / "body.csv", 4.0, dt=0.05, plots=False)
+    points = tuple(dataclasses.replace(p, body=None, relative=None) for p in model.points)
+    plain = dataclasses.replace(model, points=points, bodies=())
+    as_points = mooring.run(plain, mooring.Motion.from_table(times, expected), 4.0, dt=0.05,
+                            plots=False)
+    np.testing.assert_array_equal(on_body.end_forces, as_points.end_forces)
+    fairleads = [on_body.model.points[k - 1].index for k in (4, 5, 6)]
+    stored = on_body.solution.positions[:, fairleads, :]
+    np.testing.assert_allclose(stored, expected[: len(on_body.times)], atol=1e-4)
+    # The yaw turns the lines' pull: the fairlead tensions change.
+    tensions = on_body.end_tensions[:, :, 1]
+    assert np.ptp(tensions, axis=0).min() > 1e-3 * tensions.max()
+
+
+def test_a_body_motion_file_with_the_wrong_columns_is_refused(tmp_path):
+    model = parse_moordyn(_oc3_on_a_body())
+    path = tmp_path / "points.csv"
+    path.write_text("time,x1,y1,z1\n0,0,0,-70\n1,0,0,-70\n")
+    with pytest.raises(InvalidInputError, match="1 coupled bodies and 0 coupled points of "
+                                                "their own: give time, then x, y, z, roll"):
+        mooring.read_motion(model, path)

@@ -59,7 +59,7 @@ from vinculo.mooring.moordyn_file import (
     read_moordyn,
     write_moordyn,
 )
-from vinculo.mooring.motion import Motion
+from vinculo.mooring.motion import Motion, read_motion
 from vinculo.mooring.offsets import OffsetCurve, offset_curve, plot_offset_curve
 from vinculo.mooring.seafloor import Seafloor, read_seafloor
 from vinculo.mooring.stiffness_curve import StiffnessCurve, read_stiffness_curve
@@ -118,6 +118,7 @@ __all__ = [
     "plot_offset_curve",
     "read_current_profile",
     "read_moordyn",
+    "read_motion",
     "read_seafloor",
     "read_stiffness_curve",
     "read_wave_frequencies",

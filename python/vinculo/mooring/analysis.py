@@ -504,7 +504,9 @@ def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_en
     Arguments:
         path: the MoorDyn v2 input file (or its content).
         motion: the coupled points' motion, or a motion CSV file (see
-            :mod:`vinculo.mooring.motion`); None: they stay where they are.
+            :mod:`vinculo.mooring.motion`: with coupled bodies, their six degrees of freedom
+            first, :func:`vinculo.mooring.motion.read_motion`); None: they stay where they
+            are.
         t_end: the end time (s).
         dt: the step size (s).
         output_every: the interval of the stored states (s): a whole number of steps (MoorDyn's
@@ -547,20 +549,15 @@ def run(path: str | Path | MoorDynFile, motion: Motion | str | Path | None, t_en
     if not isinstance(path, MoorDynFile):
         path = read_moordyn(path)
     if isinstance(motion, (str, Path)):
-        motion = Motion.from_csv(motion)
+        from vinculo.mooring.motion import read_motion
+
+        motion = read_motion(path, motion)
     if not (math.isfinite(t_end) and t_end > 0.0):
         raise InvalidInputError(f"t_end = {t_end!r}: give an end time > 0 s", name="t_end",
                                 value=t_end)
     if start not in ("statics", "file"):
         raise InvalidInputError(f"start = {start!r}: give \"statics\" or \"file\"",
                                 name="start", value=start)
-    coupled_bodies = [b.id for b in path.bodies if b.attachment == "coupled"]
-    if coupled_bodies:
-        raise InvalidInputError(
-            f"body {coupled_bodies[0]} is Coupled: runs of coupled bodies (moved in six degrees "
-            f"of freedom) are not supported yet; their statics, stiffness and offset curves are "
-            f"(vinculo mooring statics, offsets), and a run moves Coupled points",
-            name="bodies", value=coupled_bodies)
     if motion is not None:
         first, last = motion.domain()
         if first > 0.0 or last < t_end:

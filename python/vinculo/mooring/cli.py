@@ -101,9 +101,9 @@ def add_mooring_parser(commands: Any) -> None:
         description=(
             "Read a MoorDyn v2 input file (LINE TYPES, BODIES, POINTS, LINES, OPTIONS) and "
             "solve its static equilibrium, or run it with the Vessel/Coupled points moved by a "
-            "recorded motion. Rods, free bodies, runs of coupled bodies and wave grids are not "
-            "supported yet: such a file is rejected with an error naming the line and the "
-            "field."
+            "recorded motion (a Coupled body by its six degrees of freedom). Rods, free bodies "
+            "and wave grids are not supported yet: such a file is rejected with an error "
+            "naming the line and the field."
         ),
     )
     actions = mooring.add_subparsers(dest="mooring_command", metavar="ACTION")
@@ -181,9 +181,11 @@ def add_mooring_parser(commands: Any) -> None:
     run.add_argument("file", metavar="FILE", type=_existing_file,
                      help="the MoorDyn v2 input file")
     run.add_argument("--motion", metavar="FILE.csv", type=_existing_file, default=None,
-                     help="the motion: a header line, then rows of time (s) and x, y, z (m) of "
-                     "each coupled point in the order of the POINTS section; the columns are "
-                     "interpolated by natural cubic splines (default: the points stay put)")
+                     help="the motion: a header line, then rows of time (s), x, y, z (m) and "
+                     "roll, pitch, yaw (deg) of each Coupled body in the order of the BODIES "
+                     "section, then x, y, z (m) of each other coupled point in the order of "
+                     "the POINTS section; the columns are interpolated by natural cubic "
+                     "splines (default: the points stay put)")
     run.add_argument("--t-end", metavar="T", type=_positive_time, required=True,
                      help="the end time (s)")
     run.add_argument("--dt", metavar="DT", type=_positive_time, default=0.02,
@@ -328,10 +330,10 @@ def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     """Run the mooring with the motion and write its results."""
     from vinculo.mooring.analysis import _whole_steps, run
     from vinculo.mooring.moordyn_file import read_moordyn
-    from vinculo.mooring.motion import Motion
+    from vinculo.mooring.motion import read_motion
 
     model = read_moordyn(args.file)
-    motion = Motion.from_csv(args.motion) if args.motion is not None else None
+    motion = read_motion(model, args.motion) if args.motion is not None else None
     if args.output_every is not None and _whole_steps(args.output_every, args.dt) is None:
         parser.error(f"--output-every {args.output_every:g}: give a whole number of steps "
                      f"of --dt {args.dt:g} s")

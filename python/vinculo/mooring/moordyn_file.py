@@ -147,8 +147,10 @@ class FileBody:
 
     A point at ``r`` in the body's frame is at ``position + R r``, with
     ``R = Rx(roll) Ry(pitch) Rz(yaw)`` (MoorDyn-C's composition of the body's angles, checked
-    against the point positions MoorDyn 2.7.2 reports). The body's own mass, inertia, volume and
-    drag act on a Free body only, which vinculo does not model yet: they are kept as written.
+    against the point positions MoorDyn 2.7.2 reports). A Coupled body's pose in a run comes
+    from the motion file (:func:`vinculo.mooring.motion.read_motion`). The body's own mass,
+    inertia, volume and drag act on a Free body only, which vinculo does not model yet: they
+    are kept as written.
 
     Arguments:
         id: the body's number (1, 2, ... in file order).

@@ -14,14 +14,23 @@ A motion file is a CSV table with a header line and the columns ``time`` (s), th
 
 Each column becomes a natural cubic spline (:func:`vinculo.tabulated`), twice continuously
 differentiable, so the points' velocities and accelerations are continuous.
+
+A file with Coupled bodies (BODIES) moves each body in six degrees of freedom: its columns come
+first, in the order of the BODIES section, ``x, y, z`` of the body's reference point (m) and its
+``roll, pitch, yaw`` (degrees, composed as the file's r0 p0 y0 are), then ``x, y, z`` of each
+coupled point that is not on a body (:func:`read_motion`; MoorDyn's order of coupled degrees of
+freedom). The points of a body follow it rigidly: at each row they are placed by its pose, and
+their coordinates become the splines, through those exact positions.
 """
 
 from __future__ import annotations
 
 import csv
+import dataclasses
 import math
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -29,7 +38,7 @@ from vinculo import laws
 from vinculo._core import Law
 from vinculo.errors import InvalidInputError
 
-__all__ = ["Motion"]
+__all__ = ["Motion", "read_motion"]
 
 
 class Motion:
@@ -194,42 +203,12 @@ class Motion:
                 names the file and the row.
         """
         path = Path(path)
-        try:
-            with path.open(newline="", encoding="utf-8") as handle:
-                rows = [row for row in csv.reader(handle) if row and any(c.strip() for c in row)]
-        except OSError as exc:
-            raise InvalidInputError(f"cannot read the motion file {str(path)!r}: {exc.strerror}",
-                                    name="motion", value=str(path)) from None
-        if len(rows) < 3:
-            raise InvalidInputError(
-                f"{path}: a motion file needs a header line and at least two rows of time, "
-                f"x, y, z per coupled point", name="motion", value=str(path))
-        header, body = rows[0], rows[1:]
+        header, values = _read_table(path)
         columns = len(header)
         if columns < 4 or (columns - 1) % 3 != 0:
             raise InvalidInputError(
                 f"{path}: the header has {columns} columns; give time, then x, y, z of each "
                 f"coupled point (1 + 3 n columns)", name="motion", value=columns)
-        values = np.empty((len(body), columns))
-        for r, row in enumerate(body, start=2):
-            if len(row) != columns:
-                raise InvalidInputError(
-                    f"{path}, row {r}: {len(row)} values where the header has {columns}",
-                    name="motion", value=len(row))
-            for c, text in enumerate(row):
-                try:
-                    values[r - 2, c] = float(text)
-                except ValueError:
-                    raise InvalidInputError(
-                        f"{path}, row {r}, column {header[c].strip()!r}: {text!r} is not a "
-                        f"number", name="motion", value=text) from None
-        if not np.all(np.isfinite(values)):
-            raise InvalidInputError(f"{path}: the motion has values that are not finite",
-                                    name="motion", value=str(path))
-        if np.any(np.diff(values[:, 0]) <= 0.0):
-            r = int(np.argmax(np.diff(values[:, 0]) <= 0.0)) + 3
-            raise InvalidInputError(f"{path}, row {r}: the times must increase",
-                                    name="motion", value=float(values[r - 2, 0]))
         return cls.from_table(values[:, 0], values[:, 1:], source=str(path))
 
     def to_csv(self, path: str | Path, times: Sequence[float] | np.ndarray) -> Path:
@@ -251,6 +230,90 @@ class Motion:
                 writer.writerow([repr(float(t))] + [repr(float(v))
                                                      for v in self.positions(t).ravel()])
         return path
+
+
+def _read_table(path: Path) -> tuple[list[str], np.ndarray]:
+    """The header and the numbers of a motion file, its rows complete, finite and in
+    increasing time (the errors name the file and the row)."""
+    try:
+        with path.open(newline="", encoding="utf-8") as handle:
+            rows = [row for row in csv.reader(handle) if row and any(c.strip() for c in row)]
+    except OSError as exc:
+        raise InvalidInputError(f"cannot read the motion file {str(path)!r}: {exc.strerror}",
+                                name="motion", value=str(path)) from None
+    if len(rows) < 3:
+        raise InvalidInputError(
+            f"{path}: a motion file needs a header line and at least two rows of time, "
+            f"x, y, z per coupled point", name="motion", value=str(path))
+    header, body = rows[0], rows[1:]
+    columns = len(header)
+    values = np.empty((len(body), columns))
+    for r, row in enumerate(body, start=2):
+        if len(row) != columns:
+            raise InvalidInputError(
+                f"{path}, row {r}: {len(row)} values where the header has {columns}",
+                name="motion", value=len(row))
+        for c, text in enumerate(row):
+            try:
+                values[r - 2, c] = float(text)
+            except ValueError:
+                raise InvalidInputError(
+                    f"{path}, row {r}, column {header[c].strip()!r}: {text!r} is not a "
+                    f"number", name="motion", value=text) from None
+    if not np.all(np.isfinite(values)):
+        raise InvalidInputError(f"{path}: the motion has values that are not finite",
+                                name="motion", value=str(path))
+    if np.any(np.diff(values[:, 0]) <= 0.0):
+        r = int(np.argmax(np.diff(values[:, 0]) <= 0.0)) + 3
+        raise InvalidInputError(f"{path}, row {r}: the times must increase",
+                                name="motion", value=float(values[r - 2, 0]))
+    return header, values
+
+
+def read_motion(model: Any, path: str | Path) -> Motion:
+    """Read the motion file of a MoorDyn file's coupled bodies and points (module
+    description): the motion of every coupled point, a body's points placed by its pose.
+
+    Arguments:
+        model: the :class:`~vinculo.mooring.moordyn_file.MoorDynFile`.
+        path: the CSV file: a header line, then ``time``, ``x, y, z, roll, pitch, yaw`` of each
+            coupled body (m, degrees), ``x, y, z`` of each coupled point not on a body (m).
+
+    Returns:
+        The motion of the coupled points (:meth:`MoorDynFile.coupled_points`'s order).
+
+    Raises:
+        InvalidInputError: as :meth:`Motion.from_csv`, and for a number of columns that does
+            not match the file's coupled bodies and points.
+    """
+    path = Path(path)
+    bodies = [b for b in model.bodies if b.attachment == "coupled"]
+    if not bodies:
+        return Motion.from_csv(path)
+    header, values = _read_table(path)
+    own = [p for p in model.coupled_points() if p.body is None]
+    expected = 1 + 6 * len(bodies) + 3 * len(own)
+    if len(header) != expected:
+        raise InvalidInputError(
+            f"{path}: the header has {len(header)} columns; the file has {len(bodies)} coupled "
+            f"bodies and {len(own)} coupled points of their own: give time, then x, y, z, "
+            f"roll, pitch, yaw (m, degrees) of each body, then x, y, z of each point "
+            f"({expected} columns)", name="motion", value=len(header))
+    column = {b.id: 1 + 6 * k for k, b in enumerate(bodies)}
+    column.update({p.id: 1 + 6 * len(bodies) + 3 * k for k, p in enumerate(own)})
+    coupled = model.coupled_points()
+    positions = np.empty((values.shape[0], len(coupled), 3))
+    for k, point in enumerate(coupled):
+        if point.body is None:
+            positions[:, k] = values[:, column[point.id]:column[point.id] + 3]
+            continue
+        body = model.bodies[point.body - 1]
+        c = column[body.id]
+        for r, row in enumerate(values):
+            pose = dataclasses.replace(body, position=tuple(row[c:c + 3]),
+                                       rotation=tuple(row[c + 3:c + 6]))
+            positions[r, k] = pose.place(point.relative)
+    return Motion.from_table(values[:, 0], positions, source=str(path))
 
 
 def _law(value: Law | float) -> Law:
