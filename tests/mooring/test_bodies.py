@@ -125,26 +125,34 @@ def test_what_bodies_do_not_support_yet_is_refused_by_name(tmp_path):
         statics.body_stiffness(2)
 
 
-def test_the_moordyn_runner_refuses_a_coupled_body():
-    # MoorDyn takes six coupled degrees of freedom for a coupled body; the peer runner's
-    # motions move coupled points: it says so instead of handing MoorDyn the wrong state.
+def test_moordyn_runs_a_coupled_body_as_its_points(tmp_path):
+    # The peer runner drives a coupled body in MoorDyn's six degrees of freedom (the motion
+    # file's pose, its angles in radians): MoorDyn's run of the OC3 fairleads on a body moved in
+    # surge and yaw agrees with its run of the same fairleads as Coupled points moved by the
+    # positions the pose gives them, to 1e-5 of the peak tension (measured 4.9e-6; MoorDyn
+    # moves a body's points rigidly over each call, the points along their chords). Read as
+    # plain points, the motion lacks the body's poses, which the runner says.
     pytest.importorskip("moordyn")
     from vinculo.mooring.peer import run_moordyn
 
-    with pytest.raises(InvalidInputError, match="body 1 is Coupled: MoorDyn runs"):
-        run_moordyn(parse_moordyn(_oc3_on_a_body()), None, 1.0)
-
-
-def test_a_coupled_bodys_offset_curve_turns_it_about_its_reference():
-    # The OC3 fairleads on a body turned by 25 degrees, turned further by +-0.01 degree about
-    # the vertical through the body's reference point: the restoring moment's slope per radian
-    # is the body's yaw stiffness (to 1e-5, central differences; measured 3e-9), with the
-    # fairleads 25 degrees off their anchors' bearings, the lines pulling them sideways.
-    model = parse_moordyn(_oc3_on_a_body(25.0))
-    curve = mooring.offset_curve(model, [-0.01, 0.0, 0.01], rotation_axis=(0.0, 0.0, 1.0),
-                                 reference=model.bodies[0].position)
-    slope = (curve.restoring[2] - curve.restoring[0]) / np.radians(0.02)
-    assert slope == pytest.approx(mooring.statics(model).body_stiffness(1)[5, 5], rel=1e-5)
+    text = _oc3_on_a_body(25.0).replace("320.0         WtrDpth",
+                                        "320.0         WtrDpth\n0.0           TmaxIC")
+    model = parse_moordyn(text)
+    times = np.arange(0.0, 6.0001, 0.05)
+    rows = _body_motion(tmp_path / "body.csv", times)
+    body = model.bodies[0]
+    expected = np.array([[dataclasses.replace(body, position=tuple(r[1:4]),
+                                              rotation=tuple(r[4:7])).place(p.relative)
+                          for p in model.points if p.body == 1] for r in rows])
+    points = tuple(dataclasses.replace(p, body=None, relative=None) for p in model.points)
+    plain = dataclasses.replace(model, points=points, bodies=())
+    as_body = run_moordyn(model, mooring.read_motion(model, tmp_path / "body.csv"), 6.0)
+    as_points = run_moordyn(plain, mooring.Motion.from_table(times, expected), 6.0)
+    assert as_body.error is None and as_points.error is None
+    peak = np.abs(as_points.segment_tensions).max()
+    assert np.abs(as_body.segment_tensions - as_points.segment_tensions).max() < 1e-5 * peak
+    with pytest.raises(InvalidInputError, match="1 coupled bodies and the motion table gives"):
+        run_moordyn(model, mooring.Motion.from_table(times, expected), 6.0)
 
 
 def _body_motion(path, times):
@@ -199,3 +207,15 @@ def test_a_body_motion_file_with_the_wrong_columns_is_refused(tmp_path):
     with pytest.raises(InvalidInputError, match="1 coupled bodies and 0 coupled points of "
                                                 "their own: give time, then x, y, z, roll"):
         mooring.read_motion(model, path)
+
+
+def test_a_coupled_bodys_offset_curve_turns_it_about_its_reference():
+    # The OC3 fairleads on a body turned by 25 degrees, turned further by +-0.01 degree about
+    # the vertical through the body's reference point: the restoring moment's slope per radian
+    # is the body's yaw stiffness (to 1e-5, central differences; measured 3e-9), with the
+    # fairleads 25 degrees off their anchors' bearings, the lines pulling them sideways.
+    model = parse_moordyn(_oc3_on_a_body(25.0))
+    curve = mooring.offset_curve(model, [-0.01, 0.0, 0.01], rotation_axis=(0.0, 0.0, 1.0),
+                                 reference=model.bodies[0].position)
+    slope = (curve.restoring[2] - curve.restoring[0]) / np.radians(0.02)
+    assert slope == pytest.approx(mooring.statics(model).body_stiffness(1)[5, 5], rel=1e-5)

@@ -64,6 +64,40 @@ class Motion:
             triples.append(tuple(_law(c) for c in triple))
         self._laws: list[tuple[Law, Law, Law]] = triples
         self.source = source
+        #: Coupled bodies' poses, six laws each (x, y, z in m; roll, pitch, yaw in degrees), in
+        #: the order of the file's coupled bodies (:func:`read_motion`); empty without bodies.
+        self.poses: list[tuple[Law, ...]] = []
+        #: The indices, among the points, of the coupled points that are not on a body.
+        self.own: list[int] = list(range(len(triples)))
+
+    def coupled_dofs(self, t: float) -> np.ndarray:
+        """MoorDyn's coupled degrees of freedom at time ``t``: each coupled body's x, y, z (m)
+        and roll, pitch, yaw (rad), then each other coupled point's x, y, z (m).
+
+        Arguments:
+            t: time (s).
+
+        Returns:
+            The flat array.
+        """
+        poses = [[law(t) for law in pose] for pose in self.poses]
+        dofs = [v for pose in poses for v in (*pose[:3], *map(math.radians, pose[3:]))]
+        own = self.positions(t)[self.own].ravel() if self.own else np.empty(0)
+        return np.concatenate([np.asarray(dofs, dtype=float), own])
+
+    def coupled_dof_rates(self, t: float) -> np.ndarray:
+        """The rates of :meth:`coupled_dofs` at time ``t`` (m/s; the angles' in rad/s).
+
+        Arguments:
+            t: time (s).
+
+        Returns:
+            The flat array.
+        """
+        rates = [[law.derivatives(t)[1] for law in pose] for pose in self.poses]
+        dofs = [v for pose in rates for v in (*pose[:3], *map(math.radians, pose[3:]))]
+        own = self.velocities(t)[self.own].ravel() if self.own else np.empty(0)
+        return np.concatenate([np.asarray(dofs, dtype=float), own])
 
     @property
     def laws(self) -> list[tuple[Law, Law, Law]]:
@@ -313,7 +347,11 @@ def read_motion(model: Any, path: str | Path) -> Motion:
             pose = dataclasses.replace(body, position=tuple(row[c:c + 3]),
                                        rotation=tuple(row[c + 3:c + 6]))
             positions[r, k] = pose.place(point.relative)
-    return Motion.from_table(values[:, 0], positions, source=str(path))
+    motion = Motion.from_table(values[:, 0], positions, source=str(path))
+    motion.poses = [tuple(laws.tabulated(values[:, 0], values[:, column[b.id] + j])
+                          for j in range(6)) for b in bodies]
+    motion.own = [k for k, point in enumerate(coupled) if point.body is None]
+    return motion
 
 
 def _law(value: Law | float) -> Law:

@@ -168,14 +168,6 @@ def _model_and_file(source: str | Path | MoorDynFile, folder: Path,
     import dataclasses
 
     model = source if isinstance(source, MoorDynFile) else read_moordyn(source)
-    coupled_bodies = [b.id for b in model.bodies if b.attachment == "coupled"]
-    if coupled_bodies:
-        # MoorDyn takes six coupled degrees of freedom for such a body, which the motions here
-        # (three a coupled point) do not give.
-        raise InvalidInputError(
-            f"body {coupled_bodies[0]} is Coupled: MoorDyn runs of coupled bodies are not "
-            f"supported here (a motion moves coupled points)", name="bodies",
-            value=coupled_bodies)
     if time_step is not None:
         model = dataclasses.replace(
             model, options=dataclasses.replace(model.options, time_step=float(time_step)))
@@ -201,6 +193,32 @@ def _end_forces(md, lines: list, sizes: list[int]) -> tuple[np.ndarray, np.ndarr
         tensions[k, 0] = np.linalg.norm(md.GetLineNodeTen(line, 0))
         tensions[k, 1] = np.linalg.norm(md.GetLineNodeTen(line, n))
     return forces, tensions
+
+
+def _coupled_motion(model: MoorDynFile, motion: Motion | None) -> Motion:
+    """The motion of the model's coupled points (theirs at the file's positions, still, when
+    None), checked against them; with coupled bodies, the bodies' poses too, which MoorDyn
+    takes as six coupled degrees of freedom each."""
+    from vinculo import laws
+
+    coupled = model.coupled_points()
+    bodies = [b for b in model.bodies if b.attachment == "coupled"]
+    if motion is None:
+        motion = Motion.still([p.position for p in coupled])
+        motion.poses = [tuple(laws.constant(v) for v in (*b.position, *b.rotation))
+                        for b in bodies]
+        motion.own = [k for k, p in enumerate(coupled) if p.body is None]
+    if motion.num_points != len(coupled):
+        raise InvalidInputError(
+            f"the motion moves {motion.num_points} points but the file has "
+            f"{len(coupled)} coupled points", name="motion", value=motion.num_points)
+    if len(motion.poses) != len(bodies):
+        raise InvalidInputError(
+            f"the file has {len(bodies)} coupled bodies and {motion.source} gives the poses of "
+            f"{len(motion.poses)}: read the motion file with vinculo.mooring.read_motion(model, "
+            f"path), which keeps them for MoorDyn's six degrees of freedom a body",
+            name="motion", value=len(motion.poses))
+    return motion
 
 
 def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: float, *,
@@ -274,12 +292,7 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
             per_output = steps_per_output // steps_per_call
             coupling = dt_output / per_output
         coupled = model.coupled_points()
-        if motion is None:
-            motion = Motion.still([p.position for p in coupled])
-        if motion.num_points != len(coupled):
-            raise InvalidInputError(
-                f"the motion moves {motion.num_points} points but the file has "
-                f"{len(coupled)} coupled points", name="motion", value=motion.num_points)
+        motion = _coupled_motion(model, motion)
         start, end = motion.domain()
         if start > 0.0 or end < t_end:
             raise InvalidInputError(
@@ -290,8 +303,8 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
             try:
                 lines = [md.GetLine(system, k + 1) for k in range(len(model.lines))]
                 sizes = [md.GetLineN(line) for line in lines]
-                x = motion.positions(0.0).ravel().tolist()
-                v = motion.velocities(0.0).ravel().tolist()
+                x = motion.coupled_dofs(0.0).tolist()
+                v = motion.coupled_dof_rates(0.0).tolist()
                 started = time.process_time()
                 _initialise(md, system, x, v, initial_state)
                 initial_cpu = time.process_time() - started
@@ -324,8 +337,8 @@ def run_moordyn(source: str | Path | MoorDynFile, motion: Motion | None, t_end: 
                         # velocity given, so they reach the motion's position at the call's
                         # end and the path is continuous (the motion's own velocity at the
                         # call's start would leave them a v' dt^2 / 2 jump at each call).
-                        x = motion.positions(t).ravel()
-                        v = ((motion.positions(t + coupling).ravel() - x) / coupling).tolist()
+                        x = motion.coupled_dofs(t)
+                        v = ((motion.coupled_dofs(t + coupling) - x) / coupling).tolist()
                         x = x.tolist()
                         tick = time.process_time()
                         try:
@@ -424,10 +437,9 @@ def moordyn_initial_state(source: str | Path | MoorDynFile, motion: Motion | Non
             source, Path(folder),
             None if time_step is None else time_step * (1.0 + _STEP_MARGIN))
         coupled = model.coupled_points()
-        if motion is None:
-            motion = Motion.still([p.position for p in coupled])
-        x = motion.positions(0.0).ravel().tolist()
-        v = motion.velocities(0.0).ravel().tolist()
+        motion = _coupled_motion(model, motion)
+        x = motion.coupled_dofs(0.0).tolist()
+        v = motion.coupled_dof_rates(0.0).tolist()
         with _silenced():
             system = _create(md, file)
             try:
