@@ -140,10 +140,7 @@ def test_moordyn_runs_a_coupled_body_as_its_points(tmp_path):
     model = parse_moordyn(text)
     times = np.arange(0.0, 6.0001, 0.05)
     rows = _body_motion(tmp_path / "body.csv", times)
-    body = model.bodies[0]
-    expected = np.array([[dataclasses.replace(body, position=tuple(r[1:4]),
-                                              rotation=tuple(r[4:7])).place(p.relative)
-                          for p in model.points if p.body == 1] for r in rows])
+    expected = _placed(model, rows)
     points = tuple(dataclasses.replace(p, body=None, relative=None) for p in model.points)
     plain = dataclasses.replace(model, points=points, bodies=())
     as_body = run_moordyn(model, mooring.read_motion(model, tmp_path / "body.csv"), 6.0)
@@ -153,6 +150,15 @@ def test_moordyn_runs_a_coupled_body_as_its_points(tmp_path):
     assert np.abs(as_body.segment_tensions - as_points.segment_tensions).max() < 1e-5 * peak
     with pytest.raises(InvalidInputError, match="1 coupled bodies and the motion table gives"):
         run_moordyn(model, mooring.Motion.from_table(times, expected), 6.0)
+
+
+def _placed(model, rows):
+    """``(rows, points, 3)``: where body 1's pose in each row of a motion table puts its
+    points."""
+    body = model.bodies[0]
+    return np.array([[dataclasses.replace(body, position=tuple(r[1:4]),
+                                          rotation=tuple(r[4:7])).place(p.relative)
+                      for p in model.points if p.body == 1] for r in rows])
 
 
 def _body_motion(path, times):
@@ -182,10 +188,7 @@ def test_a_coupled_body_runs_as_its_points_moved_with_it(tmp_path):
     model = parse_moordyn(_oc3_on_a_body(25.0))
     times = np.arange(0.0, 4.0001, 0.05)
     rows = _body_motion(tmp_path / "body.csv", times)
-    body = model.bodies[0]
-    expected = np.array([[dataclasses.replace(body, position=tuple(r[1:4]),
-                                              rotation=tuple(r[4:7])).place(p.relative)
-                          for p in model.points if p.body == 1] for r in rows])
+    expected = _placed(model, rows)
     on_body = mooring.run(model, tmp_path / "body.csv", 4.0, dt=0.05, plots=False)
     points = tuple(dataclasses.replace(p, body=None, relative=None) for p in model.points)
     plain = dataclasses.replace(model, points=points, bodies=())
