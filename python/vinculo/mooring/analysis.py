@@ -231,7 +231,7 @@ class MooringStatics:
         Returns:
             The body ids.
         """
-        return [b.id for b in self.model.file.bodies if b.attachment == "coupled"]
+        return [b.id for b in self.model.file.coupled_bodies()]
 
     def body_stiffness(self, body: int) -> np.ndarray:
         """The 6x6 linearised stiffness of the mooring on a body of the file, about its

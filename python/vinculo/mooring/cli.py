@@ -13,13 +13,14 @@ Usage::
 (columns ``line,end,point,x,y,z,fx,fy,fz,tension,laid_length``, two rows per line: end A, then
 end B; ``fx fy fz`` the force the line exerts on the end point) and, when the file has
 Vessel/Coupled points, the 6x6 stiffness of the mooring on a vessel carrying them
-(``DIR/stiffness.csv``, about ``--reference``) and their joint 3x3 blocks
-(``DIR/point_stiffness.csv``). ``offsets`` moves the coupled points together from -M to M
-along a heading (or turns them about an axis) and writes the restoring force (or moment) and
-line tensions at each offset
-(``DIR/offsets.csv``, ``DIR/offsets.png``; :mod:`vinculo.mooring.offsets`). ``run`` starts from that
-equilibrium, moves the Vessel/Coupled points by the motion file (``time``, then ``x, y, z`` of
-each coupled point in file order) and writes ``DIR/tensions.csv``, ``DIR/run.nc``, the plots
+(``DIR/stiffness.csv``, about ``--reference``; a Coupled body's, about its reference point, in
+``DIR/stiffness_body<k>.csv``) and their joint 3x3 blocks (``DIR/point_stiffness.csv``).
+``offsets`` moves the coupled points together from -M to M along a heading (or turns them about
+an axis) and writes the restoring force (or moment) and line tensions at each offset
+(``DIR/offsets.csv``, ``DIR/offsets.png``; :mod:`vinculo.mooring.offsets`). ``run`` starts from
+that equilibrium, moves the Vessel/Coupled points and bodies by the motion file (``time``, then
+each coupled body's pose and each other coupled point's ``x, y, z``: :mod:`vinculo.mooring.motion`)
+and writes ``DIR/tensions.csv``, ``DIR/run.nc``, the plots
 ``DIR/shapes.png`` and ``DIR/tensions.png``, and, when the file has an OUTPUTS section,
 ``DIR/channels.csv`` (its channels over time, :mod:`vinculo.mooring.channels`); with
 ``--check-step`` it runs again at half the step and prints how much the end tensions change, an
@@ -119,7 +120,9 @@ def add_mooring_parser(commands: Any) -> None:
             "exerts on the end point (N), laid_length the length on the seabed (m). With "
             "Vessel/Coupled points, also print the 6x6 linearised stiffness of the mooring on "
             "a vessel carrying them, about --reference, and write it (DIR/stiffness.csv) with "
-            "the joint 3x3 blocks of the points (DIR/point_stiffness.csv)."
+            "the joint 3x3 blocks of the points (DIR/point_stiffness.csv); a Coupled body's "
+            "points get the body's own, about its reference point "
+            "(DIR/stiffness_body<k>.csv)."
         ),
     )
     statics.add_argument("file", metavar="FILE", type=_existing_file,
@@ -294,11 +297,8 @@ def _body_stiffness(result: Any, body: int, folder: Path) -> list[Path]:
     except ConvergenceError as exc:
         print(f"stiffness on body {body} not computed: {exc}", flush=True)
         return []
-    row = result.model.file.bodies[body - 1]
-    where = ", ".join(f"{c:g}" for c in row.position)
-    print(f"stiffness of the mooring on body {body}, about its reference point ({where}) m "
-          f"(N/m, N/rad; N m/m, N m/rad):", flush=True)
-    print(result.stiffness_table(row.position, k), flush=True)
+    reference = result.model.file.bodies[body - 1].position
+    _print_stiffness(result, f"body {body}, about its reference point", reference, k)
     return [result.stiffness_to_csv(folder / f"stiffness_body{body}.csv", k)]
 
 
@@ -317,13 +317,18 @@ def _stiffness(result: Any, reference: Any, folder: Path) -> list[Path]:
         return []
     paths = [result.point_stiffness_to_csv(folder / "point_stiffness.csv", joint)]
     if vessel is not None:
-        where = ", ".join(f"{c:g}" for c in reference)
-        print(f"stiffness of the mooring on a vessel carrying points "
-              f"{', '.join(map(str, own))}, about ({where}) m (N/m, N/rad; N m/m, N m/rad):",
-              flush=True)
-        print(result.stiffness_table(reference, vessel), flush=True)
+        carried = f"a vessel carrying points {', '.join(map(str, own))}, about"
+        _print_stiffness(result, carried, reference, vessel)
         paths.insert(0, result.stiffness_to_csv(folder / "stiffness.csv", vessel))
     return paths
+
+
+def _print_stiffness(result: Any, what: str, reference: Any, stiffness: Any) -> None:
+    """Print a 6x6 stiffness of the mooring on ``what`` about ``reference``, as a table."""
+    where = ", ".join(f"{c:g}" for c in reference)
+    print(f"stiffness of the mooring on {what} ({where}) m (N/m, N/rad; N m/m, N m/rad):",
+          flush=True)
+    print(result.stiffness_table(reference, stiffness), flush=True)
 
 
 def _run(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -176,10 +176,15 @@ class FileBody:
 
     def place(self, relative: tuple[float, float, float]) -> tuple[float, float, float]:
         """The position of the point at ``relative`` in the body's frame (m)."""
+        return self.place_all([relative])[0]
+
+    def place_all(self, relatives: Sequence[tuple[float, float, float]]
+                  ) -> list[tuple[float, float, float]]:
+        """:meth:`place` of each point at ``relatives``, the rotation computed once."""
         rows = self.rotation_matrix()
-        return tuple(  # type: ignore[return-value]
+        return [tuple(  # type: ignore[misc]
             self.position[i] + sum(rows[i][k] * relative[k] for k in range(3))
-            for i in range(3))
+            for i in range(3)) for relative in relatives]
 
 
 @dataclass(frozen=True)
@@ -306,6 +311,15 @@ class MoorDynFile:
             The coupled points' rows.
         """
         return [p for p in self.points if p.attachment == "coupled"]
+
+    def coupled_bodies(self) -> list[FileBody]:
+        """The Coupled bodies, in file order: their six degrees of freedom come first in
+        MoorDyn's coupled state and in a motion file.
+
+        Returns:
+            The coupled bodies' rows.
+        """
+        return [b for b in self.bodies if b.attachment == "coupled"]
 
 
 # --------------------------------------------------------------------------------------------

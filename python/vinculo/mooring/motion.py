@@ -38,7 +38,7 @@ from vinculo import laws
 from vinculo._core import Law
 from vinculo.errors import InvalidInputError
 
-__all__ = ["Motion", "read_motion"]
+__all__ = ["Motion", "read_motion", "still_motion"]
 
 
 class Motion:
@@ -80,10 +80,7 @@ class Motion:
         Returns:
             The flat array.
         """
-        poses = [[law(t) for law in pose] for pose in self.poses]
-        dofs = [v for pose in poses for v in (*pose[:3], *map(math.radians, pose[3:]))]
-        own = self.positions(t)[self.own].ravel() if self.own else np.empty(0)
-        return np.concatenate([np.asarray(dofs, dtype=float), own])
+        return self._dofs(t, rates=False)
 
     def coupled_dof_rates(self, t: float) -> np.ndarray:
         """The rates of :meth:`coupled_dofs` at time ``t`` (m/s; the angles' in rad/s).
@@ -94,9 +91,17 @@ class Motion:
         Returns:
             The flat array.
         """
-        rates = [[law.derivatives(t)[1] for law in pose] for pose in self.poses]
-        dofs = [v for pose in rates for v in (*pose[:3], *map(math.radians, pose[3:]))]
-        own = self.velocities(t)[self.own].ravel() if self.own else np.empty(0)
+        return self._dofs(t, rates=True)
+
+    def _dofs(self, t: float, rates: bool) -> np.ndarray:
+        """:meth:`coupled_dofs`, or their rates."""
+        def value(law: Law) -> float:
+            return law.derivatives(t)[1] if rates else law(t)
+
+        poses = [[value(law) for law in pose] for pose in self.poses]
+        dofs = [v for pose in poses for v in (*pose[:3], *map(math.radians, pose[3:]))]
+        points = self.velocities(t) if rates else self.positions(t)
+        own = points[self.own].ravel() if self.own else np.empty(0)
         return np.concatenate([np.asarray(dofs, dtype=float), own])
 
     @property
@@ -321,11 +326,12 @@ def read_motion(model: Any, path: str | Path) -> Motion:
             not match the file's coupled bodies and points.
     """
     path = Path(path)
-    bodies = [b for b in model.bodies if b.attachment == "coupled"]
+    bodies = model.coupled_bodies()
     if not bodies:
         return Motion.from_csv(path)
     header, values = _read_table(path)
-    own = [p for p in model.coupled_points() if p.body is None]
+    coupled = model.coupled_points()
+    own = [k for k, point in enumerate(coupled) if point.body is None]
     expected = 1 + 6 * len(bodies) + 3 * len(own)
     if len(header) != expected:
         raise InvalidInputError(
@@ -333,24 +339,43 @@ def read_motion(model: Any, path: str | Path) -> Motion:
             f"bodies and {len(own)} coupled points of their own: give time, then x, y, z, "
             f"roll, pitch, yaw (m, degrees) of each body, then x, y, z of each point "
             f"({expected} columns)", name="motion", value=len(header))
-    column = {b.id: 1 + 6 * k for k, b in enumerate(bodies)}
-    column.update({p.id: 1 + 6 * len(bodies) + 3 * k for k, p in enumerate(own)})
+    times = values[:, 0]
+    poses = values[:, 1:1 + 6 * len(bodies)].reshape(len(times), len(bodies), 6)
+    positions = np.empty((len(times), len(coupled), 3))
+    positions[:, own] = values[:, 1 + 6 * len(bodies):].reshape(len(times), len(own), 3)
+    for b, body in enumerate(bodies):
+        on = [k for k, point in enumerate(coupled) if point.body == body.id]
+        arms = [coupled[k].relative for k in on]
+        for r, pose in enumerate(poses[:, b]):
+            moved = dataclasses.replace(body, position=tuple(pose[:3]),
+                                        rotation=tuple(pose[3:]))
+            positions[r, on] = moved.place_all(arms)
+    motion = Motion.from_table(times, positions, source=str(path))
+    return _with_poses(motion, [[laws.tabulated(times, poses[:, b, j]) for j in range(6)]
+                                for b in range(len(bodies))], own)
+
+
+def still_motion(model: Any) -> Motion:
+    """The coupled points and bodies of a MoorDyn file where the file puts them, at rest.
+
+    Arguments:
+        model: the :class:`~vinculo.mooring.moordyn_file.MoorDynFile`.
+
+    Returns:
+        The motion (with the bodies' poses, as :func:`read_motion`'s).
+    """
     coupled = model.coupled_points()
-    positions = np.empty((values.shape[0], len(coupled), 3))
-    for k, point in enumerate(coupled):
-        if point.body is None:
-            positions[:, k] = values[:, column[point.id]:column[point.id] + 3]
-            continue
-        body = model.bodies[point.body - 1]
-        c = column[body.id]
-        for r, row in enumerate(values):
-            pose = dataclasses.replace(body, position=tuple(row[c:c + 3]),
-                                       rotation=tuple(row[c + 3:c + 6]))
-            positions[r, k] = pose.place(point.relative)
-    motion = Motion.from_table(values[:, 0], positions, source=str(path))
-    motion.poses = [tuple(laws.tabulated(values[:, 0], values[:, column[b.id] + j])
-                          for j in range(6)) for b in bodies]
-    motion.own = [k for k, point in enumerate(coupled) if point.body is None]
+    motion = Motion.still([p.position for p in coupled])
+    poses = [[laws.constant(v) for v in (*b.position, *b.rotation)]
+             for b in model.coupled_bodies()]
+    return _with_poses(motion, poses, [k for k, p in enumerate(coupled) if p.body is None])
+
+
+def _with_poses(motion: Motion, poses: Sequence[Sequence[Law]], own: list[int]) -> Motion:
+    """``motion`` with the coupled bodies' pose laws and the indices of the points not on a
+    body (:attr:`Motion.poses`, :attr:`Motion.own`)."""
+    motion.poses = [tuple(pose) for pose in poses]
+    motion.own = own
     return motion
 
 

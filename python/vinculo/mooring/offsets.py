@@ -152,8 +152,9 @@ def _direction(heading: float | None, direction: Any, axis: Any) -> np.ndarray:
 
 def _turn(axis: np.ndarray, degrees: float) -> np.ndarray:
     """The rotation matrix of ``degrees`` about the unit ``axis`` (Rodrigues)."""
-    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]],
-                  [-axis[1], axis[0], 0.0]])
+    from vinculo.mooring.analysis import _cross_matrix
+
+    k = _cross_matrix(axis)
     angle = math.radians(degrees)
     return np.eye(3) + math.sin(angle) * k + (1.0 - math.cos(angle)) * k @ k
 

@@ -199,15 +199,11 @@ def _coupled_motion(model: MoorDynFile, motion: Motion | None) -> Motion:
     """The motion of the model's coupled points (theirs at the file's positions, still, when
     None), checked against them; with coupled bodies, the bodies' poses too, which MoorDyn
     takes as six coupled degrees of freedom each."""
-    from vinculo import laws
+    from vinculo.mooring.motion import still_motion
 
-    coupled = model.coupled_points()
-    bodies = [b for b in model.bodies if b.attachment == "coupled"]
+    coupled, bodies = model.coupled_points(), model.coupled_bodies()
     if motion is None:
-        motion = Motion.still([p.position for p in coupled])
-        motion.poses = [tuple(laws.constant(v) for v in (*b.position, *b.rotation))
-                        for b in bodies]
-        motion.own = [k for k, p in enumerate(coupled) if p.body is None]
+        motion = still_motion(model)
     if motion.num_points != len(coupled):
         raise InvalidInputError(
             f"the motion moves {motion.num_points} points but the file has "

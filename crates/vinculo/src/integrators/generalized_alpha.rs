@@ -76,8 +76,9 @@ use crate::math::Vec3;
 /// for them several times (their divisions, twenty a step, took 8 % of a pendulum's step).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GeneralizedAlpha {
-    /// Spectral radius at infinite frequency (1: no numerical damping).
-    pub rho_inf: f64,
+    /// Spectral radius at infinite frequency (1: no numerical damping); private, as the
+    /// coefficients derived from it are kept beside it ([`GeneralizedAlpha::rho_inf`]).
+    rho_inf: f64,
     /// alpha_m, alpha_f, gamma and beta of rho_inf.
     k: AlphaCoefficients,
     /// The weights of [`Predictors`] that do not depend on the step: c_a, c_m and c_f.
@@ -233,6 +234,11 @@ impl GeneralizedAlpha {
             alpha_f / (1.0 - alpha_f),
         ];
         GeneralizedAlpha { rho_inf, k, ratios }
+    }
+
+    /// Spectral radius at infinite frequency (1: no numerical damping).
+    pub fn rho_inf(&self) -> f64 {
+        self.rho_inf
     }
 
     /// The coefficients alpha_m, alpha_f, gamma, beta (see the module documentation).
